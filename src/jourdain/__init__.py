@@ -1,0 +1,58 @@
+"""jourdain: multibody dynamics by Schiehlen's Newton–Euler projection method.
+
+Describe a :class:`System` of rigid bodies, joints and force elements, then run the stages
+:func:`kinematics` → :func:`newton_euler` → :func:`projection` to get M̄, J̄, q̄^c, q̄^e and the
+equations of motion M·ÿ + k = q.
+"""
+
+from .errors import EvaluationError, JourdainError, ModelError, SingularMassMatrix
+from .kinematics import BodyKinematics, Kinematics, kinematics
+from .model import (
+    WORLD,
+    Body,
+    Cylindrical,
+    Fixed,
+    Force,
+    Free,
+    General,
+    GeneralizedForce,
+    Gravity,
+    Joint,
+    Planar,
+    Prismatic,
+    Revolute,
+    Rot,
+    RotationalSpringDamper,
+    Spherical,
+    SpringDamper,
+    System,
+    Torque,
+    Trans,
+    Universal,
+    acceleration,
+    box,
+    cylinder,
+    disc,
+    elongation,
+    elongation_d,
+    point_mass,
+    rate,
+    rod,
+    symbols,
+    t,
+)
+from .newton_euler import NewtonEuler, newton_euler
+from .projection import EquationsOfMotion, projection
+from .symbolic import SymMatrix
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "EvaluationError", "JourdainError", "ModelError", "SingularMassMatrix",
+    "BodyKinematics", "Kinematics", "kinematics", "NewtonEuler", "newton_euler",
+    "EquationsOfMotion", "projection", "SymMatrix",
+    "WORLD", "Body", "Cylindrical", "Fixed", "Force", "Free", "General", "GeneralizedForce",
+    "Gravity", "Joint", "Planar", "Prismatic", "Revolute", "Rot", "RotationalSpringDamper",
+    "Spherical", "SpringDamper", "System", "Torque", "Trans", "Universal", "acceleration", "box",
+    "cylinder", "disc", "elongation", "elongation_d", "point_mass", "rate", "rod", "symbols", "t",
+]

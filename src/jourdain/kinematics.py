@@ -1,0 +1,328 @@
+"""Kinematics of every body (METHOD.md §1): r, S, ω, J_T, J_R, v̄, ω̄, ā, ᾱ.
+
+Conventions
+-----------
+* Translational quantities (``r``, ``J_T``, ``v_bar``, ``a_bar``) are in the **inertial frame**.
+* Rotational quantities (``omega``, ``J_R``, ``omega_bar``, ``alpha_bar``) are in the **body
+  frame**, where the inertia tensor is constant.
+* ``S`` turns body-frame components into inertial ones: ``x_inertial = S · x_body``.
+
+So ``v = J_T·ẏ + v̄`` (inertial) and ``ω = J_R·ẏ + ω̄`` (body frame), and likewise
+``a = J_T·ÿ + ā``, ``α = J_R·ÿ + ᾱ``.
+
+Method
+------
+The quantities are built *recursively* along the tree, one elementary transformation at a time
+(as in recursive Newton–Euler algorithms), never by differentiating the composed position
+vectors. Each new expression refers to the previous ones, so the result is a shared expression
+graph whose size grows linearly with the depth of the tree instead of exponentially. Only the
+angles and distances of the elementary steps (short user expressions) are differentiated.
+Consecutive rotations about the same fixed axis are merged into one angle, so a planar chain
+measured with absolute angles gives ``S = R_z(q_i)`` rather than a product of rotations.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from types import MappingProxyType
+from typing import TYPE_CHECKING
+
+import symengine as se
+
+from .model.forces import acceleration, rate
+from .model.joints import IDENTITY, Mat3, Rot, Trans, Vec3, rotation_matrix
+from .symbolic import SymMatrix
+
+if TYPE_CHECKING:
+    from .model.system import System
+
+ZERO = se.Integer(0)
+Z3: Vec3 = (ZERO, ZERO, ZERO)
+
+
+# --- small vector helpers on 3-tuples of SymEngine expressions ---------------------------------
+def _add(a: Vec3, b: Vec3) -> Vec3:
+    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
+
+
+def _scale(a: Vec3, s: se.Basic) -> Vec3:
+    return (a[0] * s, a[1] * s, a[2] * s)
+
+
+def _cross(a: Vec3, b: Vec3) -> Vec3:
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def _dot(a: Vec3, b: Vec3) -> se.Basic:
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def _mv(A: Mat3, v: Vec3) -> Vec3:
+    """A·v"""
+    return (
+        A[0][0] * v[0] + A[0][1] * v[1] + A[0][2] * v[2],
+        A[1][0] * v[0] + A[1][1] * v[1] + A[1][2] * v[2],
+        A[2][0] * v[0] + A[2][1] * v[1] + A[2][2] * v[2],
+    )
+
+
+def _mtv(A: Mat3, v: Vec3) -> Vec3:
+    """Aᵀ·v"""
+    return (
+        A[0][0] * v[0] + A[1][0] * v[1] + A[2][0] * v[2],
+        A[0][1] * v[0] + A[1][1] * v[1] + A[2][1] * v[2],
+        A[0][2] * v[0] + A[1][2] * v[1] + A[2][2] * v[2],
+    )
+
+
+def _mm(A: Mat3, B: Mat3) -> Mat3:
+    return tuple(
+        tuple(A[i][0] * B[0][j] + A[i][1] * B[1][j] + A[i][2] * B[2][j] for j in range(3))
+        for i in range(3)
+    )  # type: ignore[return-value]
+
+
+def _is_zero(v: Vec3) -> bool:
+    return v[0] == 0 and v[1] == 0 and v[2] == 0
+
+
+@dataclass
+class _Frame:
+    """State of a moving frame during the recursion (mutable scratch, never returned)."""
+
+    S: Mat3 = IDENTITY
+    identity: bool = True
+    axis: tuple[Vec3, se.Basic] | None = None  # all rotations so far about this fixed axis
+    r: Vec3 = Z3
+    JT: dict[int, Vec3] = field(default_factory=dict)
+    v_bar: Vec3 = Z3
+    a_bar: Vec3 = Z3
+    JR: dict[int, Vec3] = field(default_factory=dict)
+    omega: Vec3 = Z3
+    omega_bar: Vec3 = Z3
+    alpha_bar: Vec3 = Z3
+
+    def copy(self) -> _Frame:
+        return _Frame(self.S, self.identity, self.axis, self.r, dict(self.JT), self.v_bar,
+                      self.a_bar, dict(self.JR), self.omega, self.omega_bar, self.alpha_bar)
+
+
+class _Rates:
+    """Time derivatives of a scalar expression s(y, t) of the elementary steps."""
+
+    __slots__ = ("dy", "dt", "d1", "d2_local")
+
+    def __init__(self, s: se.Basic, ctx: _Context) -> None:
+        idx = ctx.index.get(s) if isinstance(s, se.Symbol) else None
+        if idx is not None:  # s is a coordinate itself
+            self.dy = {idx: se.Integer(1)}
+            self.dt = ZERO
+            self.d1 = ctx.yd[idx]
+            self.d2_local = ZERO
+            return
+        free = s.free_symbols
+        self.dy = {}
+        for sym in free:
+            j = ctx.index.get(sym)
+            if j is not None:
+                self.dy[j] = se.diff(s, sym)
+        self.dt = se.diff(s, ctx.t) if ctx.t in free else ZERO
+        self.d1 = sum((c * ctx.yd[j] for j, c in self.dy.items()), self.dt)
+        # d²s/dt² without the ÿ terms: d/dt of ṡ at constant ÿ
+        d2 = se.diff(self.d1, ctx.t) if (ctx.t in free) else ZERO
+        for sym in free:
+            j = ctx.index.get(sym)
+            if j is not None:
+                d2 = d2 + se.diff(self.d1, sym) * ctx.yd[j]
+        self.d2_local = d2
+
+    @property
+    def constant(self) -> bool:
+        return not self.dy and self.dt == 0
+
+
+@dataclass
+class _Context:
+    index: dict[se.Symbol, int]
+    yd: tuple[se.Symbol, ...]
+    t: se.Symbol
+
+
+def _rotate(F: _Frame, u: Vec3, angle: se.Basic, ctx: _Context) -> None:
+    """Apply the elementary rotation about u (current frame) by ``angle``."""
+    if angle == 0:
+        return
+    rt = _Rates(angle, ctx)
+    A = rotation_matrix(u, angle)
+    # orientation, merging rotations about one fixed axis into a single angle
+    if F.identity:
+        F.S, F.axis = A, (u, angle)
+    elif F.axis is not None and F.axis[0] == u:
+        theta = F.axis[1] + angle
+        F.S, F.axis = rotation_matrix(u, theta), (u, theta)
+    else:
+        F.S, F.axis = _mm(F.S, A), None
+    F.identity = False
+    # angular velocity and acceleration in the new frame: ω' = Aᵀ(ω + u·θ̇)
+    keys = set(F.JR) | set(rt.dy)
+    F.JR = {
+        j: _mtv(A, _add(F.JR.get(j, Z3), _scale(u, rt.dy[j])) if j in rt.dy else F.JR[j])
+        for j in keys
+    }
+    F.omega_bar = _mtv(A, _add(F.omega_bar, _scale(u, rt.dt)))
+    w_rel = _scale(u, rt.d1)
+    F.alpha_bar = _mtv(A, _add(_add(F.alpha_bar, _scale(u, rt.d2_local)), _cross(F.omega, w_rel)))
+    F.omega = _mtv(A, _add(F.omega, w_rel))
+
+
+def _reorient(F: _Frame, R0: Mat3) -> None:
+    """Apply a constant change of axes R0 (new axes in current-frame components)."""
+    if R0 == IDENTITY:
+        return
+    F.S = R0 if F.identity else _mm(F.S, R0)
+    F.identity, F.axis = False, None
+    F.JR = {j: _mtv(R0, c) for j, c in F.JR.items()}
+    F.omega, F.omega_bar, F.alpha_bar = (_mtv(R0, F.omega), _mtv(R0, F.omega_bar),
+                                         _mtv(R0, F.alpha_bar))
+
+
+def _translate(F: _Frame, d: Vec3, ctx: _Context) -> None:
+    """Apply the elementary translation by the vector d(y, t) given in the current frame."""
+    if _is_zero(d):
+        return
+    rates = [_Rates(c, ctx) for c in d]
+    S = F.S
+    toI = (lambda v: v) if F.identity else (lambda v: _mv(S, v))
+    F.r = _add(F.r, toI(d))
+    keys = set(F.JT) | set(F.JR) | {j for rt in rates for j in rt.dy}
+    newJT = {}
+    for j in keys:
+        local = Z3
+        if j in F.JR:
+            local = _cross(F.JR[j], d)
+        dj = tuple(rt.dy.get(j, ZERO) for rt in rates)
+        if not _is_zero(dj):  # type: ignore[arg-type]
+            local = _add(local, dj)  # type: ignore[arg-type]
+        col = F.JT.get(j, Z3)
+        newJT[j] = _add(col, toI(local)) if not _is_zero(local) else col
+    F.JT = newJT
+    d_t: Vec3 = tuple(rt.dt for rt in rates)  # type: ignore[assignment]
+    d_1: Vec3 = tuple(rt.d1 for rt in rates)  # type: ignore[assignment]
+    d_2: Vec3 = tuple(rt.d2_local for rt in rates)  # type: ignore[assignment]
+    F.v_bar = _add(F.v_bar, toI(_add(_cross(F.omega_bar, d), d_t)))
+    acc = _add(_cross(F.alpha_bar, d), _cross(F.omega, _cross(F.omega, d)))
+    if not _is_zero(d_1):
+        acc = _add(acc, _add(_scale(_cross(F.omega, d_1), se.Integer(2)), d_2))
+    F.a_bar = _add(F.a_bar, toI(acc))
+
+
+@dataclass(frozen=True)
+class BodyKinematics:
+    """Kinematics of one body (fields named as in METHOD.md §1).
+
+    ``r`` (3×1, inertial): centre of mass; ``S`` (3×3): body → inertial; ``omega`` (3×1, body
+    frame): angular velocity ``J_R·ẏ + ω̄`` as an expression in y, ẏ, t; ``J_T`` (3×f, inertial),
+    ``J_R`` (3×f, body frame); ``v_bar``, ``a_bar`` (inertial), ``omega_bar``, ``alpha_bar``
+    (body frame). ``r_O``, ``J_T_O``, ``v_bar_O``, ``a_bar_O``: the same for the body frame's
+    origin (the joint point), used for points on the body.
+    """
+
+    name: str
+    r: SymMatrix
+    S: SymMatrix
+    omega: SymMatrix
+    J_T: SymMatrix
+    J_R: SymMatrix
+    v_bar: SymMatrix
+    omega_bar: SymMatrix
+    a_bar: SymMatrix
+    alpha_bar: SymMatrix
+    r_O: SymMatrix
+    J_T_O: SymMatrix
+    v_bar_O: SymMatrix
+    a_bar_O: SymMatrix
+    # sparse columns (coordinate index -> 3-vector) of J_T, J_R, J_T_O for the fast stages
+    cols_T: MappingProxyType = field(repr=False, compare=False)
+    cols_R: MappingProxyType = field(repr=False, compare=False)
+    cols_T_O: MappingProxyType = field(repr=False, compare=False)
+
+    def point(self, p: Vec3) -> tuple[Vec3, dict[int, Vec3], Vec3, Vec3]:
+        """Position, J_T columns, v̄ and ā (inertial) of the point ``p`` (body-frame, from the
+        body frame's origin)."""
+        S = _mat(self.S)
+        Sp = _mv(S, p)
+        r = _add(_vec(self.r_O), Sp)
+        cols = dict(self.cols_T_O)
+        for j, c in self.cols_R.items():
+            extra = _mv(S, _cross(c, p))
+            cols[j] = _add(cols.get(j, Z3), extra)
+        w, wb, ab = _vec(self.omega), _vec(self.omega_bar), _vec(self.alpha_bar)
+        v_bar = _add(_vec(self.v_bar_O), _mv(S, _cross(wb, p)))
+        a_bar = _add(_vec(self.a_bar_O), _mv(S, _add(_cross(ab, p), _cross(w, _cross(w, p)))))
+        return r, cols, v_bar, a_bar
+
+
+def _vec(m: SymMatrix) -> Vec3:
+    return (m.rows[0][0], m.rows[1][0], m.rows[2][0])
+
+
+def _mat(m: SymMatrix) -> Mat3:
+    return m.rows  # type: ignore[return-value]
+
+
+def _dense(cols: dict[int, Vec3], f: int) -> SymMatrix:
+    return SymMatrix(tuple(tuple(cols[j][i] if j in cols else ZERO for j in range(f))
+                           for i in range(3)))
+
+
+@dataclass(frozen=True)
+class Kinematics:
+    """Result of :func:`kinematics`: one :class:`BodyKinematics` per body, in tree order."""
+
+    system: System
+    bodies: tuple[BodyKinematics, ...]
+    y: tuple[se.Symbol, ...]
+    yd: tuple[se.Symbol, ...]
+    ydd: tuple[se.Symbol, ...]
+    t: se.Symbol
+
+    def __getitem__(self, name: str) -> BodyKinematics:
+        for b in self.bodies:
+            if b.name == name:
+                return b
+        self.system.body(name)  # raises ModelError naming the body
+        raise KeyError(name)
+
+
+def kinematics(system: System) -> Kinematics:
+    """Kinematics of every body of ``system`` (METHOD.md §1), built recursively along the tree."""
+    y = system.coordinates
+    ctx = _Context({c: i for i, c in enumerate(y)}, tuple(rate(c) for c in y), system.t)
+    f = len(y)
+    frames: dict[str, _Frame] = {"world": _Frame()}
+    out = []
+    for body in system.bodies:
+        F = frames[body.parent].copy()
+        j = body.joint
+        # joint frame on the parent, then the joint's elementary transformations
+        _translate(F, j.position, ctx)
+        _reorient(F, j.orientation)
+        for step in j.steps:
+            if isinstance(step, Rot):
+                _rotate(F, step.axis, step.angle, ctx)
+            elif isinstance(step, Trans):
+                _translate(F, step.vector, ctx)
+        frames[body.name] = F
+        # centre of mass
+        C = F.copy()
+        _translate(C, body.com, ctx)
+        col = SymMatrix.column
+        out.append(BodyKinematics(
+            name=body.name, r=col(C.r), S=SymMatrix.from_rows(F.S), omega=col(F.omega),
+            J_T=_dense(C.JT, f), J_R=_dense(F.JR, f), v_bar=col(C.v_bar),
+            omega_bar=col(F.omega_bar), a_bar=col(C.a_bar), alpha_bar=col(F.alpha_bar),
+            r_O=col(F.r), J_T_O=_dense(F.JT, f), v_bar_O=col(F.v_bar), a_bar_O=col(F.a_bar),
+            cols_T=MappingProxyType(C.JT), cols_R=MappingProxyType(F.JR),
+            cols_T_O=MappingProxyType(F.JT),
+        ))
+    return Kinematics(system, tuple(out), y, ctx.yd, tuple(acceleration(c) for c in y), system.t)

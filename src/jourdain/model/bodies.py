@@ -1,0 +1,136 @@
+"""Rigid bodies and helpers for the inertia of common shapes.
+
+A body's frame is the frame its joint ends in; the centre of mass ``com`` and the inertia tensor
+``inertia`` (about the centre of mass) are given in that body frame, so they are constant.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import symengine as se
+
+from ..errors import ModelError
+from .expressions import Expr, as_expr, as_matrix3, as_vector
+from .joints import Joint, Mat3, Vec3
+
+WORLD = "world"
+
+_ZERO = se.Integer(0)
+
+
+@dataclass(frozen=True)
+class Body:
+    """A rigid body hanging from ``parent`` (a body name or ``"world"``) through ``joint``.
+
+    Parameters
+    ----------
+    name : str
+    parent : str
+        Name of the parent body, or ``"world"`` for the inertial frame.
+    joint : Joint
+    mass : expression
+        May be zero only for massless frames (then ``inertia`` must be zero as well).
+    com : 3-vector
+        Centre of mass in the body frame.
+    inertia : 3x3 matrix or 3-vector
+        Inertia tensor about the centre of mass in the body frame; a 3-vector gives its
+        diagonal (principal moments). Zero for point masses.
+    """
+
+    name: str
+    parent: str
+    joint: Joint
+    mass: Expr
+    com: Vec3
+    inertia: Mat3
+
+    def __init__(self, name: str, parent: str, joint: Joint, mass: object = None,
+                 com: object = (0, 0, 0), inertia: object = None) -> None:
+        if not isinstance(name, str) or not name.isidentifier():
+            raise ModelError(f"body name {name!r} must be an identifier")
+        if name == WORLD:
+            raise ModelError(f'body name "{WORLD}" is reserved for the inertial frame')
+        if not isinstance(parent, str):
+            raise ModelError(f'body "{name}": parent must be a body name or "world"')
+        if not isinstance(joint, Joint):
+            raise ModelError(f'body "{name}": joint must be a Joint, got {type(joint).__name__}')
+        if mass is None:
+            raise ModelError(f'body "{name}": mass is missing')
+        m = as_expr(mass, f'body "{name}" mass')
+        c = as_vector(com, f'body "{name}" com')
+        if inertia is None:
+            raise ModelError(
+                f'body "{name}": inertia is missing (use zeros for a point mass, or the helpers '
+                "point_mass, rod, disc, cylinder, box)"
+            )
+        if isinstance(inertia, list | tuple) and len(inertia) == 3 and not isinstance(
+            inertia[0], list | tuple
+        ):
+            d = as_vector(inertia, f'body "{name}" inertia')
+            I = ((d[0], _ZERO, _ZERO), (_ZERO, d[1], _ZERO), (_ZERO, _ZERO, d[2]))
+        else:
+            I = as_matrix3(inertia, f'body "{name}" inertia')
+        for i in range(3):
+            for j in range(i + 1, 3):
+                if se.expand(I[i][j] - I[j][i]) != 0:
+                    raise ModelError(
+                        f'body "{name}": inertia tensor is not symmetric '
+                        f"(I[{i},{j}] = {I[i][j]} but I[{j},{i}] = {I[j][i]})"
+                    )
+        object.__setattr__(self, "name", name)
+        object.__setattr__(self, "parent", parent)
+        object.__setattr__(self, "joint", joint)
+        object.__setattr__(self, "mass", m)
+        object.__setattr__(self, "com", c)
+        object.__setattr__(self, "inertia", I)
+
+    @property
+    def has_inertia(self) -> bool:
+        """False for point masses and massless frames (inertia tensor identically zero)."""
+        return any(x != 0 for row in self.inertia for x in row)
+
+
+def _diag(a: object, b: object, c: object) -> Mat3:
+    A, B, C = (as_expr(v, "inertia") for v in (a, b, c))
+    return ((A, _ZERO, _ZERO), (_ZERO, B, _ZERO), (_ZERO, _ZERO, C))
+
+
+def point_mass() -> Mat3:
+    """Inertia tensor of a point mass: zero."""
+    return _diag(0, 0, 0)
+
+
+def rod(mass: object, length: object, axis: str = "x") -> Mat3:
+    """Thin rod of given length along ``axis``, about its centre: m l²/12 across, 0 along."""
+    m, l = as_expr(mass, "rod mass"), as_expr(length, "rod length")
+    J = m * l**2 / 12
+    return _axis_diag(axis, 0, J, "rod")
+
+
+def disc(mass: object, radius: object, axis: str = "z") -> Mat3:
+    """Thin disc with symmetry ``axis``: m r²/2 about the axis, m r²/4 across."""
+    m, r = as_expr(mass, "disc mass"), as_expr(radius, "disc radius")
+    return _axis_diag(axis, m * r**2 / 2, m * r**2 / 4, "disc")
+
+
+def cylinder(mass: object, radius: object, length: object, axis: str = "z") -> Mat3:
+    """Solid cylinder with symmetry ``axis``: m r²/2 along, m (3 r² + l²)/12 across."""
+    m = as_expr(mass, "cylinder mass")
+    r, l = as_expr(radius, "cylinder radius"), as_expr(length, "cylinder length")
+    return _axis_diag(axis, m * r**2 / 2, m * (3 * r**2 + l**2) / 12, "cylinder")
+
+
+def box(mass: object, a: object, b: object, c: object) -> Mat3:
+    """Solid cuboid with edge lengths a, b, c along x, y, z."""
+    m = as_expr(mass, "box mass")
+    a, b, c = (as_expr(v, "box edge") for v in (a, b, c))
+    return _diag(m * (b**2 + c**2) / 12, m * (a**2 + c**2) / 12, m * (a**2 + b**2) / 12)
+
+
+def _axis_diag(axis: str, along: object, across: object, what: str) -> Mat3:
+    if axis not in ("x", "y", "z"):
+        raise ModelError(f"{what}: axis must be x, y or z, got {axis!r}")
+    d = [across, across, across]
+    d["xyz".index(axis)] = along
+    return _diag(*d)

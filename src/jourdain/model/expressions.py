@@ -1,0 +1,129 @@
+"""Conversion of user input (numbers, SymPy or SymEngine expressions) into SymEngine expressions.
+
+Strings are *not* accepted here: model files go through jourdain's own restricted parser
+(:mod:`jourdain.io`), and Python users build expressions from symbols, so nothing is ever
+parsed or evaluated as code.
+"""
+
+from __future__ import annotations
+
+import numbers
+from collections.abc import Iterable, Sequence
+
+import symengine as se
+
+from ..errors import ModelError
+
+Expr = se.Basic
+
+#: time, shared by every model
+t = se.Symbol("t")
+
+
+def symbols(names: str) -> tuple[se.Symbol, ...] | se.Symbol:
+    """Create SymEngine symbols from a space- or comma-separated string of names.
+
+    >>> phi1, phi2 = symbols("phi1 phi2")
+    """
+    parts = [p for p in names.replace(",", " ").split() if p]
+    for p in parts:
+        if not p.isidentifier():
+            raise ModelError(f"symbol name {p!r} is not a valid identifier")
+    syms = tuple(se.Symbol(p) for p in parts)
+    return syms[0] if len(syms) == 1 else syms
+
+
+def as_expr(value: object, where: str) -> Expr:
+    """Convert a number or a SymPy/SymEngine expression to a SymEngine expression.
+
+    ``where`` names the model element for the error message.
+    """
+    if isinstance(value, se.Basic):
+        return value
+    if isinstance(value, bool):
+        raise ModelError(f"{where}: expected a number or an expression, got a bool {value!r}")
+    if isinstance(value, numbers.Integral):
+        return se.Integer(int(value))
+    if isinstance(value, numbers.Real):
+        v = float(value)
+        if v != v or v in (float("inf"), float("-inf")):
+            raise ModelError(f"{where}: value {value!r} is not finite")
+        # keep exact rationals for simple decimal numbers such as 0.5
+        return se.Float(v) if v != int(v) else se.Integer(int(v))
+    # SymPy expressions (duck-typed: do not import sympy on the hot path)
+    if hasattr(value, "free_symbols") and hasattr(value, "subs") and not isinstance(value, str):
+        try:
+            return se.sympify(value)
+        except Exception as exc:  # noqa: BLE001 - conversion failure reported with context
+            raise ModelError(f"{where}: cannot convert {value!r} to SymEngine: {exc}") from exc
+    raise ModelError(
+        f"{where}: expected a number or a SymPy/SymEngine expression, got {type(value).__name__} "
+        f"{value!r}"
+    )
+
+
+def as_vector(value: object, where: str, n: int = 3) -> tuple[Expr, ...]:
+    """Convert an n-sequence (or an axis name 'x', 'y', 'z', '-x', ...) to a tuple of expressions."""
+    if isinstance(value, str):
+        return axis_vector(value, where)
+    if hasattr(value, "shape") and not isinstance(value, se.Basic):
+        try:
+            value = list(value.reshape(-1)) if hasattr(value, "reshape") else list(value)
+        except Exception:  # noqa: BLE001
+            value = list(value)  # type: ignore[arg-type]
+    if not isinstance(value, Iterable):
+        raise ModelError(f"{where}: expected a {n}-vector, got {value!r}")
+    items = list(value)  # type: ignore[arg-type]
+    if len(items) != n:
+        raise ModelError(f"{where}: expected a {n}-vector, got {len(items)} components")
+    return tuple(as_expr(v, f"{where}[{i}]") for i, v in enumerate(items))
+
+
+_AXES = {"x": (1, 0, 0), "y": (0, 1, 0), "z": (0, 0, 1)}
+
+
+def axis_vector(value: object, where: str) -> tuple[Expr, ...]:
+    """An axis given as 'x', 'y', 'z' (optionally with a sign) or a 3-vector of unit length."""
+    if isinstance(value, str):
+        s = value.strip().lower()
+        sign = -1 if s.startswith("-") else 1
+        s = s.lstrip("+-")
+        if s not in _AXES:
+            raise ModelError(
+                f"{where}: expected one of x, y, z or a 3-vector, got {value!r}"
+            )
+        return tuple(se.Integer(sign * c) for c in _AXES[s])
+    vec = as_vector(value, where)
+    free = set().union(*(v.free_symbols for v in vec))
+    if not free:
+        norm2 = sum(float(v) ** 2 for v in vec)
+        if abs(norm2 - 1.0) > 1e-12:
+            if norm2 == 0.0:
+                raise ModelError(f"{where}: axis must not be the zero vector")
+            raise ModelError(f"{where}: axis {tuple(float(v) for v in vec)} is not a unit vector")
+    return vec
+
+
+def as_matrix3(value: object, where: str) -> tuple[tuple[Expr, ...], ...]:
+    """A 3x3 matrix from nested sequences (or a SymPy/NumPy matrix)."""
+    try:
+        rows = [list(value[i]) if not hasattr(value, "shape") else [value[i, j] for j in range(3)]  # type: ignore[index]
+                for i in range(3)]
+    except Exception as exc:  # noqa: BLE001
+        raise ModelError(f"{where}: expected a 3x3 matrix, got {value!r}") from exc
+    if any(len(r) != 3 for r in rows):
+        raise ModelError(f"{where}: expected a 3x3 matrix")
+    try:
+        if len(value) != 3 and not hasattr(value, "shape"):  # type: ignore[arg-type]
+            raise ModelError(f"{where}: expected a 3x3 matrix")
+    except TypeError:
+        pass
+    return tuple(tuple(as_expr(rows[i][j], f"{where}[{i},{j}]") for j in range(3)) for i in range(3))
+
+
+def free_names(exprs: Sequence[Expr]) -> set[str]:
+    """Names of the free symbols of some expressions."""
+    out: set[str] = set()
+    for e in exprs:
+        out.update(str(s) for s in e.free_symbols)
+    return out

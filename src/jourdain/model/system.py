@@ -1,0 +1,351 @@
+"""The immutable, validated model: coordinates, parameters, inputs, bodies and force elements."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import symengine as se
+
+from ..errors import ModelError
+from .bodies import WORLD, Body
+from .expressions import as_expr, free_names, t
+from .forces import (
+    RESERVED,
+    Force,
+    ForceElement,
+    GeneralizedForce,
+    Gravity,
+    SpringDamper,
+    Torque,
+    acceleration,
+    elongation,
+    elongation_d,
+    rate,
+)
+
+if TYPE_CHECKING:
+    from ..kinematics import Kinematics
+    from ..newton_euler import NewtonEuler
+    from ..projection import EquationsOfMotion
+
+
+def _symbol_list(items: Iterable[object] | str, what: str) -> tuple[se.Symbol, ...]:
+    if isinstance(items, str):
+        items = items.replace(",", " ").split()
+    out = []
+    for it in items:
+        s = se.Symbol(it) if isinstance(it, str) else as_expr(it, what)
+        if not isinstance(s, se.Symbol):
+            raise ModelError(f"{what}: expected a symbol or a name, got {it!r}")
+        if not str(s).isidentifier():
+            raise ModelError(f"{what}: {str(s)!r} is not a valid name")
+        out.append(s)
+    return tuple(out)
+
+
+@dataclass(frozen=True, eq=True)
+class System:
+    """A multibody system of rigid bodies in a tree of joints (immutable once built).
+
+    Parameters
+    ----------
+    coordinates : sequence of symbols or names
+        The generalized coordinates ``y`` (f of them). Their rates are named ``<name>_d``.
+    bodies : sequence of Body
+        Each hangs from ``"world"`` or from another body through its joint.
+    forces : sequence of force elements
+        Gravity, Force, Torque, SpringDamper, GeneralizedForce (RotationalSpringDamper).
+    parameters : mapping name -> default value
+        Every symbol in the model other than coordinates, rates, inputs and ``t``.
+    inputs : sequence of symbols or names
+        Input symbols ``u`` (actuator forces, excitations), given as functions of time when
+        simulating.
+    units : mapping name -> unit string, optional
+        Units of parameters and coordinates, for reports.
+    name : str
+    """
+
+    coordinates: tuple[se.Symbol, ...]
+    bodies: tuple[Body, ...]
+    forces: tuple[ForceElement, ...]
+    parameters: tuple[tuple[str, float], ...]
+    inputs: tuple[se.Symbol, ...]
+    units: tuple[tuple[str, str], ...]
+    name: str
+
+    def __init__(self, coordinates: Sequence[object] | str, bodies: Sequence[Body],
+                 forces: Sequence[ForceElement] = (), parameters: Mapping[str, float] | None = None,
+                 inputs: Sequence[object] | str = (), units: Mapping[str, str] | None = None,
+                 name: str = "system") -> None:
+        y = _symbol_list(coordinates, "coordinates")
+        u = _symbol_list(inputs, "inputs")
+        params = dict(parameters or {})
+        set_ = object.__setattr__
+        set_(self, "name", str(name))
+        set_(self, "coordinates", y)
+        set_(self, "inputs", u)
+        pvals: list[tuple[str, float]] = []
+        for k, v in params.items():
+            if not isinstance(k, str) or not k.isidentifier():
+                raise ModelError(f"parameter name {k!r} must be an identifier")
+            try:
+                fv = float(v)
+            except (TypeError, ValueError):
+                raise ModelError(f'parameter "{k}": value must be a number, got {v!r}') from None
+            if not math.isfinite(fv):
+                raise ModelError(f'parameter "{k}": value {v!r} is not finite')
+            pvals.append((k, fv))
+        set_(self, "parameters", tuple(pvals))
+        set_(self, "units", tuple((str(k), str(v)) for k, v in (units or {}).items()))
+        bodies = list(bodies)
+        for b in bodies:
+            if not isinstance(b, Body):
+                raise ModelError(f"bodies: expected Body objects, got {type(b).__name__} {b!r}")
+        forces = list(forces)
+        for f in forces:
+            if not isinstance(f, Gravity | Force | Torque | SpringDamper | GeneralizedForce):
+                raise ModelError(f"forces: expected force elements, got {type(f).__name__} {f!r}")
+        set_(self, "bodies", _tree_order(bodies))
+        set_(self, "forces", tuple(forces))
+        _validate(self)
+
+    # --- names and symbols -------------------------------------------------------------------
+    @property
+    def y(self) -> tuple[se.Symbol, ...]:
+        """Generalized coordinates y."""
+        return self.coordinates
+
+    @property
+    def yd(self) -> tuple[se.Symbol, ...]:
+        """Symbols of the rates ẏ (``<name>_d``)."""
+        return tuple(rate(c) for c in self.coordinates)
+
+    @property
+    def ydd(self) -> tuple[se.Symbol, ...]:
+        """Symbols of the accelerations ÿ (``<name>_dd``)."""
+        return tuple(acceleration(c) for c in self.coordinates)
+
+    @property
+    def t(self) -> se.Symbol:
+        return t
+
+    @property
+    def f(self) -> int:
+        """Number of degrees of freedom."""
+        return len(self.coordinates)
+
+    @property
+    def coordinate_names(self) -> list[str]:
+        return [str(c) for c in self.coordinates]
+
+    @property
+    def input_names(self) -> list[str]:
+        return [str(c) for c in self.inputs]
+
+    @property
+    def parameter_values(self) -> dict[str, float]:
+        """Default numeric values of the parameters (a fresh dict)."""
+        return dict(self.parameters)
+
+    @property
+    def parameter_symbols(self) -> tuple[se.Symbol, ...]:
+        return tuple(se.Symbol(k) for k, _ in self.parameters)
+
+    @property
+    def body_names(self) -> list[str]:
+        return [b.name for b in self.bodies]
+
+    def body(self, name: str) -> Body:
+        """The body called ``name`` (ModelError if there is none)."""
+        for b in self.bodies:
+            if b.name == name:
+                return b
+        raise ModelError(f'unknown body "{name}"; bodies are: {", ".join(self.body_names)}')
+
+    # --- the stages, for convenience -------------------------------------------------------
+    def kinematics(self) -> Kinematics:
+        """Kinematics of every body (METHOD §1); see :func:`jourdain.kinematics.kinematics`."""
+        from ..kinematics import kinematics
+
+        return kinematics(self)
+
+    def newton_euler(self) -> NewtonEuler:
+        """Newton–Euler equations M̄·J̄·ÿ + q̄^c = q̄^e + Q̄·g (METHOD §2)."""
+        from ..newton_euler import newton_euler
+
+        return newton_euler(self.kinematics())
+
+    def equations_of_motion(self) -> EquationsOfMotion:
+        """Equations of motion M·ÿ + k = q by projection with J̄ᵀ (METHOD §3)."""
+        from ..projection import projection
+
+        return projection(self.newton_euler())
+
+    def evaluate(self, y: Any, yd: Any, t: float = 0.0, parameters: Mapping[str, float] | None = None,
+                 inputs: Mapping[str, float] | Sequence[float] | None = None) -> dict[str, np.ndarray]:
+        """Numbers at one state: a dict from the seed's names to NumPy arrays.
+
+        Keys: ``M_bar, J_bar, q_c, q_e, M, k, q``. ``parameters`` overrides default values by
+        name; ``inputs`` gives the inputs by name (or in the order of :attr:`input_names`).
+        """
+        from ..numeric import evaluate
+
+        return evaluate(self, y, yd, t=t, parameters=parameters, inputs=inputs)
+
+    def __repr__(self) -> str:
+        return (f"System({self.name!r}: {len(self.bodies)} bodies, f={self.f}, "
+                f"coordinates={self.coordinate_names}, parameters={list(dict(self.parameters))}, "
+                f"inputs={self.input_names})")
+
+
+def _tree_order(bodies: list[Body]) -> tuple[Body, ...]:
+    """Bodies ordered so that every parent comes before its children (stable otherwise)."""
+    names: dict[str, Body] = {}
+    for b in bodies:
+        if b.name in names:
+            raise ModelError(f'duplicate body name "{b.name}"')
+        names[b.name] = b
+    for b in bodies:
+        if b.parent != WORLD and b.parent not in names:
+            raise ModelError(
+                f'body "{b.name}": unknown parent "{b.parent}" (not a body and not "world")'
+            )
+    order: list[Body] = []
+    placed: set[str] = set()
+    remaining = list(bodies)
+    while remaining:
+        progress = [b for b in remaining if b.parent == WORLD or b.parent in placed]
+        if not progress:
+            cyc = ", ".join(f'"{b.name}"' for b in remaining)
+            raise ModelError(f"bodies {cyc} are not connected to the inertial frame (a cycle of parents)")
+        for b in progress:
+            order.append(b)
+            placed.add(b.name)
+        remaining = [b for b in remaining if b.name not in placed]
+    return tuple(order)
+
+
+def _validate(sys: System) -> None:
+    y_names = [str(c) for c in sys.coordinates]
+    u_names = [str(c) for c in sys.inputs]
+    p_names = [k for k, _ in sys.parameters]
+    rate_names = [f"{n}_d" for n in y_names] + [f"{n}_dd" for n in y_names]
+    if not y_names:
+        raise ModelError("a system needs at least one generalized coordinate")
+    if not sys.bodies:
+        raise ModelError("a system needs at least one body")
+    seen: dict[str, str] = {}
+    for kind, names in (("coordinate", y_names), ("input", u_names), ("parameter", p_names),
+                        ("coordinate rate", rate_names)):
+        for n in names:
+            if n in RESERVED:
+                raise ModelError(f'{kind} name "{n}" is reserved')
+            if n in seen:
+                raise ModelError(f'name "{n}" is declared twice (as {seen[n]} and as {kind})')
+            seen[n] = kind
+
+    joint_names: dict[str, str] = {}
+    driven_by: dict[str, str] = {}
+    used_coords: set[str] = set()
+    allowed_kin = set(y_names) | set(p_names) | {"t"}
+    for b in sys.bodies:
+        j = b.joint
+        if j.name in joint_names:
+            raise ModelError(
+                f'duplicate joint name "{j.name}" (bodies "{joint_names[j.name]}" and "{b.name}")'
+            )
+        if j.name in {bb.name for bb in sys.bodies} and j.name != b.name:
+            pass  # a joint may share a name with its own body only
+        joint_names[j.name] = b.name
+        for c in j.coordinates:
+            cn = str(c)
+            if cn not in y_names:
+                raise ModelError(f'joint "{j.name}" (body "{b.name}"): "{cn}" is not a declared coordinate')
+            if cn in driven_by:
+                raise ModelError(
+                    f'coordinate "{cn}" is driven by two joints: "{driven_by[cn]}" and "{j.name}"'
+                )
+            driven_by[cn] = j.name
+        exprs = [*j.position, *(x for row in j.orientation for x in row)]
+        for s in j.steps:
+            exprs.extend([s.angle] if hasattr(s, "angle") else list(s.vector))
+        names = free_names(exprs)
+        bad = names - allowed_kin
+        if bad:
+            raise ModelError(
+                f'joint "{j.name}" (body "{b.name}"): undeclared symbol(s) {sorted(bad)}; joints may '
+                "depend on coordinates, parameters and t only"
+            )
+        used_coords |= names & set(y_names)
+        # mass data
+        mass_names = free_names([b.mass, *b.com, *(x for row in b.inertia for x in row)])
+        bad = mass_names - set(p_names)
+        if bad:
+            raise ModelError(f'body "{b.name}": mass data use undeclared symbol(s) {sorted(bad)}')
+        _check_mass(sys, b)
+    unused = [n for n in y_names if n not in used_coords]
+    if unused:
+        raise ModelError(f"coordinate(s) {unused} are not used by any joint")
+
+    body_names = {b.name for b in sys.bodies}
+    allowed_force = set(y_names) | set(p_names) | set(u_names) | {"t"} | {f"{n}_d" for n in y_names}
+    force_names: set[str] = set()
+    for f in sys.forces:
+        w = f'force "{f.name}"'
+        if f.name in force_names:
+            raise ModelError(f'duplicate force name "{f.name}"')
+        force_names.add(f.name)
+        exprs: list = []
+        extra: set[str] = set()
+        if isinstance(f, Gravity):
+            exprs = list(f.vector)
+        elif isinstance(f, Force | Torque):
+            if f.body not in body_names:
+                raise ModelError(f'{w}: unknown body "{f.body}"')
+            if f.frame != WORLD and f.frame not in body_names:
+                raise ModelError(f'{w}: unknown frame "{f.frame}" (a body name or "world")')
+            exprs = list(f.vector) + list(getattr(f, "point", ()))
+        elif isinstance(f, SpringDamper):
+            for bn in (f.body_a, f.body_b):
+                if bn != WORLD and bn not in body_names:
+                    raise ModelError(f'spring-damper "{f.name}": unknown body "{bn}"')
+            if f.body_a == f.body_b:
+                raise ModelError(f'spring-damper "{f.name}": both ends are on body "{f.body_a}"')
+            exprs = [*f.point_a, *f.point_b, f.stiffness, f.damping, f.rest_length]
+            if f.law is not None:
+                exprs.append(f.law)
+                extra = {str(elongation), str(elongation_d)}
+        elif isinstance(f, GeneralizedForce):
+            if str(f.coordinate) not in y_names:
+                raise ModelError(f'{w}: "{f.coordinate}" is not a declared coordinate')
+            exprs = [f.value]
+        bad = free_names(exprs) - allowed_force - extra
+        if bad:
+            raise ModelError(f"{w}: undeclared symbol(s) {sorted(bad)}")
+
+
+def _check_mass(sys: System, b: Body) -> None:
+    """Mass ≥ 0 and inertia symmetric positive semi-definite at the default parameter values."""
+    subs = {se.Symbol(k): v for k, v in sys.parameters}
+    try:
+        m = float(b.mass.subs(subs))
+        I = np.array([[float(x.subs(subs)) for x in row] for row in b.inertia])
+    except (RuntimeError, TypeError, ValueError) as exc:
+        raise ModelError(f'body "{b.name}": mass data do not evaluate to numbers: {exc}') from None
+    if not math.isfinite(m) or m < 0:
+        raise ModelError(f'body "{b.name}": mass must be a non-negative number, got {m}')
+    if not np.all(np.isfinite(I)):
+        raise ModelError(f'body "{b.name}": inertia tensor has non-finite entries')
+    ev = np.linalg.eigvalsh(0.5 * (I + I.T))
+    scale = max(1.0, float(np.abs(I).max()))
+    if ev.min() < -1e-12 * scale:
+        raise ModelError(
+            f'body "{b.name}": inertia tensor is not positive semi-definite '
+            f"(eigenvalues {np.array2string(ev, precision=4)})"
+        )
+    if m == 0 and np.abs(I).max() > 0:
+        raise ModelError(f'body "{b.name}": a massless body cannot have rotational inertia')

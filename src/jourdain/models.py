@@ -1,0 +1,173 @@
+"""Sample models shared by the tests, the documentation and the benchmarks."""
+
+from __future__ import annotations
+
+import numpy as np
+import symengine as se
+
+from .model import (
+    Body,
+    Force,
+    General,
+    Gravity,
+    Prismatic,
+    Revolute,
+    Rot,
+    Spherical,
+    System,
+    Universal,
+    point_mass,
+    rod,
+    symbols,
+)
+
+
+def n_link_pendulum_on_cart(n: int) -> System:
+    """n-link pendulum on a cart, the same system as
+    ``sympy.physics.mechanics.models.n_link_pendulum_on_cart(n, cart_force=True)``.
+
+    Coordinates ``q0`` (cart position along x) and ``q1 … qn`` (absolute link angles about z,
+    measured from the upward y axis); masses ``m0`` (cart) … ``mn`` (point masses at the link
+    ends); lengths ``l0 … l(n-1)``; gravity ``g`` along -y; input ``F``, the horizontal force on
+    the cart. Links are massless. Absolute angles are joint angles ``q_i - q_(i-1)`` of general
+    joints, which the kinematics merges back into ``R_z(q_i)``.
+    """
+    if n < 1:
+        raise ValueError("n must be at least 1")
+    q = [se.Symbol(f"q{i}") for i in range(n + 1)]
+    m = [se.Symbol(f"m{i}") for i in range(n + 1)]
+    l = [se.Symbol(f"l{i}") for i in range(n)]
+    g, F = symbols("g F")
+    bodies = [Body("cart", "world", Prismatic("slider", q[0], "x"), mass=m[0],
+                   inertia=point_mass())]
+    for i in range(1, n + 1):
+        if i == 1:
+            joint = Revolute("hinge1", q[1], "z")
+        else:
+            joint = General(f"hinge{i}", [Rot("z", q[i] - q[i - 1])], coordinates=[q[i]],
+                            position=(0, l[i - 2], 0))
+        bodies.append(Body(f"link{i}", "cart" if i == 1 else f"link{i - 1}", joint, mass=m[i],
+                           com=(0, l[i - 1], 0), inertia=point_mass()))
+    params = {f"m{i}": 1.0 for i in range(n + 1)}
+    params.update({f"l{i}": 1.0 for i in range(n)})
+    params["g"] = 9.81
+    return System(q, bodies, [Gravity((0, -g, 0)), Force("cart_force", "cart", (F, 0, 0))],
+                  parameters=params, inputs=[F], name=f"{n}-link pendulum on a cart",
+                  units={"g": "m/s^2", **{f"m{i}": "kg" for i in range(n + 1)},
+                         **{f"l{i}": "m" for i in range(n)}})
+
+
+def double_pendulum() -> System:
+    """Planar double pendulum of two uniform rods hanging from revolute joints about z.
+
+    ``phi1``: angle of the first rod from the downward vertical; ``phi2``: angle of the second
+    rod relative to the first. Rods of mass ``m1, m2`` and length ``l1, l2`` along the body's
+    -y axis; gravity ``g`` along -y.
+    """
+    phi1, phi2 = symbols("phi1 phi2")
+    m1, m2, l1, l2, g = symbols("m1 m2 l1 l2 g")
+    bodies = [
+        Body("rod1", "world", Revolute("hinge1", phi1, "z"), mass=m1, com=(0, -l1 / 2, 0),
+             inertia=rod(m1, l1, "y")),
+        Body("rod2", "rod1", Revolute("hinge2", phi2, "z", position=(0, -l1, 0)), mass=m2,
+             com=(0, -l2 / 2, 0), inertia=rod(m2, l2, "y")),
+    ]
+    return System([phi1, phi2], bodies, [Gravity((0, -g, 0))],
+                  parameters={"m1": 1.0, "m2": 0.5, "l1": 1.0, "l2": 0.7, "g": 9.81},
+                  units={"m1": "kg", "m2": "kg", "l1": "m", "l2": "m", "g": "m/s^2",
+                         "phi1": "rad", "phi2": "rad"},
+                  name="double pendulum")
+
+
+def heavy_top() -> System:
+    """Heavy symmetric top on a fixed point, in Euler angles ``psi`` (precession), ``theta``
+    (nutation), ``phi`` (spin) of the z-x-z sequence.
+
+    Centre of mass at distance ``L`` on the symmetry axis (body z); moments of inertia ``A``
+    (transverse) and ``C`` (axial) about the centre of mass; gravity ``g`` along -z.
+    """
+    psi, theta, phi = symbols("psi theta phi")
+    m, L, A, C, g = symbols("m L A C g")
+    body = Body("top", "world", Spherical("pivot", (psi, theta, phi), "zxz"), mass=m,
+                com=(0, 0, L), inertia=(A, A, C))
+    return System([psi, theta, phi], [body], [Gravity((0, 0, -g))],
+                  parameters={"m": 1.0, "L": 0.1, "A": 0.004, "C": 0.006, "g": 9.81},
+                  units={"m": "kg", "L": "m", "A": "kg*m^2", "C": "kg*m^2", "g": "m/s^2"},
+                  name="heavy symmetric top")
+
+
+def spatial_chain_data(n: int, seed: int = 0) -> list[dict]:
+    """Numeric data of :func:`spatial_chain` (one dict per body), for building peer models.
+
+    Keys: ``joint`` ("revolute", "universal", "spherical"), ``axes`` (axis names), ``mass``,
+    ``com`` (3,), ``inertia`` (3×3, about the centre of mass, body frame), ``offset`` (3,): the
+    next joint's position in this body's frame.
+    """
+    rng = np.random.default_rng(seed)
+    kinds = ("revolute", "universal", "spherical")
+    rev_axes = ("z", "x", "y")
+    out = []
+    for i in range(n):
+        kind = kinds[i % 3]
+        if kind == "revolute":
+            axes = (rev_axes[(i // 3) % 3],)
+        elif kind == "universal":
+            axes = ("x", "y") if (i // 3) % 2 == 0 else ("z", "x")
+        else:
+            axes = ("x", "y", "z")
+        # full, non-diagonal inertia: principal moments (triangle inequality) turned by a rotation
+        a, b = rng.uniform(0.02, 0.05, 2)
+        c = rng.uniform(abs(a - b) + 0.005, a + b - 0.005)
+        Qm, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+        I = Qm @ np.diag([a, b, c]) @ Qm.T
+        I = np.round(0.5 * (I + I.T), 6)
+        out.append({
+            "joint": kind, "axes": axes, "mass": round(float(rng.uniform(0.5, 2.0)), 4),
+            "com": np.round(rng.uniform(-0.1, 0.1, 3) + np.array([0.0, 0.0, 0.15]), 4),
+            "inertia": I,
+            "offset": np.round(rng.uniform(-0.1, 0.1, 3) + np.array([0.0, 0.0, 0.3]), 4),
+        })
+    return out
+
+
+def spatial_chain(n: int, seed: int = 0) -> System:
+    """A spatial chain of ``n`` rigid bodies with full (non-diagonal) inertia tensors, joined by
+    revolute, universal and spherical (Cardan xyz) joints in turn, under gravity ``g`` along -z.
+
+    Body ``i`` has mass ``m{i}``, centre of mass ``(cx{i}, cy{i}, cz{i})``, inertia entries
+    ``I{i}xx, I{i}xy, …`` and the next joint at ``(dx{i}, dy{i}, dz{i})`` in its frame; all are
+    parameters whose default values come from :func:`spatial_chain_data` (so a peer tool can be
+    built from the same numbers). Coordinates ``q0, q1, …`` in joint order.
+    """
+    data = spatial_chain_data(n, seed)
+    coords: list[se.Symbol] = []
+    bodies = []
+    params: dict[str, float] = {"g": 9.81}
+    comp = "xyz"
+    for i, d in enumerate(data):
+        nq = {"revolute": 1, "universal": 2, "spherical": 3}[d["joint"]]
+        qs = [se.Symbol(f"q{len(coords) + k}") for k in range(nq)]
+        coords.extend(qs)
+        pos = (0, 0, 0) if i == 0 else tuple(se.Symbol(f"d{c}{i - 1}") for c in comp)
+        name = f"joint{i}"
+        if d["joint"] == "revolute":
+            joint = Revolute(name, qs[0], d["axes"][0], position=pos)
+        elif d["joint"] == "universal":
+            joint = Universal(name, qs, d["axes"], position=pos)
+        else:
+            joint = Spherical(name, qs, "xyz", position=pos)
+        m = se.Symbol(f"m{i}")
+        com = tuple(se.Symbol(f"c{c}{i}") for c in comp)
+        I = [[se.Symbol(f"I{i}{comp[min(a, b)]}{comp[max(a, b)]}") for b in range(3)]
+             for a in range(3)]
+        bodies.append(Body(f"body{i}", "world" if i == 0 else f"body{i - 1}", joint, mass=m,
+                           com=com, inertia=I))
+        params[f"m{i}"] = float(d["mass"])
+        for a in range(3):
+            params[f"c{comp[a]}{i}"] = float(d["com"][a])
+            params[f"d{comp[a]}{i}"] = float(d["offset"][a])
+            for b in range(a, 3):
+                params[f"I{i}{comp[a]}{comp[b]}"] = float(d["inertia"][a, b])
+    g = se.Symbol("g")
+    return System(coords, bodies, [Gravity((0, 0, -g))], parameters=params,
+                  name=f"spatial chain of {n} bodies")

@@ -1,0 +1,268 @@
+"""Newton–Euler equations of the free bodies (METHOD.md §2):
+
+    M̄ · J̄ · ÿ + q̄^c = q̄^e + Q̄ · g
+
+Rows are ordered as in the seed: the 3p translational rows of all bodies (inertial frame), then the
+3p rotational rows (each body's own frame, about its centre of mass).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import symengine as se
+
+from .errors import ModelError
+from .kinematics import Z3, BodyKinematics, Kinematics, _add, _cross, _dot, _mm, _mtv, _mv, _scale
+from .model.bodies import WORLD, Body
+from .model.forces import Force, GeneralizedForce, Gravity, SpringDamper, Torque
+from .model.joints import IDENTITY, Joint, Mat3, Rot, Trans, Vec3, rotation_matrix
+from .symbolic import SymMatrix
+
+if TYPE_CHECKING:
+    from .model.system import System
+
+ZERO = se.Integer(0)
+
+
+@dataclass(frozen=True)
+class BodyForces:
+    """Resultant applied force ``f`` (inertial, at the centre of mass) and torque ``l`` (body
+    frame, about the centre of mass) on one body: its rows of q̄^e."""
+
+    name: str
+    f: Vec3
+    l: Vec3
+
+
+@dataclass(frozen=True)
+class NewtonEuler:
+    """Result of :func:`newton_euler`.
+
+    Attributes
+    ----------
+    M_bar : SymMatrix (6p×6p)
+        ``diag(m_1 E, …, m_p E, I_1, …, I_p)``.
+    J_bar : SymMatrix (6p×f)
+        ``[J_T1; …; J_Tp; J_R1; …; J_Rp]``.
+    q_c : SymMatrix (6p×1)
+        ``[m_i ā_i; …; I_i ᾱ_i + ω̃_i I_i ω_i; …]``: Coriolis, centrifugal and gyroscopic forces.
+    q_e : SymMatrix (6p×1)
+        ``[f_i^e; …; l_i^e; …]``: applied forces (inertial) and torques (body frames).
+    joints : tuple of (Joint, child body name, parent name)
+        The joints whose constrained directions form Q̄ (reactions stage).
+    kinematics : Kinematics
+    forces : tuple of BodyForces
+    """
+
+    kinematics: Kinematics
+    M_bar: SymMatrix
+    J_bar: SymMatrix
+    q_c: SymMatrix
+    q_e: SymMatrix
+    joints: tuple[tuple[Joint, str, str], ...]
+    forces: tuple[BodyForces, ...]
+
+    @property
+    def system(self) -> System:
+        return self.kinematics.system
+
+
+def newton_euler(kin: Kinematics) -> NewtonEuler:
+    """Assemble M̄, J̄, q̄^c and q̄^e from the kinematics of every body."""
+    system = kin.system
+    bodies = system.bodies
+    p = len(bodies)
+    # q̄^c: Newton m ā, Euler I ᾱ + ω × (I ω)
+    qc_T: list[se.Basic] = []
+    qc_R: list[se.Basic] = []
+    for body, bk in zip(bodies, kin.bodies, strict=True):
+        qc_T.extend(_scale(_v(bk.a_bar), body.mass))
+        qc_R.extend(_euler_gyro(body, bk))
+    forces = applied_forces(kin)
+    qe = [x for bf in forces for x in bf.f] + [x for bf in forces for x in bf.l]
+    # M̄ block diagonal
+    n = 6 * p
+    rows = [[ZERO] * n for _ in range(n)]
+    for i, body in enumerate(bodies):
+        for a in range(3):
+            rows[3 * i + a][3 * i + a] = body.mass
+            for b in range(3):
+                rows[3 * p + 3 * i + a][3 * p + 3 * i + b] = body.inertia[a][b]
+    J_bar = SymMatrix(tuple(r for bk in kin.bodies for r in bk.J_T.rows)
+                      + tuple(r for bk in kin.bodies for r in bk.J_R.rows))
+    joints = tuple((b.joint, b.name, b.parent) for b in bodies)
+    return NewtonEuler(kin, SymMatrix.from_rows(rows), J_bar, SymMatrix.column(qc_T + qc_R),
+                       SymMatrix.column(qe), joints, forces)
+
+
+def _v(m: SymMatrix) -> Vec3:
+    return (m.rows[0][0], m.rows[1][0], m.rows[2][0])
+
+
+def _euler_gyro(body: Body, bk: BodyKinematics) -> Vec3:
+    if not body.has_inertia:
+        return Z3
+    I = body.inertia
+    w = _v(bk.omega)
+    return _add(_mv(I, _v(bk.alpha_bar)), _cross(w, _mv(I, w)))
+
+
+class _Accumulator:
+    """Per-body resultant force (inertial) and torque about the centre of mass (body frame)."""
+
+    def __init__(self, kin: Kinematics) -> None:
+        self.kin = kin
+        self.sys = kin.system
+        self.f: dict[str, list[se.Basic]] = {b.name: [] for b in self.sys.bodies}
+        self.f = {b.name: [[], [], []] for b in self.sys.bodies}  # type: ignore[misc]
+        self.l = {b.name: [[], [], []] for b in self.sys.bodies}
+
+    def S(self, name: str) -> Mat3:
+        return self.kin[name].S.rows  # type: ignore[return-value]
+
+    def to_body(self, vec: Vec3, frame: str, body: str) -> tuple[Vec3, Vec3]:
+        """(inertial, body-frame) components of ``vec`` given in ``frame``."""
+        if frame == body:
+            return _mv(self.S(body), vec), vec
+        vI = vec if frame == WORLD else _mv(self.S(frame), vec)
+        return vI, _mtv(self.S(body), vI)
+
+    def add_force(self, body: str, F_I: Vec3, F_B: Vec3, point: Vec3) -> None:
+        """Force (inertial F_I = S·F_B) acting at ``point`` of ``body`` (body frame)."""
+        if body == WORLD:
+            return
+        c = self.sys.body(body).com
+        arm = (point[0] - c[0], point[1] - c[1], point[2] - c[2])
+        for a in range(3):
+            self.f[body][a].append(F_I[a])
+        self.add_torque(body, _cross(arm, F_B))
+
+    def add_torque(self, body: str, T_B: Vec3) -> None:
+        if body == WORLD:
+            return
+        for a in range(3):
+            self.l[body][a].append(T_B[a])
+
+    def result(self) -> tuple[BodyForces, ...]:
+        return tuple(
+            BodyForces(b.name, tuple(se.Add(*c) if c else ZERO for c in self.f[b.name]),  # type: ignore[arg-type]
+                       tuple(se.Add(*c) if c else ZERO for c in self.l[b.name]))  # type: ignore[arg-type]
+            for b in self.sys.bodies
+        )
+
+
+def applied_forces(kin: Kinematics) -> tuple[BodyForces, ...]:
+    """Resultant applied force and torque on every body from the model's force elements."""
+    acc = _Accumulator(kin)
+    sys = kin.system
+    for fe in sys.forces:
+        if isinstance(fe, Gravity):
+            for b in sys.bodies:
+                if b.mass != 0:
+                    for a in range(3):
+                        acc.f[b.name][a].append(b.mass * fe.vector[a])
+        elif isinstance(fe, Force):
+            F_I, F_B = acc.to_body(fe.vector, fe.frame, fe.body)
+            acc.add_force(fe.body, F_I, F_B, fe.point)
+        elif isinstance(fe, Torque):
+            _, T_B = acc.to_body(fe.vector, fe.frame, fe.body)
+            acc.add_torque(fe.body, T_B)
+        elif isinstance(fe, SpringDamper):
+            _spring_damper(acc, kin, fe)
+        elif isinstance(fe, GeneralizedForce):
+            _generalized_force(acc, sys, fe)
+    return acc.result()
+
+
+def _point_state(kin: Kinematics, body: str, p: Vec3) -> tuple[Vec3, Vec3]:
+    """Inertial position and velocity of a point (body frame) of ``body`` or of the world."""
+    if body == WORLD:
+        return p, Z3
+    r, cols, v_bar, _ = kin[body].point(p)
+    v = v_bar
+    for j, c in cols.items():
+        v = _add(v, _scale(c, kin.yd[j]))
+    return r, v
+
+
+def _spring_damper(acc: _Accumulator, kin: Kinematics, fe: SpringDamper) -> None:
+    ra, va = _point_state(kin, fe.body_a, fe.point_a)
+    rb, vb = _point_state(kin, fe.body_b, fe.point_b)
+    d = (rb[0] - ra[0], rb[1] - ra[1], rb[2] - ra[2])
+    L = se.sqrt(_dot(d, d))
+    e = _scale(d, 1 / L)
+    L_d = _dot(e, (vb[0] - va[0], vb[1] - va[1], vb[2] - va[2]))
+    T = fe.tension(L, L_d)
+    F_on_a = _scale(e, T)  # tension pulls a towards b
+    F_on_b = _scale(e, -T)
+    for body, point, F in ((fe.body_a, fe.point_a, F_on_a), (fe.body_b, fe.point_b, F_on_b)):
+        if body != WORLD:
+            acc.add_force(body, F, _mtv(acc.S(body), F), point)
+
+
+def joint_step_frames(joint: Joint) -> list[tuple[Mat3, Vec3, Mat3]]:
+    """For each step k of ``joint``: (R_before, p_before, R_after).
+
+    R_before turns the frame before step k into the parent's body frame, p_before is that frame's
+    origin in the parent frame; R_after turns the child body frame into the frame after step k.
+    """
+    R, pvec = joint.orientation, joint.position
+    before = []
+    for s in joint.steps:
+        before.append((R, pvec))
+        if isinstance(s, Rot):
+            R = _mm(R, rotation_matrix(s.axis, s.angle))
+        else:
+            pvec = _add(pvec, _mv(R, s.vector))
+    out = []
+    for k, (Rb, pb) in enumerate(before):
+        Ra = IDENTITY
+        for s in joint.steps[k + 1:]:
+            if isinstance(s, Rot):
+                Ra = _mm(Ra, rotation_matrix(s.axis, s.angle))
+        out.append((Rb, pb, Ra))
+    return out
+
+
+def _generalized_force(acc: _Accumulator, sys: System, fe: GeneralizedForce) -> None:
+    """Realize a generalized force on a coordinate as a torque/force pair on its joint step."""
+    for body in sys.bodies:
+        j = body.joint
+        for k, step in enumerate(j.steps):
+            if step.parameter is not None and step.parameter == fe.coordinate:
+                Rb, _, Ra = joint_step_frames(j)[k]
+                u = step.axis
+                v_child = _mtv(Ra, _scale(u, fe.value))
+                v_parent = _scale(_mv(Rb, u), -fe.value)
+                if isinstance(step, Rot):
+                    acc.add_torque(body.name, v_child)
+                    acc.add_torque(body.parent, v_parent)
+                else:
+                    # force pair at the child frame's origin
+                    acc.add_force(body.name, _mv(acc.S(body.name), v_child), v_child, Z3)
+                    if body.parent != WORLD:
+                        p_child = joint_child_origin(j)
+                        acc.add_force(body.parent, _mv(acc.S(body.parent), v_parent), v_parent,
+                                      p_child)
+                return
+    raise ModelError(
+        f'generalized force "{fe.name}": coordinate "{fe.coordinate}" is not the angle or distance '
+        "of a single joint step (Rot/Trans with that coordinate alone); apply it as forces or "
+        "torques on bodies instead"
+    )
+
+
+def joint_child_origin(joint: Joint) -> Vec3:
+    """Origin of the child body frame in the parent's body frame."""
+    R, pvec = joint.orientation, joint.position
+    for s in joint.steps:
+        if isinstance(s, Rot):
+            R = _mm(R, rotation_matrix(s.axis, s.angle))
+        else:
+            pvec = _add(pvec, _mv(R, s.vector))
+    return pvec
+
+
+_ = Trans  # re-exported type used in annotations elsewhere

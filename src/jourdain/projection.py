@@ -1,0 +1,118 @@
+"""Projection with J̄ᵀ, which eliminates the reaction forces (METHOD.md §3):
+
+    M(y,t)·ÿ + k(y,ẏ,t) = q(y,ẏ,t),   M = J̄ᵀ M̄ J̄,  k = J̄ᵀ q̄^c,  q = J̄ᵀ q̄^e
+
+The products are formed body by body from the sparse columns of J_T and J_R, never as dense
+6p×6p products; terms that share the same Jacobian columns are collected first (so M_jk of a chain
+reads ``(m_i + m_{i+1} + …)·(J_T,j · J_T,k)``), and only the upper triangle of M is built, so M is
+exactly symmetric.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import symengine as se
+
+from .kinematics import _add, _cross, _dot, _mv, _scale
+from .newton_euler import NewtonEuler
+from .symbolic import SymMatrix
+
+ZERO = se.Integer(0)
+
+
+@dataclass(frozen=True)
+class EquationsOfMotion:
+    """Result of :func:`projection`: ``M·ÿ + k = q``.
+
+    ``M`` (f×f, symmetric), ``k`` (f×1: Coriolis, centrifugal and gyroscopic forces), ``q``
+    (f×1: applied generalized forces); ``newton_euler`` is the stage it came from.
+    """
+
+    newton_euler: NewtonEuler
+    M: SymMatrix
+    k: SymMatrix
+    q: SymMatrix
+
+    @property
+    def system(self):  # noqa: ANN201 - System, avoided import cycle
+        return self.newton_euler.system
+
+    @property
+    def y(self) -> tuple[se.Symbol, ...]:
+        return self.newton_euler.kinematics.y
+
+    @property
+    def yd(self) -> tuple[se.Symbol, ...]:
+        return self.newton_euler.kinematics.yd
+
+
+def projection(ne: NewtonEuler) -> EquationsOfMotion:
+    """Project the Newton–Euler equations with J̄ᵀ: M = J̄ᵀM̄J̄, k = J̄ᵀq̄^c, q = J̄ᵀq̄^e."""
+    kin = ne.kinematics
+    system = kin.system
+    f = len(kin.y)
+    # translational part: group bodies by identical Jacobian columns
+    mass_of_pair: dict[tuple[int, int], dict[tuple, list]] = {}
+    force_of_col: list[dict[tuple, list]] = [dict() for _ in range(f)]
+    gyro_of_col: list[dict[tuple, list]] = [dict() for _ in range(f)]
+    M_terms: list[list[list[se.Basic]]] = [[[] for _ in range(f)] for _ in range(f)]
+    k_terms: list[list[se.Basic]] = [[] for _ in range(f)]
+    q_terms: list[list[se.Basic]] = [[] for _ in range(f)]
+    for body, bk, bf in zip(system.bodies, kin.bodies, ne.forces, strict=True):
+        m = body.mass
+        T = bk.cols_T
+        a_bar = (bk.a_bar.rows[0][0], bk.a_bar.rows[1][0], bk.a_bar.rows[2][0])
+        ma = _scale(a_bar, m)
+        keys = sorted(T)
+        for ii, j in enumerate(keys):
+            cj = T[j]
+            if m != 0:
+                for kk in keys[ii:]:
+                    mass_of_pair.setdefault((j, kk), {}).setdefault((cj, T[kk]), []).append(m)
+                gyro_of_col[j].setdefault(cj, []).append(ma)
+            if any(x != 0 for x in bf.f):
+                force_of_col[j].setdefault(cj, []).append(bf.f)
+        # rotational part
+        R = bk.cols_R
+        has_I = body.has_inertia
+        gyro_R = None
+        if has_I:
+            I = body.inertia
+            w = (bk.omega.rows[0][0], bk.omega.rows[1][0], bk.omega.rows[2][0])
+            ab = (bk.alpha_bar.rows[0][0], bk.alpha_bar.rows[1][0], bk.alpha_bar.rows[2][0])
+            gyro_R = _add(_mv(I, ab), _cross(w, _mv(I, w)))
+            IR = {j: _mv(I, c) for j, c in R.items()}
+        l_nonzero = any(x != 0 for x in bf.l)
+        rkeys = sorted(R)
+        for ii, j in enumerate(rkeys):
+            cj = R[j]
+            if has_I:
+                for kk in rkeys[ii:]:
+                    M_terms[j][kk].append(_dot(cj, IR[kk]))
+                k_terms[j].append(_dot(cj, gyro_R))
+            if l_nonzero:
+                q_terms[j].append(_dot(cj, bf.l))
+    for (j, kk), groups in mass_of_pair.items():
+        for (cj, ck), masses in groups.items():
+            M_terms[j][kk].append(_dot(cj, ck) * se.Add(*masses))
+    for j in range(f):
+        for cj, vecs in gyro_of_col[j].items():
+            k_terms[j].append(_dot(cj, _sum(vecs)))
+        for cj, vecs in force_of_col[j].items():
+            q_terms[j].append(_dot(cj, _sum(vecs)))
+    M = [[ZERO] * f for _ in range(f)]
+    for j in range(f):
+        for kk in range(j, f):
+            e = se.Add(*M_terms[j][kk]) if M_terms[j][kk] else ZERO
+            M[j][kk] = e
+            M[kk][j] = e
+    k = [se.Add(*ts) if ts else ZERO for ts in k_terms]
+    q = [se.Add(*ts) if ts else ZERO for ts in q_terms]
+    return EquationsOfMotion(ne, SymMatrix.from_rows(M), SymMatrix.column(k), SymMatrix.column(q))
+
+
+def _sum(vecs: list) -> tuple:
+    if len(vecs) == 1:
+        return vecs[0]
+    return tuple(se.Add(*(v[a] for v in vecs)) for a in range(3))
