@@ -53,9 +53,11 @@ def projection(ne: NewtonEuler) -> EquationsOfMotion:
     system = kin.system
     f = len(kin.y)
     # translational part: group bodies by identical Jacobian columns
-    mass_of_pair: dict[tuple[int, int], dict[tuple, list]] = {}
-    force_of_col: list[dict[tuple, list]] = [dict() for _ in range(f)]
-    gyro_of_col: list[dict[tuple, list]] = [dict() for _ in range(f)]
+    # groups are keyed by the columns' hashes: == on distinct but equal deep expressions would
+    # walk whole trees; the stored column is the group's representative
+    mass_of_pair: dict[tuple[int, int], dict[tuple, tuple[tuple, tuple, list]]] = {}
+    force_of_col: list[dict[tuple, tuple[tuple, list]]] = [dict() for _ in range(f)]
+    gyro_of_col: list[dict[tuple, tuple[tuple, list]]] = [dict() for _ in range(f)]
     M_terms: list[list[list[se.Basic]]] = [[[] for _ in range(f)] for _ in range(f)]
     k_terms: list[list[se.Basic]] = [[] for _ in range(f)]
     q_terms: list[list[se.Basic]] = [[] for _ in range(f)]
@@ -65,14 +67,17 @@ def projection(ne: NewtonEuler) -> EquationsOfMotion:
         a_bar = (bk.a_bar.rows[0][0], bk.a_bar.rows[1][0], bk.a_bar.rows[2][0])
         ma = _scale(a_bar, m)
         keys = sorted(T)
+        hT = {j: _h(c) for j, c in T.items()}
+        f_nonzero = any(x != 0 for x in bf.f)
         for ii, j in enumerate(keys):
             cj = T[j]
             if m != 0:
                 for kk in keys[ii:]:
-                    mass_of_pair.setdefault((j, kk), {}).setdefault((cj, T[kk]), []).append(m)
-                gyro_of_col[j].setdefault(cj, []).append(ma)
-            if any(x != 0 for x in bf.f):
-                force_of_col[j].setdefault(cj, []).append(bf.f)
+                    mass_of_pair.setdefault((j, kk), {}).setdefault(
+                        hT[j] + hT[kk], (cj, T[kk], []))[2].append(m)
+                gyro_of_col[j].setdefault(hT[j], (cj, []))[1].append(ma)
+            if f_nonzero:
+                force_of_col[j].setdefault(hT[j], (cj, []))[1].append(bf.f)
         # rotational part
         R = bk.cols_R
         has_I = body.has_inertia
@@ -94,12 +99,12 @@ def projection(ne: NewtonEuler) -> EquationsOfMotion:
             if l_nonzero:
                 q_terms[j].append(_dot(cj, bf.l))
     for (j, kk), groups in mass_of_pair.items():
-        for (cj, ck), masses in groups.items():
+        for cj, ck, masses in groups.values():
             M_terms[j][kk].append(_dot(cj, ck) * se.Add(*masses))
     for j in range(f):
-        for cj, vecs in gyro_of_col[j].items():
+        for cj, vecs in gyro_of_col[j].values():
             k_terms[j].append(_dot(cj, _sum(vecs)))
-        for cj, vecs in force_of_col[j].items():
+        for cj, vecs in force_of_col[j].values():
             q_terms[j].append(_dot(cj, _sum(vecs)))
     M = [[ZERO] * f for _ in range(f)]
     for j in range(f):
@@ -110,6 +115,10 @@ def projection(ne: NewtonEuler) -> EquationsOfMotion:
     k = [se.Add(*ts) if ts else ZERO for ts in k_terms]
     q = [se.Add(*ts) if ts else ZERO for ts in q_terms]
     return EquationsOfMotion(ne, SymMatrix.from_rows(M), SymMatrix.column(k), SymMatrix.column(q))
+
+
+def _h(v: tuple) -> tuple[int, ...]:
+    return tuple(hash(x) for x in v)
 
 
 def _sum(vecs: list) -> tuple:

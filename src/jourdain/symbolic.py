@@ -112,70 +112,38 @@ def to_sympy(expr: Expr, memo: dict | None = None) -> Any:
     """Convert a SymEngine expression to SymPy, visiting shared sub-expressions once."""
     import sympy
 
+    # keyed by SymEngine's cached hash: == on distinct equal deep nodes walks the whole tree
     if memo is None:
         memo = {}
     stack = [expr]
     while stack:
         node = stack[-1]
-        if node in memo:
+        h = hash(node)
+        if h in memo:
             stack.pop()
             continue
         args = node.args
         name = type(node).__name__
         if not args or name not in _SYMPY_FUNCS:
-            memo[node] = node._sympy_() if hasattr(node, "_sympy_") else sympy.sympify(str(node))
+            memo[h] = node._sympy_() if hasattr(node, "_sympy_") else sympy.sympify(str(node))
             stack.pop()
             continue
-        pending = [a for a in args if a not in memo]
+        pending = [a for a in args if hash(a) not in memo]
         if pending:
             stack.extend(pending)
             continue
         f = getattr(sympy, _SYMPY_FUNCS[name])
-        memo[node] = f(*(memo[a] for a in args))
+        memo[h] = f(*(memo[hash(a)] for a in args))
         stack.pop()
-    return memo[expr]
+    return memo[hash(expr)]
 
 
 def count_ops(exprs: Sequence[Expr], cse: bool = True) -> int:
-    """Operation count of a list of expressions, optionally after CSE.
+    """Operation count of a list of expressions (n-ary + and * count n-1, functions and powers
+    one), after common-subexpression elimination (:mod:`jourdain.cse`) when ``cse``, else
+    counting each distinct node of the shared graph once."""
+    from .cse import cse as graph_cse
+    from .cse import graph_ops
 
-    Counts each n-ary addition or multiplication as n-1 operations and each function call or
-    power as one; with ``cse`` the replacements are counted once each.
-    """
-    exprs = [e for e in exprs]
-    if cse:
-        reps, reduced = se.cse(exprs)
-        return sum(_tree_ops(e) for _, e in reps) + sum(_tree_ops(e) for e in reduced)
-    seen: set = set()
-    total = 0
-    stack = list(exprs)
-    while stack:
-        n = stack.pop()
-        if n in seen:
-            continue
-        seen.add(n)
-        total += _node_ops(n)
-        stack.extend(n.args)
-    return total
-
-
-def _node_ops(n: Expr) -> int:
-    name = type(n).__name__
-    a = n.args
-    if not a:
-        return 0
-    if name in ("Add", "Mul"):
-        ops = len(a) - 1
-        # a leading -1 coefficient is a negation, count it as one operation like sympy does
-        return ops
-    return 1
-
-
-def _tree_ops(e: Expr) -> int:
-    total = 0
-    stack = [e]
-    while stack:
-        n = stack.pop()
-        total += _node_ops(n)
-        stack.extend(n.args)
-    return total
+    exprs = list(exprs)
+    return graph_cse(exprs).count_ops() if cse else graph_ops(exprs)
