@@ -5,6 +5,8 @@ Describe a :class:`System` of rigid bodies, joints and force elements, then run 
 equations of motion M·ÿ + k = q.
 """
 
+from symengine import atan2, cos, exp, log, pi, sin, sqrt, tan
+
 from .errors import EvaluationError, JourdainError, ModelError, SingularMassMatrix
 from .kinematics import BodyKinematics, Kinematics, kinematics
 from .model import (
@@ -48,6 +50,7 @@ from .symbolic import SymMatrix
 __version__ = "0.1.0"
 
 __all__ = [
+    "atan2", "cos", "exp", "log", "pi", "sin", "sqrt", "tan",
     "EvaluationError", "JourdainError", "ModelError", "SingularMassMatrix",
     "BodyKinematics", "Kinematics", "kinematics", "NewtonEuler", "newton_euler",
     "EquationsOfMotion", "projection", "SymMatrix",

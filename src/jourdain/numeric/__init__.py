@@ -155,4 +155,8 @@ def evaluate(system: System, y: Any, yd: Any, t: float = 0.0,
     """``M_bar, J_bar, q_c, q_e, M, k, q`` as NumPy arrays at one state (vectors 1-D)."""
     args = state_vectors(system, y, yd, t, parameters, inputs)
     out = _eom_function(system)(*args)
-    return {k: (v.reshape(-1) if v.shape[1] == 1 else v) for k, v in out.items()}
+    # vectors (q_c, q_e, k, q) come back 1-D, matrices keep their shape even when 1x1
+    return {k: (v.reshape(-1) if k in _VECTORS else v) for k, v in out.items()}
+
+
+_VECTORS = frozenset({"q_c", "q_e", "k", "q"})
