@@ -1,0 +1,103 @@
+"""Compile generated C once with the system's C compiler and cache the shared library on disk.
+
+The cache is a plain directory (``$JOURDAIN_CACHE``, else ``$XDG_CACHE_HOME/jourdain``, else
+``~/.cache/jourdain``) holding ``<key>.c`` (the source, for reading) and ``<key>.so`` (the
+library), where ``<key>`` is a SHA-256 hash of the content that determines the code. Deleting
+the directory, or any file in it, is always safe: the library is rebuilt on the next use. Only
+shared libraries compiled from jourdain's own generated source are loaded; nothing is pickled.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import hashlib
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+from ..errors import JourdainError
+
+#: Compiler flags; part of every cache key. No -ffast-math: NaN checks must keep working.
+CFLAGS = ("-O2", "-fPIC", "-shared", "-fno-math-errno", "-std=c99")
+
+_loaded: dict[str, ctypes.CDLL] = {}
+
+
+class CompilerError(JourdainError, RuntimeError):
+    """No C compiler, or the generated code did not compile."""
+
+
+def cache_dir() -> Path:
+    """The directory of compiled libraries (created on demand; safe to delete)."""
+    env = os.environ.get("JOURDAIN_CACHE")
+    if env:
+        return Path(env).expanduser()
+    xdg = os.environ.get("XDG_CACHE_HOME")
+    base = Path(xdg).expanduser() if xdg else Path.home() / ".cache"
+    return base / "jourdain"
+
+
+def compiler() -> str:
+    """The C compiler: ``$CC``, else ``cc``, ``gcc`` or ``clang`` on the PATH."""
+    cand = [os.environ["CC"]] if os.environ.get("CC") else ["cc", "gcc", "clang"]
+    for c in cand:
+        path = shutil.which(c)
+        if path:
+            return path
+    raise CompilerError(
+        "no C compiler found (tried " + ", ".join(cand) + "); jourdain compiles its numeric code "
+        "with the system's C compiler: install gcc or clang, or set CC")
+
+
+def content_key(*parts: str) -> str:
+    """SHA-256 of the parts, the compiler flags and the Python platform."""
+    h = hashlib.sha256()
+    for part in (*parts, " ".join(CFLAGS), sys.platform):
+        h.update(part.encode())
+        h.update(b"\0")
+    return h.hexdigest()[:32]
+
+
+def cached_library(key: str) -> ctypes.CDLL | None:
+    """The library cached under ``key``, or None if it was never built (or was deleted)."""
+    if key in _loaded:
+        return _loaded[key]
+    so = cache_dir() / f"{key}.so"
+    if not so.exists():
+        return None
+    try:
+        lib = ctypes.CDLL(str(so))
+    except OSError:  # a truncated or foreign file: rebuild
+        return None
+    _loaded[key] = lib
+    return lib
+
+
+def build(key: str, source: str) -> ctypes.CDLL:
+    """Compile ``source`` to ``<cache>/<key>.so`` (unless there) and load it."""
+    lib = cached_library(key)
+    if lib is not None:
+        return lib
+    d = cache_dir()
+    d.mkdir(parents=True, exist_ok=True)
+    so = d / f"{key}.so"
+    src = d / f"{key}.c"
+    src.write_text(source)
+    # compile to a private name, then rename: concurrent builds never see a half-written file
+    fd, tmp = tempfile.mkstemp(suffix=".so", dir=d)
+    os.close(fd)
+    try:
+        proc = subprocess.run([compiler(), *CFLAGS, "-o", tmp, str(src), "-lm"],
+                              capture_output=True, text=True)
+        if proc.returncode != 0:
+            raise CompilerError(f"compiling {src} failed:\n{proc.stderr[-4000:]}")
+        os.replace(tmp, so)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+    lib = ctypes.CDLL(str(so))
+    _loaded[key] = lib
+    return lib
