@@ -1,0 +1,950 @@
+"""Model files: a multibody system, its nominal motions and simulation settings in TOML.
+
+The format is described in ``docs/model-format.md``. :func:`load_model` reads a file,
+:func:`loads_model` a string. Expressions are read by :mod:`jourdain.io.expressions` (never by
+Python); every mistake raises :class:`ModelFileError` naming the file, the line and the key path::
+
+    double.toml:14: body "rod2" → joint → axis: expected one of x, y, z or a 3-vector, got "w"
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+import re
+import tomllib
+from collections.abc import Callable, Container, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path as FsPath
+from typing import Any
+
+import symengine as se
+
+from ..errors import ModelError
+from ..model import (
+    WORLD,
+    Body,
+    Cylindrical,
+    Fixed,
+    Force,
+    Free,
+    General,
+    GeneralizedForce,
+    Gravity,
+    Planar,
+    Prismatic,
+    Revolute,
+    Rot,
+    RotationalSpringDamper,
+    Spherical,
+    SpringDamper,
+    System,
+    Torque,
+    Trans,
+    Universal,
+    box,
+    cylinder,
+    disc,
+    rod,
+)
+from .expressions import RESERVED_NAMES, ExpressionError, parse_expression
+from .toml_positions import Path, key_lines, line_of
+
+__all__ = ["ModelFile", "ModelFileError", "NominalMotion", "SimulationSettings", "load_model",
+           "loads_model"]
+
+
+class ModelFileError(ModelError):
+    """A mistake in a model file. ``file``, ``line`` and ``path`` (the key path) say where."""
+
+    def __init__(self, message: str, file: str, line: int | None, path: Path = (),
+                 detail: str = "") -> None:
+        super().__init__(message)
+        self.file = file
+        self.line = line
+        self.path = path
+        self.detail = detail
+
+
+@dataclass(frozen=True)
+class NominalMotion:
+    """A nominal motion y_s(t) to linearize about (METHOD §5).
+
+    ``y``, ``yd``, ``ydd`` are tuples (one entry per coordinate, in the system's order) of
+    expressions in ``t`` and the parameters; ``yd`` and ``ydd`` are the time derivatives of ``y``
+    unless the file gives the rates explicitly.
+    """
+
+    name: str
+    y: tuple[se.Basic, ...]
+    yd: tuple[se.Basic, ...]
+    ydd: tuple[se.Basic, ...]
+    description: str = ""
+
+    @property
+    def is_equilibrium(self) -> bool:
+        """True when y_s is constant (no ``t``) and all rates vanish."""
+        t = se.Symbol("t")
+        return all(t not in e.free_symbols for e in self.y) and all(e == 0 for e in self.yd)
+
+
+@dataclass(frozen=True)
+class SimulationSettings:
+    """How ``jourdain simulate`` integrates the equations of motion.
+
+    ``y0`` and ``yd0`` are the initial coordinates and rates (system order); ``inputs`` maps each
+    input name to an expression in ``t`` and the parameters (0 when not given).
+    """
+
+    t_end: float = 5.0
+    samples: int = 501
+    method: str = "RK45"
+    rtol: float = 1e-8
+    atol: float = 1e-10
+    y0: tuple[float, ...] = ()
+    yd0: tuple[float, ...] = ()
+    inputs: tuple[tuple[str, se.Basic], ...] = ()
+
+
+@dataclass(frozen=True)
+class ModelFile:
+    """A loaded model file: the :class:`~jourdain.System` and what else the file describes."""
+
+    path: str
+    system: System
+    description: str = ""
+    nominal: tuple[NominalMotion, ...] = ()
+    simulation: SimulationSettings = field(default_factory=SimulationSettings)
+    descriptions: tuple[tuple[str, str], ...] = ()
+    view: str | None = None
+
+    def nominal_motion(self, name: str | None = None) -> NominalMotion:
+        """The nominal motion called ``name`` (the first one when ``None``)."""
+        if not self.nominal:
+            raise ModelError(f"{self.path}: the model defines no nominal motion ([nominal.<name>])")
+        if name is None:
+            return self.nominal[0]
+        for n in self.nominal:
+            if n.name == name:
+                return n
+        names = ", ".join(n.name for n in self.nominal)
+        raise ModelError(f'{self.path}: no nominal motion "{name}"; the model has: {names}')
+
+
+# ------------------------------------------------------------------------------------------
+# schema
+# ------------------------------------------------------------------------------------------
+
+_TOP = {"model", "coordinates", "parameters", "inputs", "bodies", "forces", "nominal",
+        "simulation", "report"}
+_JOINT_KEYS: dict[str, set[str]] = {
+    "revolute": {"coordinate", "axis"},
+    "prismatic": {"coordinate", "axis"},
+    "cylindrical": {"coordinates", "axis"},
+    "universal": {"coordinates", "axes"},
+    "spherical": {"coordinates", "sequence"},
+    "planar": {"coordinates", "normal"},
+    "free": {"coordinates", "sequence"},
+    "fixed": set(),
+    "general": {"steps", "coordinates"},
+}
+_JOINT_COMMON = {"type", "name", "position", "orientation"}
+_FORCE_KEYS: dict[str, set[str]] = {
+    "gravity": {"vector"},
+    "force": {"body", "vector", "point", "frame"},
+    "torque": {"body", "vector", "frame"},
+    "spring_damper": {"body_a", "point_a", "body_b", "point_b", "stiffness", "damping",
+                      "rest_length", "law"},
+    "generalized": {"coordinate", "value"},
+    "rotational_spring_damper": {"coordinate", "stiffness", "damping", "rest_angle"},
+}
+_SHAPES = {"point": set(), "rod": {"length", "axis"}, "disc": {"radius", "axis"},
+           "cylinder": {"radius", "length", "axis"}, "box": {"a", "b", "c"}}
+_IDENT = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
+
+
+def _type_name(v: object) -> str:
+    if isinstance(v, bool):
+        return "a boolean"
+    if isinstance(v, int | float):
+        return f"the number {v!r}"
+    if isinstance(v, str):
+        return f'the string "{v}"'
+    if isinstance(v, dict):
+        return "a table"
+    if isinstance(v, list):
+        return f"an array of {len(v)} item{'s' if len(v) != 1 else ''}"
+    return type(v).__name__
+
+
+def describe_path(path: Path) -> str:
+    """``("bodies", "link2", "joint", "axis")`` → ``body "link2" → joint → axis``."""
+    singular = {"bodies": "body", "forces": "force", "parameters": "parameter",
+                "coordinates": "coordinate", "inputs": "input", "nominal": "nominal motion"}
+    parts: list[str] = []
+    items = list(path)
+    if len(items) >= 2 and items[0] in singular and isinstance(items[1], str):
+        parts.append(f'{singular[str(items[0])]} "{items[1]}"')
+        items = items[2:]
+    elif items and isinstance(items[0], str):
+        parts.append(f"[{items[0]}]" if items[0] in _TOP else str(items[0]))
+        items = items[1:]
+    for it in items:
+        if isinstance(it, int):
+            if parts:
+                parts[-1] += f"[{it}]"
+            else:
+                parts.append(f"[{it}]")
+        else:
+            parts.append(str(it))
+    return " → ".join(parts) if parts else "the file"
+
+
+# ------------------------------------------------------------------------------------------
+# loader
+# ------------------------------------------------------------------------------------------
+
+class _Loader:
+    def __init__(self, text: str, filename: str) -> None:
+        self.file = filename
+        self.text = text
+        self.lines: dict[Path, int] = {}
+        self.coords: list[str] = []
+        self.params: dict[str, float] = {}
+        self.inputs: list[str] = []
+        self.units: dict[str, str] = {}
+        self.descriptions: dict[str, str] = {}
+        self.body_names: list[str] = []
+        self.joint_of_body: dict[str, str] = {}
+
+    # --- errors ---------------------------------------------------------------------------
+    def fail(self, path: Path, message: str) -> ModelFileError:
+        line = line_of(self.lines, path)
+        where = describe_path(path)
+        loc = f"{self.file}:{line}" if line else self.file
+        return ModelFileError(f"{loc}: {where}: {message}", self.file, line, path, message)
+
+    def suggest(self, word: str, options: list[str]) -> str:
+        close = difflib.get_close_matches(word, options, n=1)
+        return f' (did you mean "{close[0]}"?)' if close else ""
+
+    # --- typed access ---------------------------------------------------------------------
+    def table(self, value: object, path: Path, allowed: set[str] | None = None,
+              what: str = "a table") -> dict[str, Any]:
+        if not isinstance(value, dict):
+            raise self.fail(path, f"expected {what}, got {_type_name(value)}")
+        if allowed is not None:
+            for k in value:
+                if k not in allowed:
+                    opts = sorted(allowed)
+                    raise self.fail((*path, k), f'unknown key "{k}"{self.suggest(k, opts)}; '
+                                    f"expected one of {', '.join(opts)}")
+        return value
+
+    def require(self, tbl: Mapping[str, Any], key: str, path: Path) -> Any:
+        if key not in tbl:
+            raise self.fail(path, f'missing key "{key}"')
+        return tbl[key]
+
+    def string(self, value: object, path: Path) -> str:
+        if not isinstance(value, str):
+            raise self.fail(path, f"expected a string, got {_type_name(value)}")
+        return value
+
+    def number(self, value: object, path: Path, positive: bool = False,
+               integer: bool = False) -> float:
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise self.fail(path, f"expected a number, got {_type_name(value)}")
+        if integer and not isinstance(value, int):
+            raise self.fail(path, f"expected an integer, got {_type_name(value)}")
+        if not math.isfinite(value):
+            raise self.fail(path, f"expected a finite number, got {value}")
+        if positive and value <= 0:
+            raise self.fail(path, f"expected a positive number, got {value}")
+        return float(value)
+
+    def name(self, value: object, path: Path, what: str) -> str:
+        s = self.string(value, path)
+        if not _IDENT.match(s):
+            raise self.fail(path, f'{what} name "{s}" must start with a letter and contain only '
+                            "letters, digits and _")
+        return s
+
+    # --- expressions ----------------------------------------------------------------------
+    def names_hint(self, allowed: Container[str], context: str) -> Callable[[str], str]:
+        def hint(name: str) -> str:
+            if name in self.coords and "coordinates" not in context:
+                return f" (coordinates are not allowed in {context})"
+            if name.endswith("_d") and name[:-2] in self.coords:
+                return f" (rates are not allowed in {context})"
+            if name == "t":
+                return f" (time t is not allowed in {context})"
+            if name in self.inputs:
+                return f" (inputs are not allowed in {context})"
+            if name in ("elongation", "elongation_d"):
+                return " (elongation and elongation_d are allowed in a spring law only)"
+            pool = [n for n in (*self.coords, *self.params, *self.inputs) if n in allowed]
+            sugg = self.suggest(name, pool)
+            return f"; it is not declared{sugg} — {context} may use {_listing(self, allowed)}"
+        return hint
+
+    def expr(self, value: object, path: Path, allowed: Container[str], context: str) -> se.Basic:
+        if isinstance(value, bool):
+            raise self.fail(path, "expected a number or an expression string, got a boolean")
+        if isinstance(value, int):
+            return se.Integer(value)
+        if isinstance(value, float):
+            if not math.isfinite(value):
+                raise self.fail(path, f"expected a finite number, got {value}")
+            return se.Integer(int(value)) if value == int(value) else se.Float(value)
+        if not isinstance(value, str):
+            raise self.fail(path, f"expected a number or an expression string, got "
+                            f"{_type_name(value)}")
+        try:
+            return parse_expression(value, allowed, describe=self.names_hint(allowed, context))
+        except ExpressionError as exc:
+            col = f" at column {exc.column}" if exc.column else ""
+            raise self.fail(path, f'in expression "{value}"{col}: {exc}') from None
+
+    def vector(self, value: object, path: Path, allowed: Container[str], context: str,
+               n: int = 3) -> tuple[se.Basic, ...]:
+        if not isinstance(value, list):
+            raise self.fail(path, f"expected a {n}-vector (an array of {n} numbers or "
+                            f"expressions), got {_type_name(value)}")
+        if len(value) != n:
+            raise self.fail(path, f"expected a {n}-vector, got {len(value)} component"
+                            f"{'s' if len(value) != 1 else ''}")
+        return tuple(self.expr(v, (*path, i), allowed, context) for i, v in enumerate(value))
+
+    def axis(self, value: object, path: Path, allowed: Container[str],
+             context: str) -> str | tuple[se.Basic, ...]:
+        if isinstance(value, str):
+            s = value.strip().lower().lstrip("+")
+            if s.lstrip("-") not in ("x", "y", "z"):
+                raise self.fail(path, f'expected one of x, y, z or a 3-vector, got "{value}"')
+            return s
+        if isinstance(value, list):
+            vec = self.vector(value, path, allowed, context)
+            if not any(e.free_symbols for e in vec):
+                norm = math.sqrt(sum(float(e) ** 2 for e in vec))
+                if norm == 0:
+                    raise self.fail(path, "the axis must not be the zero vector")
+                if abs(norm - 1) > 1e-12:
+                    # a direction is meant; make it a unit vector
+                    vec = tuple(e / se.sqrt(sum(x**2 for x in vec)) for e in vec)
+            return vec
+        raise self.fail(path, f"expected one of x, y, z or a 3-vector, got {_type_name(value)}")
+
+    def matrix3(self, value: object, path: Path, allowed: Container[str],
+                context: str) -> tuple[tuple[se.Basic, ...], ...]:
+        if not isinstance(value, list) or len(value) != 3 or not all(
+                isinstance(r, list) for r in value):
+            raise self.fail(path, f"expected a 3x3 matrix (an array of 3 rows of 3), got "
+                            f"{_type_name(value)}")
+        for i, r in enumerate(value):
+            if len(r) != 3:
+                raise self.fail((*path, i), f"expected a row of 3 entries, got {len(r)}")
+        return tuple(tuple(self.expr(v, (*path, i, j), allowed, context)
+                           for j, v in enumerate(r)) for i, r in enumerate(value))
+
+    # --- sections -------------------------------------------------------------------------
+    def load(self) -> ModelFile:
+        try:
+            data = tomllib.loads(self.text)
+        except tomllib.TOMLDecodeError as exc:
+            msg = str(exc)
+            m = re.search(r"\(at line (\d+), column (\d+)\)", msg)
+            line = int(m.group(1)) if m else None
+            core = re.sub(r"\s*\(at line \d+, column \d+\)", "", msg)
+            col = f", column {m.group(2)}" if m else ""
+            loc = f"{self.file}:{line}" if line else self.file
+            raise ModelFileError(f"{loc}: TOML syntax error{col}: {core}", self.file, line,
+                                 (), core) from None
+        self.lines = key_lines(self.text)
+        self.table(data, (), _TOP)
+        model = self.table(data.get("model", {}), ("model",),
+                           {"name", "description", "view"})
+        name = self.string(model.get("name", FsPath(self.file).stem), ("model", "name"))
+        description = self.string(model.get("description", ""), ("model", "description"))
+        view = None
+        if "view" in model:
+            view = self.string(model["view"], ("model", "view")).lower()
+            if view not in ("xy", "xz", "yz", "yx", "zx", "zy", "3d"):
+                raise self.fail(("model", "view"), f'expected one of xy, xz, yz or 3d, got '
+                                f'"{model["view"]}"')
+
+        self.read_coordinates(data)
+        self.read_parameters(data)
+        self.read_inputs(data)
+        self.check_names()
+        bodies = self.read_bodies(data)
+        forces = self.read_forces(data)
+        try:
+            system = System(self.coords, bodies, forces, parameters=self.params,
+                            inputs=self.inputs, units=self.units, name=name)
+        except ModelFileError:
+            raise
+        except ModelError as exc:
+            raise self.fail(self.locate(str(exc)), str(exc)) from None
+        nominal = self.read_nominal(data, system)
+        sim = self.read_simulation(data, system)
+        return ModelFile(self.file, system, description, nominal, sim,
+                         tuple(self.descriptions.items()), view)
+
+    def locate(self, message: str) -> Path:
+        """Best key path for an error the core raised about the assembled system."""
+        m = re.search(r'body "(\w+)"', message)
+        if m and m.group(1) in self.body_names:
+            return ("bodies", m.group(1))
+        m = re.search(r'joint "(\w+)"', message)
+        if m:
+            for b, j in self.joint_of_body.items():
+                if j == m.group(1):
+                    return ("bodies", b, "joint")
+        m = re.search(r'(?:force|spring-damper|torque) "(\w+)"', message)
+        if m:
+            return ("forces", m.group(1))
+        if "coordinate" in message:
+            return ("coordinates",)
+        return ()
+
+    def read_coordinates(self, data: dict) -> None:
+        path: Path = ("coordinates",)
+        if "coordinates" not in data:
+            raise self.fail((), "missing table [coordinates] (the generalized coordinates)")
+        coords = data["coordinates"]
+        if isinstance(coords, list):
+            for i, c in enumerate(coords):
+                self.coords.append(self.name(c, (*path, i), "coordinate"))
+            return
+        tbl = self.table(coords, path, what="a table of coordinates or an array of names")
+        for cname, spec in tbl.items():
+            p = (*path, cname)
+            self.name(cname, p, "coordinate")
+            self.coords.append(cname)
+            if isinstance(spec, str):  # shorthand: the unit
+                self.units[cname] = spec
+                continue
+            spec = self.table(spec, p, {"unit", "description"},
+                              what='a table such as { unit = "rad" }')
+            if "unit" in spec:
+                self.units[cname] = self.string(spec["unit"], (*p, "unit"))
+            if "description" in spec:
+                self.descriptions[cname] = self.string(spec["description"], (*p, "description"))
+        if not self.coords:
+            raise self.fail(path, "the model needs at least one coordinate")
+
+    def read_parameters(self, data: dict) -> None:
+        path: Path = ("parameters",)
+        tbl = self.table(data.get("parameters", {}), path)
+        for pname, spec in tbl.items():
+            p = (*path, pname)
+            self.name(pname, p, "parameter")
+            if isinstance(spec, dict):
+                spec = self.table(spec, p, {"value", "unit", "description"})
+                value = self.number(self.require(spec, "value", p), (*p, "value"))
+                if "unit" in spec:
+                    self.units[pname] = self.string(spec["unit"], (*p, "unit"))
+                if "description" in spec:
+                    self.descriptions[pname] = self.string(spec["description"],
+                                                           (*p, "description"))
+            else:
+                if isinstance(spec, str):
+                    raise self.fail(p, f'a parameter value must be a number, got the string '
+                                    f'"{spec}" (parameters are not expressions; write the number)')
+                value = self.number(spec, p)
+            self.params[pname] = value
+
+    def read_inputs(self, data: dict) -> None:
+        path: Path = ("inputs",)
+        inputs = data.get("inputs", {})
+        if isinstance(inputs, list):
+            for i, c in enumerate(inputs):
+                self.inputs.append(self.name(c, (*path, i), "input"))
+            return
+        tbl = self.table(inputs, path, what="a table of inputs or an array of names")
+        for iname, spec in tbl.items():
+            p = (*path, iname)
+            self.name(iname, p, "input")
+            self.inputs.append(iname)
+            if isinstance(spec, str):
+                self.units[iname] = spec
+                continue
+            spec = self.table(spec, p, {"unit", "description"})
+            if "unit" in spec:
+                self.units[iname] = self.string(spec["unit"], (*p, "unit"))
+            if "description" in spec:
+                self.descriptions[iname] = self.string(spec["description"], (*p, "description"))
+
+    def check_names(self) -> None:
+        seen: dict[str, str] = {}
+        groups = (("coordinates", self.coords), ("parameters", list(self.params)),
+                  ("inputs", self.inputs))
+        for section, names in groups:
+            for n in names:
+                p: Path = (section, n)
+                if n in RESERVED_NAMES:
+                    raise self.fail(p, f'"{n}" is a reserved name (a function, a constant, t, '
+                                    "world or elongation); choose another name")
+                if n in seen:
+                    raise self.fail(p, f'"{n}" is already declared in [{seen[n]}]')
+                seen[n] = section
+        for c in self.coords:
+            for suffix in ("_d", "_dd"):
+                if c + suffix in seen:
+                    raise self.fail((seen[c + suffix], c + suffix),
+                                    f'"{c + suffix}" is the name of the rate of coordinate '
+                                    f'"{c}"; choose another name')
+
+    # --- bodies ---------------------------------------------------------------------------
+    def read_bodies(self, data: dict) -> list[Body]:
+        path: Path = ("bodies",)
+        if "bodies" not in data:
+            raise self.fail((), "missing table [bodies.<name>] (at least one body)")
+        tbl = self.table(data["bodies"], path, what="tables [bodies.<name>]")
+        if not tbl:
+            raise self.fail(path, "the model needs at least one body")
+        for bname in tbl:
+            self.name(bname, (*path, bname), "body")
+            if bname == WORLD:
+                raise self.fail((*path, bname), '"world" is the inertial frame, not a body name')
+        self.body_names = list(tbl)
+        return [self.read_body(bname, spec) for bname, spec in tbl.items()]
+
+    def read_body(self, bname: str, spec: object) -> Body:
+        p: Path = ("bodies", bname)
+        spec = self.table(spec, p, {"parent", "joint", "mass", "com", "inertia", "description"})
+        parent = self.string(self.require(spec, "parent", p), (*p, "parent"))
+        if parent != WORLD and parent not in self.body_names:
+            raise self.fail((*p, "parent"), f'unknown parent "{parent}"'
+                            f'{self.suggest(parent, self.body_names)}; expected "world" or one '
+                            f"of the bodies {', '.join(self.body_names)}")
+        if parent == bname:
+            raise self.fail((*p, "parent"), "a body cannot be its own parent")
+        params = set(self.params)
+        ctx = "mass data (parameters only)"
+        mass = self.expr(self.require(spec, "mass", p), (*p, "mass"), params, ctx)
+        com = self.vector(spec.get("com", [0, 0, 0]), (*p, "com"), params, ctx)
+        inertia = self.inertia(self.require(spec, "inertia", p), (*p, "inertia"), mass, params,
+                               ctx)
+        joint = self.joint(self.require(spec, "joint", p), (*p, "joint"), bname)
+        if "description" in spec:
+            self.descriptions[bname] = self.string(spec["description"], (*p, "description"))
+        try:
+            return Body(bname, parent, joint, mass=mass, com=com, inertia=inertia)
+        except ModelError as exc:
+            raise self.fail(p, str(exc)) from None
+
+    def inertia(self, value: object, path: Path, mass: se.Basic, params: set[str],
+                ctx: str) -> Any:
+        if isinstance(value, str):
+            if value == "point":
+                return [0, 0, 0]
+            raise self.fail(path, f'expected "point", [Ixx, Iyy, Izz], a 3x3 matrix or a shape '
+                            f"table such as {{ rod = {{ length = \"l\", axis = \"x\" }} }}, got "
+                            f'"{value}"')
+        if isinstance(value, list):
+            if value and isinstance(value[0], list):
+                return self.matrix3(value, path, params, ctx)
+            if len(value) != 3:
+                raise self.fail(path, f"expected the 3 principal moments [Ixx, Iyy, Izz] or a "
+                                f"3x3 matrix, got {len(value)} entries")
+            return list(self.vector(value, path, params, ctx))
+        if isinstance(value, dict):
+            if len(value) != 1:
+                raise self.fail(path, "a shape table has exactly one key: point, rod, disc, "
+                                "cylinder or box")
+            shape, args = next(iter(value.items()))
+            sp = (*path, shape)
+            if shape not in _SHAPES:
+                raise self.fail(sp, f'unknown shape "{shape}"{self.suggest(shape, list(_SHAPES))}'
+                                f"; expected one of {', '.join(_SHAPES)}")
+            args = self.table(args, sp, _SHAPES[shape] | {"mass"})
+            m = self.expr(args["mass"], (*sp, "mass"), params, ctx) if "mass" in args else mass
+
+            def get(k: str) -> se.Basic:
+                return self.expr(self.require(args, k, sp), (*sp, k), params, ctx)
+
+            def ax(default: str) -> str:
+                a = args.get("axis", default)
+                if a not in ("x", "y", "z"):
+                    raise self.fail((*sp, "axis"), f'expected one of x, y, z, got '
+                                    f"{_type_name(a)}")
+                return str(a)
+
+            if shape == "point":
+                return [0, 0, 0]
+            if shape == "rod":
+                return rod(m, get("length"), ax("x"))
+            if shape == "disc":
+                return disc(m, get("radius"), ax("z"))
+            if shape == "cylinder":
+                return cylinder(m, get("radius"), get("length"), ax("z"))
+            return box(m, get("a"), get("b"), get("c"))
+        raise self.fail(path, f"expected an inertia (see docs/model-format.md), got "
+                        f"{_type_name(value)}")
+
+    # --- joints ---------------------------------------------------------------------------
+    def joint(self, value: object, p: Path, bname: str) -> Any:
+        spec = self.table(value, p, what='a joint table such as { type = "revolute", '
+                          'coordinate = "phi", axis = "z" }')
+        jtype = self.string(self.require(spec, "type", p), (*p, "type")).lower()
+        if jtype not in _JOINT_KEYS:
+            raise self.fail((*p, "type"), f'unknown joint type "{jtype}"'
+                            f"{self.suggest(jtype, list(_JOINT_KEYS))}; expected one of "
+                            f"{', '.join(_JOINT_KEYS)}")
+        self.table(spec, p, _JOINT_KEYS[jtype] | _JOINT_COMMON)
+        jname = self.name(spec.get("name", bname), (*p, "name"), "joint")
+        if jname in self.joint_of_body.values():
+            other = next(b for b, j in self.joint_of_body.items() if j == jname)
+            raise self.fail((*p, "name"), f'joint name "{jname}" is already used by body '
+                            f'"{other}"')
+        self.joint_of_body[bname] = jname
+        params = set(self.params)
+        kin = set(self.coords) | params | {"t"}
+        ctx_const = "joint positions and orientations (parameters only)"
+        position = self.vector(spec.get("position", [0, 0, 0]), (*p, "position"), params,
+                               ctx_const)
+        orientation = None
+        if "orientation" in spec:
+            orientation = self.orientation(spec["orientation"], (*p, "orientation"), params,
+                                           ctx_const)
+        kw = {"position": position, "orientation": orientation}
+
+        def coord(key: str) -> se.Symbol:
+            v = self.require(spec, key, p)
+            return se.Symbol(self.coordinate(v, (*p, key)))
+
+        def coords(n: int) -> list[se.Symbol]:
+            v = self.require(spec, "coordinates", p)
+            if not isinstance(v, list) or len(v) != n:
+                raise self.fail((*p, "coordinates"), f"a {jtype} joint needs an array of {n} "
+                                f"coordinates, got {_type_name(v)}")
+            return [se.Symbol(self.coordinate(c, (*p, "coordinates", i)))
+                    for i, c in enumerate(v)]
+
+        def sequence(default: str) -> str:
+            s = self.string(spec.get("sequence", default), (*p, "sequence")).lower()
+            ok = {"xyz", "xzy", "yxz", "yzx", "zxy", "zyx", "zxz", "xyx", "xzx", "yxy", "yzy",
+                  "zyz"}
+            if s not in ok:
+                raise self.fail((*p, "sequence"), f'expected a rotation sequence such as "xyz" '
+                                f'or "zxz", got "{s}"')
+            return s
+
+        ctx_kin = "joints (coordinates, parameters and t)"
+        try:
+            if jtype == "revolute":
+                return Revolute(jname, coord("coordinate"),
+                                self.axis(spec.get("axis", "z"), (*p, "axis"), params, ctx_const),
+                                **kw)
+            if jtype == "prismatic":
+                return Prismatic(jname, coord("coordinate"),
+                                 self.axis(spec.get("axis", "x"), (*p, "axis"), params,
+                                           ctx_const), **kw)
+            if jtype == "cylindrical":
+                return Cylindrical(jname, coords(2), self.axis(spec.get("axis", "z"),
+                                                               (*p, "axis"), params, ctx_const),
+                                   **kw)
+            if jtype == "universal":
+                axes = spec.get("axes", ["x", "y"])
+                if not isinstance(axes, list) or len(axes) != 2:
+                    raise self.fail((*p, "axes"), f"expected an array of 2 axes, got "
+                                    f"{_type_name(axes)}")
+                ax = [self.axis(a, (*p, "axes", i), params, ctx_const)
+                      for i, a in enumerate(axes)]
+                return Universal(jname, coords(2), ax, **kw)
+            if jtype == "spherical":
+                return Spherical(jname, coords(3), sequence("xyz"), **kw)
+            if jtype == "planar":
+                normal = self.string(spec.get("normal", "z"), (*p, "normal"))
+                if normal not in ("x", "y", "z"):
+                    raise self.fail((*p, "normal"), f'expected one of x, y, z, got "{normal}"')
+                return Planar(jname, coords(3), normal, **kw)
+            if jtype == "free":
+                return Free(jname, coords(6), sequence("xyz"), **kw)
+            if jtype == "fixed":
+                return Fixed(jname, **kw)
+            steps = self.steps(self.require(spec, "steps", p), (*p, "steps"), kin, ctx_kin)
+            driven = []
+            if "coordinates" in spec:
+                v = spec["coordinates"]
+                if not isinstance(v, list):
+                    raise self.fail((*p, "coordinates"), f"expected an array of coordinate "
+                                    f"names, got {_type_name(v)}")
+                driven = [se.Symbol(self.coordinate(c, (*p, "coordinates", i)))
+                          for i, c in enumerate(v)]
+            else:
+                used = set().union(*(_free(s) for s in steps)) & set(self.coords)
+                driven = [se.Symbol(c) for c in self.coords if c in used]
+            return General(jname, steps, coordinates=driven, **kw)
+        except ModelFileError:
+            raise
+        except ModelError as exc:
+            raise self.fail(p, str(exc)) from None
+
+    def coordinate(self, value: object, path: Path) -> str:
+        s = self.string(value, path)
+        if s not in self.coords:
+            raise self.fail(path, f'"{s}" is not a declared coordinate'
+                            f"{self.suggest(s, self.coords)}; coordinates are "
+                            f"{', '.join(self.coords)}")
+        return s
+
+    def orientation(self, value: object, path: Path, params: set[str], ctx: str) -> Any:
+        if isinstance(value, list) and value and all(isinstance(r, dict) for r in value):
+            rots = self.steps(value, path, params, ctx)
+            if any(isinstance(s, Trans) for s in rots):
+                raise self.fail(path, "an orientation is made of rotations only ({ rot = ..., "
+                                "angle = ... })")
+            return list(rots)
+        return self.matrix3(value, path, params, ctx)
+
+    def steps(self, value: object, path: Path, allowed: set[str], ctx: str) -> list[Rot | Trans]:
+        if not isinstance(value, list) or not value:
+            raise self.fail(path, f'expected an array of steps such as {{ rot = "z", angle = '
+                            f'"phi" }} or {{ trans = "x", distance = "s" }}, got '
+                            f"{_type_name(value)}")
+        out: list[Rot | Trans] = []
+        for i, st in enumerate(value):
+            sp = (*path, i)
+            st = self.table(st, sp, {"rot", "angle", "trans", "distance"},
+                            what='a step table such as { rot = "z", angle = "phi" }')
+            if "rot" in st:
+                if "trans" in st or "distance" in st:
+                    raise self.fail(sp, "a step is either a rotation (rot, angle) or a "
+                                    "translation (trans, distance), not both")
+                ax = self.axis(st["rot"], (*sp, "rot"), set(self.params), ctx)
+                angle = self.expr(self.require(st, "angle", sp), (*sp, "angle"), allowed, ctx)
+                out.append(Rot(ax, angle))
+            elif "trans" in st:
+                if "angle" in st:
+                    raise self.fail((*sp, "angle"), "a translation step has a distance, not an "
+                                    "angle")
+                tr = st["trans"]
+                if isinstance(tr, list) and "distance" not in st:
+                    out.append(Trans(vector=self.vector(tr, (*sp, "trans"), allowed, ctx)))
+                else:
+                    ax = self.axis(tr, (*sp, "trans"), set(self.params), ctx)
+                    dist = self.expr(self.require(st, "distance", sp), (*sp, "distance"),
+                                     allowed, ctx)
+                    out.append(Trans(ax, dist))
+            else:
+                raise self.fail(sp, 'a step needs "rot" (with "angle") or "trans" (with '
+                                '"distance", or a 3-vector)')
+        return out
+
+    # --- forces ---------------------------------------------------------------------------
+    def read_forces(self, data: dict) -> list[Any]:
+        path: Path = ("forces",)
+        tbl = self.table(data.get("forces", {}), path, what="tables [forces.<name>]")
+        out = []
+        for fname, spec in tbl.items():
+            out.append(self.force(fname, spec, (*path, fname)))
+        return out
+
+    def force(self, fname: str, spec: object, p: Path) -> Any:
+        self.name(fname, p, "force")
+        spec = self.table(spec, p, what='a force table with a "type"')
+        ftype = self.string(self.require(spec, "type", p), (*p, "type")).lower()
+        if ftype not in _FORCE_KEYS:
+            raise self.fail((*p, "type"), f'unknown force type "{ftype}"'
+                            f"{self.suggest(ftype, list(_FORCE_KEYS))}; expected one of "
+                            f"{', '.join(_FORCE_KEYS)}")
+        self.table(spec, p, _FORCE_KEYS[ftype] | {"type", "description"})
+        rates = {f"{c}_d" for c in self.coords}
+        allowed = set(self.coords) | rates | set(self.params) | set(self.inputs) | {"t"}
+        ctx = "forces (coordinates, rates, parameters, inputs and t)"
+        params = set(self.params)
+        pctx = "points (parameters only)"
+
+        def body(key: str, world_ok: bool) -> str:
+            b = self.string(self.require(spec, key, p), (*p, key))
+            ok = self.body_names + ([WORLD] if world_ok else [])
+            if b not in ok:
+                raise self.fail((*p, key), f'unknown body "{b}"{self.suggest(b, ok)}; expected '
+                                f"one of {', '.join(ok)}")
+            return b
+
+        def frame() -> str:
+            fr = self.string(spec.get("frame", WORLD), (*p, "frame"))
+            ok = [WORLD, *self.body_names]
+            if fr not in ok:
+                raise self.fail((*p, "frame"), f'unknown frame "{fr}"; expected "world" or a '
+                                "body name")
+            return fr
+
+        def e(key: str, default: object = None, names: set[str] = allowed,
+              context: str = ctx) -> se.Basic:
+            v = spec.get(key, default) if default is not None else self.require(spec, key, p)
+            return self.expr(v, (*p, key), names, context)
+
+        try:
+            if ftype == "gravity":
+                return Gravity(self.vector(self.require(spec, "vector", p), (*p, "vector"),
+                                           params | {"t"}, "gravity (parameters and t)"),
+                               name=fname)
+            if ftype == "force":
+                return Force(fname, body("body", False),
+                             self.vector(self.require(spec, "vector", p), (*p, "vector"),
+                                         allowed, ctx),
+                             self.vector(spec.get("point", [0, 0, 0]), (*p, "point"), params,
+                                         pctx), frame())
+            if ftype == "torque":
+                return Torque(fname, body("body", False),
+                              self.vector(self.require(spec, "vector", p), (*p, "vector"),
+                                          allowed, ctx), frame())
+            if ftype == "spring_damper":
+                law = None
+                if "law" in spec:
+                    law = e("law", names=allowed | {"elongation", "elongation_d"},
+                            context="a spring law (elongation, elongation_d, coordinates, "
+                            "rates, parameters, inputs and t)")
+                return SpringDamper(
+                    fname, body("body_a", True),
+                    self.vector(spec.get("point_a", [0, 0, 0]), (*p, "point_a"), params, pctx),
+                    body("body_b", True),
+                    self.vector(spec.get("point_b", [0, 0, 0]), (*p, "point_b"), params, pctx),
+                    stiffness=e("stiffness", 0), damping=e("damping", 0),
+                    rest_length=e("rest_length", 0), law=law)
+            if ftype == "generalized":
+                c = se.Symbol(self.coordinate(self.require(spec, "coordinate", p),
+                                              (*p, "coordinate")))
+                return GeneralizedForce(fname, c, e("value"))
+            c = se.Symbol(self.coordinate(self.require(spec, "coordinate", p),
+                                          (*p, "coordinate")))
+            return RotationalSpringDamper(fname, c, stiffness=e("stiffness", 0),
+                                          damping=e("damping", 0),
+                                          rest_angle=e("rest_angle", 0, params | {"t"},
+                                                       "a rest angle (parameters and t)"))
+        except ModelFileError:
+            raise
+        except ModelError as exc:
+            raise self.fail(p, str(exc)) from None
+
+    # --- nominal motions and simulation ---------------------------------------------------
+    def read_nominal(self, data: dict, system: System) -> tuple[NominalMotion, ...]:
+        path: Path = ("nominal",)
+        tbl = self.table(data.get("nominal", {}), path, what="tables [nominal.<name>]")
+        allowed = set(self.params) | {"t"}
+        ctx = "a nominal motion (parameters and t)"
+        t = se.Symbol("t")
+        out = []
+        for nname, spec in tbl.items():
+            p = (*path, nname)
+            self.name(nname, p, "nominal motion")
+            spec = self.table(spec, p, {"y", "yd", "description"})
+
+            def values(key: str, spec: dict = spec, p: Path = p) -> dict[str, se.Basic]:
+                tb = self.table(spec.get(key, {}), (*p, key),
+                                what="a table of coordinate = value")
+                out: dict[str, se.Basic] = {}
+                for c, v in tb.items():
+                    if c not in self.coords:
+                        raise self.fail((*p, key, c), f'"{c}" is not a declared coordinate'
+                                        f"{self.suggest(c, self.coords)}")
+                    out[c] = self.expr(v, (*p, key, c), allowed, ctx)
+                return out
+
+            y = values("y")
+            y_full = tuple(y.get(c, se.Integer(0)) for c in self.coords)
+            if "yd" in spec:
+                yd = values("yd")
+                yd_full = tuple(yd.get(c, se.diff(y.get(c, se.Integer(0)), t))
+                                for c in self.coords)
+            else:
+                yd_full = tuple(se.diff(e, t) for e in y_full)
+            ydd_full = tuple(se.diff(e, t) for e in yd_full)
+            desc = self.string(spec.get("description", ""), (*p, "description"))
+            out.append(NominalMotion(nname, y_full, yd_full, ydd_full, desc))
+        return tuple(out)
+
+    def read_simulation(self, data: dict, system: System) -> SimulationSettings:
+        p: Path = ("simulation",)
+        spec = self.table(data.get("simulation", {}), p,
+                          {"t_end", "samples", "method", "rtol", "atol", "y0", "yd0", "inputs"})
+        kw: dict[str, Any] = {}
+        if "t_end" in spec:
+            kw["t_end"] = self.number(spec["t_end"], (*p, "t_end"), positive=True)
+        if "samples" in spec:
+            n = self.number(spec["samples"], (*p, "samples"), positive=True, integer=True)
+            if n < 2:
+                raise self.fail((*p, "samples"), "expected at least 2 samples")
+            kw["samples"] = int(n)
+        if "method" in spec:
+            methods = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
+            m = self.string(spec["method"], (*p, "method"))
+            if m not in methods:
+                raise self.fail((*p, "method"), f'unknown method "{m}"'
+                                f"{self.suggest(m, list(methods))}; expected one of "
+                                f"{', '.join(methods)}")
+            kw["method"] = m
+        for k in ("rtol", "atol"):
+            if k in spec:
+                kw[k] = self.number(spec[k], (*p, k), positive=True)
+        nums: set[str] = set()  # initial values are constant expressions (pi/4)
+        for key in ("y0", "yd0"):
+            tb = self.table(spec.get(key, {}), (*p, key), what="a table of coordinate = value")
+            vals = {}
+            for c, v in tb.items():
+                cname = c[:-2] if key == "yd0" and c.endswith("_d") else c
+                if cname not in self.coords:
+                    raise self.fail((*p, key, c), f'"{c}" is not a declared coordinate'
+                                    f"{self.suggest(c, self.coords)}")
+                ex = self.expr(v, (*p, key, c), nums | set(self.params),
+                               "initial values (numbers and parameters)")
+                vals[cname] = float(ex.subs({se.Symbol(k): x for k, x in self.params.items()}))
+            kw[key] = tuple(vals.get(c, 0.0) for c in self.coords)
+        tb = self.table(spec.get("inputs", {}), (*p, "inputs"),
+                        what="a table of input = expression in t")
+        ins = []
+        for iname, v in tb.items():
+            if iname not in self.inputs:
+                raise self.fail((*p, "inputs", iname), f'"{iname}" is not a declared input'
+                                f"{self.suggest(iname, self.inputs)}")
+            ins.append((iname, self.expr(v, (*p, "inputs", iname), set(self.params) | {"t"},
+                                         "input laws (parameters and t)")))
+        kw["inputs"] = tuple(ins)
+        kw.setdefault("y0", tuple(0.0 for _ in self.coords))
+        kw.setdefault("yd0", tuple(0.0 for _ in self.coords))
+        return SimulationSettings(**kw)
+
+
+def _free(step: Rot | Trans) -> set[str]:
+    exprs = [step.angle] if isinstance(step, Rot) else list(step.vector)
+    return {str(s) for e in exprs for s in e.free_symbols}
+
+
+def _listing(loader: _Loader, allowed: Container[str]) -> str:
+    parts = []
+    for label, names in (("coordinates", loader.coords),
+                         ("rates", [f"{c}_d" for c in loader.coords]),
+                         ("parameters", list(loader.params)), ("inputs", loader.inputs)):
+        shown = [n for n in names if n in allowed]
+        if shown:
+            parts.append(f"{label} {', '.join(shown)}")
+    if "t" in allowed:
+        parts.append("t")
+    return "; ".join(parts) if parts else "numbers only"
+
+
+def loads_model(text: str, filename: str = "<string>") -> ModelFile:
+    """Read a model from TOML ``text``; ``filename`` is used in error messages."""
+    return _Loader(text, filename).load()
+
+
+def load_model(path: str | FsPath) -> ModelFile:
+    """Read a model file. Raises :class:`ModelFileError` (a :class:`~jourdain.ModelError`)."""
+    name = str(path)
+    try:
+        raw = FsPath(path).read_bytes()
+    except OSError as exc:
+        raise ModelFileError(f"{name}: cannot read the model file: {exc.strerror}", name,
+                             None) from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = raw[:exc.start].count(b"\n") + 1
+        raise ModelFileError(f"{name}:{line}: the file is not valid UTF-8 text", name,
+                             line) from None
+    return loads_model(text, name)
