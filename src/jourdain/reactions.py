@@ -1,0 +1,910 @@
+"""Reaction forces (METHOD.md §4): Q̄ from the joints, N̂·g = k̂ − q̂.
+
+Every joint transmits a *wrench* (force and torque) in the directions it constrains. The wrench
+is written in the child body's frame (the frame at the end of the joint) and acts at that frame's
+origin, the joint point on the child side; the child body receives it with a plus sign, the
+parent with a minus sign, each with the lever arm from the joint point to its centre of mass:
+
+* translational rows (inertial frame): ``±S_c·F``
+* rotational rows, child (child body frame, about its centre of mass): ``T − c_c × F``
+* rotational rows, parent (parent body frame, about its centre of mass):
+  ``−(R_pc·T + (o_pc − c_p) × R_pc·F)``, ``R_pc`` the rotation child → parent and ``o_pc`` the
+  child frame's origin in the parent frame.
+
+So ``Q̄`` (6p×q) has one column per constrained direction, ``g`` (q) are the magnitudes of the
+reaction forces and torques, named ``<joint>.F_x``, ``<joint>.T_y``, ... after the joint and the
+direction in the child frame. Multiplying ``M̄·J̄·ÿ + q̄^c = q̄^e + Q̄·g`` by ``Q̄ᵀM̄⁻¹`` removes
+ÿ (orthogonality ``J̄ᵀQ̄ = 0``)::
+
+    N̂·g = k̂ − q̂,   N̂ = Q̄ᵀM̄⁻¹Q̄,  k̂ = Q̄ᵀM̄⁻¹q̄^c,  q̂ = Q̄ᵀM̄⁻¹q̄^e.
+
+Singular inertia
+----------------
+Rows of M̄ that are zero (the rotational rows of a point mass, the axial row of a thin rod, all
+six rows of a massless body) have no inverse. They are *not* dropped: they state that the
+wrench on a body without inertia balances (``0 = q̄^e_s − q̄^c_s + Q̄_s·g``, the statics of a
+massless link), which determines, e.g., that a massless rod with a point mass transmits only an
+axial force. With ``r`` the regular and ``s`` the singular rows, ``N̂, k̂, q̂`` are formed from the
+regular rows, and the reactions solve the bordered system ::
+
+    [ N̂    Q̄_sᵀ ] [ g ]   [ k̂ − q̂         ]
+    [ Q̄_s  0    ] [ λ ] = [ q̄^c_s − q̄^e_s ],   λ = J̄_s·ÿ
+
+(multiply the regular rows by ``Q̄_rᵀM̄_r⁻¹`` and use ``Q̄_rᵀJ̄_r = −Q̄_sᵀJ̄_s``). It is exact:
+the limit of the regular method for inertia ε → 0. Components of ``g`` that this system leaves
+open (redundant constrained directions, a statically indeterminate joint) are reported as
+undetermined (NaN, and listed by name), never as numbers.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from functools import lru_cache
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import symengine as se
+
+from .errors import EvaluationError, JourdainError, ModelError
+from .kinematics import Z3, _add, _cross, _dot, _mm, _mtv, _mv, _scale
+from .model.bodies import WORLD
+from .model.joints import IDENTITY, Joint, Mat3, Rot, Trans, Vec3, rotation_matrix
+from .newton_euler import NewtonEuler
+from .symbolic import SymMatrix
+
+if TYPE_CHECKING:
+    from .model.system import System
+
+ZERO = se.Integer(0)
+ONE = se.Integer(1)
+Wrench = tuple[se.Basic, se.Basic, se.Basic, se.Basic, se.Basic, se.Basic]
+
+_UNIT = {
+    "F_x": (1, 0, 0, 0, 0, 0), "F_y": (0, 1, 0, 0, 0, 0), "F_z": (0, 0, 1, 0, 0, 0),
+    "T_x": (0, 0, 0, 1, 0, 0), "T_y": (0, 0, 0, 0, 1, 0), "T_z": (0, 0, 0, 0, 0, 1),
+}
+
+
+def _unit(name: str) -> Wrench:
+    return tuple(se.Integer(c) for c in _UNIT[name])  # type: ignore[return-value]
+
+
+# --- constrained directions of one joint ---------------------------------------------------------
+@dataclass(frozen=True)
+class JointReactions:
+    """The constrained directions of one joint.
+
+    ``names`` are the components of ``g`` (``hinge1.F_x`` ...), ``wrenches`` the unit wrenches
+    ``(F_x, F_y, F_z, T_x, T_y, T_z)`` in the child body frame at its origin (they may depend on
+    the joint's coordinates, as the torque of a universal joint does), ``columns`` their indices
+    in ``g`` and in the columns of ``Q̄``.
+    """
+
+    joint: Joint
+    child: str
+    parent: str
+    names: tuple[str, ...]
+    wrenches: tuple[Wrench, ...]
+    columns: tuple[int, ...]
+
+
+def _perpendicular(u: Vec3, joint: Joint, what: str) -> list[tuple[str, Vec3]]:
+    """Two unit vectors perpendicular to the unit axis ``u`` (named after the coordinate axes
+    when ``u`` is one of them)."""
+    if any(c.free_symbols for c in u):
+        raise ModelError(
+            f'joint "{joint.name}": the reactions need a numeric {what} axis, got {u}; use a '
+            "General joint with constrained=[...] for a symbolic axis"
+        )
+    uv = np.array([float(c) for c in u])
+    for k, ax in enumerate("xyz"):
+        if abs(abs(uv[k]) - 1.0) < 1e-15:
+            others = [a for a in "xyz" if a != ax]
+            return [(a, tuple(se.Integer(int(a == b)) for b in "xyz")) for a in others]  # type: ignore[misc]
+    k = int(np.argmin(np.abs(uv)))
+    e = np.zeros(3)
+    e[k] = 1.0
+    e1 = np.cross(uv, e)
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(uv, e1)
+    return [("1", tuple(se.Float(float(x)) for x in e1)),  # type: ignore[misc]
+            ("2", tuple(se.Float(float(x)) for x in e2))]
+
+
+def _wrench(F: Vec3 = Z3, T: Vec3 = Z3) -> Wrench:
+    return (*F, *T)  # type: ignore[return-value]
+
+
+def _joint_rotation(joint: Joint) -> tuple[Mat3, Vec3]:
+    """(R_pc, o_pc): child frame → parent frame rotation and the child origin in the parent."""
+    R, p = joint.orientation, joint.position
+    for s in joint.steps:
+        if isinstance(s, Rot):
+            R = _mm(R, rotation_matrix(s.axis, s.angle))
+        else:
+            p = _add(p, _mv(R, s.vector))
+    return R, p
+
+
+def relative_twist(joint: Joint, coordinates: Sequence[se.Symbol]) -> list[tuple[Vec3, Vec3]]:
+    """Columns ``(v, ω)`` of the joint's relative twist Jacobian, one per coordinate in
+    ``coordinates``: the velocity of the child frame's origin and the angular velocity of the
+    child relative to the parent, per unit rate of the coordinate, in the child body frame."""
+    R: Mat3 = IDENTITY
+    p: Vec3 = Z3
+    rots: list[tuple[Vec3, Vec3, se.Basic]] = []  # (axis in joint frame, origin, angle)
+    trans: list[tuple[Mat3, Vec3]] = []  # (frame before the step, vector)
+    for s in joint.steps:
+        if isinstance(s, Rot):
+            rots.append((_mv(R, s.axis), p, s.angle))
+            R = _mm(R, rotation_matrix(s.axis, s.angle))
+        else:
+            trans.append((R, s.vector))
+            p = _add(p, _mv(R, s.vector))
+    out = []
+    for y in coordinates:
+        w: Vec3 = Z3
+        v: Vec3 = Z3
+        for axis, origin, angle in rots:
+            d = se.diff(angle, y)
+            if d != 0:
+                w = _add(w, _scale(axis, d))
+                v = _add(v, _scale(_cross(axis, (p[0] - origin[0], p[1] - origin[1],
+                                                 p[2] - origin[2])), d))
+        for Rb, vec in trans:
+            dv = tuple(se.diff(c, y) for c in vec)
+            if any(c != 0 for c in dv):
+                v = _add(v, _mv(Rb, dv))  # type: ignore[arg-type]
+        out.append((_mtv(R, v), _mtv(R, w)))
+    return out
+
+
+def constrained_directions(joint: Joint, coordinates: Sequence[se.Symbol] = (),
+                           parameters: Mapping[str, float] | None = None
+                           ) -> list[tuple[str, Wrench]]:
+    """The constrained directions of ``joint``: ``[(suffix, unit wrench), ...]``.
+
+    Wrenches ``(F_x, F_y, F_z, T_x, T_y, T_z)`` are in the child body frame at its origin.
+    Standard joints: revolute 3 forces + 2 torques, prismatic 2 forces + 3 torques, cylindrical
+    2 + 2, universal 3 forces + the torque ``T_n`` about the normal to both rotation axes,
+    spherical 3 forces, planar the normal force and 2 torques, free none, fixed all six. A
+    general joint takes the user's ``constrained`` list or derives the directions from its
+    elementary steps (``coordinates``: the system's coordinates, ``parameters``: default values
+    for the numeric rank test).
+    """
+    kind = joint.kind
+    steps = joint.steps
+    if joint.constrained is not None:
+        return _user_directions(joint)
+    if kind == "fixed":
+        return [(n, _unit(n)) for n in _UNIT]
+    if kind == "free":
+        return []
+    if kind == "spherical":
+        return [(n, _unit(n)) for n in ("F_x", "F_y", "F_z")]
+    if kind == "revolute":
+        u = steps[0].axis
+        return ([(n, _unit(n)) for n in ("F_x", "F_y", "F_z")]
+                + [(f"T_{a}", _wrench(T=e)) for a, e in _perpendicular(u, joint, "rotation")])
+    if kind == "prismatic":
+        u = steps[0].axis
+        return ([(f"F_{a}", _wrench(F=e)) for a, e in _perpendicular(u, joint, "translation")]
+                + [(n, _unit(n)) for n in ("T_x", "T_y", "T_z")])
+    if kind == "cylindrical":
+        u = steps[0].axis
+        perp = _perpendicular(u, joint, "cylinder")
+        return ([(f"F_{a}", _wrench(F=e)) for a, e in perp]
+                + [(f"T_{a}", _wrench(T=e)) for a, e in perp])
+    if kind == "planar":
+        n = steps[2].axis
+        ax = "xyz"[[abs(int(c)) for c in n].index(1)]
+        return [(f"F_{ax}", _unit(f"F_{ax}"))] + [
+            (f"T_{a}", _unit(f"T_{a}")) for a in "xyz" if a != ax]
+    if kind == "universal":
+        (w1, w2) = (w for _, w in relative_twist(joint, joint.coordinates))
+        n = _cross(w1, w2)
+        u1, u2 = steps[0].axis, steps[1].axis
+        norm = se.sqrt(_dot(_cross(u1, u2), _cross(u1, u2)))  # constant: |A2ᵀu1 × u2| = |u1 × u2|
+        if not any(c.free_symbols for c in (*u1, *u2)):
+            norm = se.Float(float(norm)) if float(norm) != 1.0 else ONE
+        return ([(nm, _unit(nm)) for nm in ("F_x", "F_y", "F_z")]
+                + [("T_n", _wrench(T=_scale(n, 1 / norm)))])
+    return _derived_directions(joint, coordinates, parameters or {})
+
+
+def _user_directions(joint: Joint) -> list[tuple[str, Wrench]]:
+    out: list[tuple[str, Wrench]] = []
+    for k, item in enumerate(joint.constrained or ()):
+        where = f'joint "{joint.name}" constrained[{k}]'
+        if isinstance(item, str):
+            if item not in _UNIT:
+                raise ModelError(f"{where}: {item!r} is not one of {', '.join(_UNIT)}; give "
+                                 "(name, (F_x, F_y, F_z, T_x, T_y, T_z)) for other directions")
+            out.append((item, _unit(item)))
+            continue
+        if not (isinstance(item, tuple | list) and len(item) == 2 and isinstance(item[0], str)):
+            raise ModelError(f"{where}: expected a name like 'F_x' or a pair "
+                             f"(name, (F_x, F_y, F_z, T_x, T_y, T_z)), got {item!r}")
+        name, vec = item
+        if not name.isidentifier():
+            raise ModelError(f"{where}: name {name!r} must be an identifier")
+        from .model.expressions import as_vector
+
+        w = as_vector(vec, where, n=6)
+        if all(c == 0 for c in w):
+            raise ModelError(f"{where}: the wrench direction {name!r} is zero")
+        out.append((name, w))  # type: ignore[arg-type]
+    names = [n for n, _ in out]
+    dup = {n for n in names if names.count(n) > 1}
+    if dup:
+        raise ModelError(f'joint "{joint.name}": constrained direction(s) {sorted(dup)} given twice')
+    return out
+
+
+def _derived_directions(joint: Joint, coordinates: Sequence[se.Symbol],
+                        parameters: Mapping[str, float]) -> list[tuple[str, Wrench]]:
+    """Constrained directions of a general joint: a basis of the wrenches that do no work in
+    any motion its elementary steps allow (the complement of the relative twist), chosen among
+    the unit wrenches along the child frame's axes and the torques normal to two rotation axes.
+    """
+    ys = [c for c in coordinates
+          if any(c in (s.angle.free_symbols if isinstance(s, Rot) else
+                       set().union(*(x.free_symbols for x in s.vector))) for s in joint.steps)]
+    twists = relative_twist(joint, ys)
+    cols: list[se.Basic] = [x for v, w in twists for x in (*v, *w)]
+    candidates: list[tuple[str, Wrench]] = [(n, _unit(n)) for n in _UNIT]
+    axes = [w for _, w in twists]
+    normals = 0
+    for i in range(len(axes)):
+        for j in range(i + 1, len(axes)):
+            n = _cross(axes[i], axes[j])
+            if any(c != 0 for c in n):
+                normals += 1
+                candidates.append((f"T_n{normals}" if normals > 1 else "T_n", _wrench(T=n)))
+    rng = np.random.default_rng(20240601)
+    samples = 3
+    values = _sample_values(cols + [c for _, w in candidates for c in w], coordinates,
+                            parameters, rng, samples)
+    J = values[:len(cols)].reshape(len(ys), 6, samples) if ys else np.zeros((0, 6, samples))
+    Wc = values[len(cols):].reshape(len(candidates), 6, samples)
+    rank = max((np.linalg.matrix_rank(J[:, :, s].T, tol=1e-9) for s in range(samples)), default=0)
+    need = 6 - rank
+    chosen: list[int] = []
+    for c in range(len(candidates)):
+        if len(chosen) == need:
+            break
+        w = Wc[c]
+        scale = max(1.0, float(np.abs(w).max()))
+        if J.shape[0] and np.abs(np.einsum("jas,as->js", J, w)).max() > 1e-9 * scale * max(
+                1.0, float(np.abs(J).max())):
+            continue
+        trial = Wc[chosen + [c]]
+        if all(np.linalg.matrix_rank(trial[:, :, s], tol=1e-9) == len(chosen) + 1
+               for s in range(samples)):
+            chosen.append(c)
+    if len(chosen) < need:
+        raise ModelError(
+            f'joint "{joint.name}": cannot derive its {need} constrained directions from its '
+            f"steps (found {[candidates[c][0] for c in chosen]}); give them with "
+            "General(..., constrained=['F_x', ..., ('T_a', (0, 0, 0, tx, ty, tz))])"
+        )
+    out = []
+    for c in chosen:
+        name, w = candidates[c]
+        if name.startswith("T_n"):
+            norm = np.linalg.norm(Wc[c][3:], axis=0)
+            if np.ptp(norm) < 1e-12 * norm.max():  # constant length: normalize symbolically
+                w = tuple(x / se.Float(float(norm[0])) if float(norm[0]) != 1.0 else x for x in w)
+        out.append((name, w))
+    return out  # type: ignore[return-value]
+
+
+# --- numeric evaluation of expression graphs ----------------------------------------------------
+_NUMPY = {"sin": np.sin, "cos": np.cos, "tan": np.tan, "exp": np.exp, "log": np.log,
+          "Abs": np.abs, "asin": np.arcsin, "acos": np.arccos, "atan": np.arctan,
+          "sinh": np.sinh, "cosh": np.cosh, "tanh": np.tanh, "sign": np.sign}
+
+
+def graph_values(exprs: Sequence[se.Basic], values: Mapping[se.Basic, Any]) -> list[Any]:
+    """Numeric values of ``exprs`` for the symbol values ``values`` (NumPy arrays broadcast), each
+    distinct node of the shared expression graph evaluated once."""
+    from . import cse as _cse
+
+    key = getattr(_cse, "expr_key", hash)  # the Graph's node identity
+    g = _cse.Graph(list(exprs))
+    given = {k: np.asarray(v, dtype=float) for k, v in values.items()}
+
+    def atom(a: se.Basic) -> Any:
+        if isinstance(a, se.Symbol):
+            if a in given:
+                return given[a]
+            raise EvaluationError(f"no value for symbol {a}")
+        return float(a)
+
+    val: dict[Any, Any] = {}
+    for h in g.order:
+        node = g.node[h]
+        args = [val[ka] if a.args else atom(a)
+                for a, ka in zip(node.args, g.children[h], strict=True)]
+        name = type(node).__name__
+        if name == "Add":
+            r = args[0]
+            for x in args[1:]:
+                r = r + x
+        elif name == "Mul":
+            r = args[0]
+            for x in args[1:]:
+                r = r * x
+        elif name == "Pow":
+            r = np.power(args[0], args[1])
+        elif name in _NUMPY:
+            r = _NUMPY[name](*args)
+        elif name == "atan2":
+            r = np.arctan2(*args)
+        else:
+            r = np.vectorize(lambda *xs, f=node.func: float(f(*(se.Float(x) for x in xs))))(*args)
+        val[h] = r
+    return [val[key(e)] if e.args else atom(e) for e in exprs]
+
+
+def _sample_values(exprs: list[se.Basic], coordinates: Sequence[se.Symbol],
+                   parameters: Mapping[str, float], rng: np.random.Generator,
+                   samples: int) -> np.ndarray:
+    """Values of ``exprs`` at ``samples`` random coordinates and times, parameters at their
+    defaults (perturbed by up to 10 %), as an array (len(exprs), samples)."""
+    vals: dict[se.Basic, Any] = {c: rng.uniform(-math.pi, math.pi, samples) for c in coordinates}
+    vals[se.Symbol("t")] = rng.uniform(0.0, 2.0, samples)
+    for k, v in parameters.items():
+        vals[se.Symbol(k)] = v * rng.uniform(0.9, 1.1, samples)
+    for e in exprs:  # symbols nobody declared (a joint checked on its own): random values
+        for s in e.free_symbols:
+            vals.setdefault(s, rng.uniform(0.5, 1.5, samples))
+    out = graph_values(exprs, vals)
+    return np.array([np.broadcast_to(np.asarray(v, float), (samples,)) for v in out])
+
+
+# --- the stage ----------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Reactions:
+    """Result of :func:`reactions` (METHOD.md §4).
+
+    Attributes
+    ----------
+    Q_bar : SymMatrix (6p×q)
+        Distribution matrix of the reaction forces; translational rows inertial, rotational rows
+        in each body's frame about its centre of mass; column k belongs to ``g_names[k]``.
+    N_hat : SymMatrix (q×q)
+        ``Q̄_rᵀ M̄_r⁻¹ Q̄_r`` over the regular rows r of M̄ (all rows when every body has mass and
+        a regular inertia tensor; then symmetric positive definite).
+    k_hat, q_hat : SymMatrix (q×1)
+        ``Q̄_rᵀ M̄_r⁻¹ q̄^c_r`` and ``Q̄_rᵀ M̄_r⁻¹ q̄^e_r``.
+    g_names : tuple of str
+        ``<joint>.<direction>``, e.g. ``hinge1.F_x``: force/torque components in the child body
+        frame at the joint point.
+    joints : tuple of JointReactions
+    singular_rows : tuple of int
+        Rows of the 6p-vectors where M̄ is zero (no inertia); see the module docstring.
+    newton_euler : NewtonEuler
+        The stage this came from.
+    """
+
+    newton_euler: NewtonEuler
+    Q_bar: SymMatrix
+    N_hat: SymMatrix
+    k_hat: SymMatrix
+    q_hat: SymMatrix
+    g_names: tuple[str, ...]
+    joints: tuple[JointReactions, ...]
+    singular_rows: tuple[int, ...]
+
+    @property
+    def system(self) -> System:
+        return self.newton_euler.system
+
+    def joint(self, name: str) -> JointReactions:
+        """The constrained directions of the joint called ``name``."""
+        for jr in self.joints:
+            if jr.joint.name == name:
+                return jr
+        raise ModelError(f'unknown joint "{name}"; joints are: '
+                         f'{", ".join(j.joint.name for j in self.joints)}')
+
+    def g(self, max_unknowns: int = 30, simplify: bool = True) -> Any:
+        """``g`` in closed form, a :class:`sympy.Matrix` (q×1) in y, ẏ, t, parameters, inputs.
+
+        Solves ``N̂·g = k̂ − q̂`` (with the rows of bodies without inertia, see the module
+        docstring) with SymPy; meant for small systems (at most ``max_unknowns`` unknowns).
+        Components that the model leaves undetermined raise :class:`JourdainError`.
+        """
+        import sympy
+
+        q = len(self.g_names)
+        s = len(self.singular_rows)
+        if q + s > max_unknowns:
+            raise JourdainError(
+                f"closed-form g has {q + s} unknowns (more than max_unknowns={max_unknowns}); "
+                "evaluate it numerically with evaluate() or joint_reactions()"
+            )
+        ne = self.newton_euler
+        memo: dict = {}
+        from .symbolic import to_sympy
+
+        N = sympy.Matrix(q + s, q + s, lambda i, j: 0)
+        rhs = sympy.zeros(q + s, 1)
+        for i in range(q):
+            for j in range(q):
+                N[i, j] = to_sympy(self.N_hat[i, j], memo)
+            rhs[i] = to_sympy(self.k_hat[i] - self.q_hat[i], memo)
+        for a, row in enumerate(self.singular_rows):
+            for j in range(q):
+                e = to_sympy(self.Q_bar[row, j], memo)
+                N[q + a, j] = e
+                N[j, q + a] = e
+            rhs[q + a] = to_sympy(ne.q_c[row] - ne.q_e[row], memo)
+        unknowns = sympy.symbols(f"_g0:{q + s}")
+        sol = sympy.linsolve((N, rhs), unknowns)
+        if not sol:
+            raise JourdainError("the reaction equations have no solution (inconsistent loads on "
+                                "bodies without inertia)")
+        (vals,) = list(sol)
+        out = []
+        for k in range(q):
+            v = vals[k]
+            if v.free_symbols & set(unknowns):
+                raise JourdainError(f'reaction component "{self.g_names[k]}" is undetermined')
+            out.append(sympy.simplify(v) if simplify else v)
+        return sympy.Matrix(out)
+
+    def joint_g(self, name: str) -> SymMatrix:
+        """Reaction components of one joint without forming all of ``g``.
+
+        The wrench that the joint transmits equals the Newton–Euler residual of the sub-tree it
+        carries, ``Σ (m_i a_i − f_i^e, I_i α_i + ω̃_i I_i ω_i − l_i^e)``, moved to the joint
+        point and the child frame; projected on the joint's (orthonormal) directions. The result
+        is in y, ẏ, ÿ (symbols ``<name>_dd``), t, parameters and inputs: insert ÿ from the
+        equations of motion, or from a measured or simulated motion.
+        """
+        jr = self.joint(name)
+        W = _subtree_wrench(self.newton_euler, jr.child)
+        return SymMatrix.column(_project(jr, W))
+
+    def evaluate(self, y: Any, yd: Any, t: float = 0.0,
+                 parameters: Mapping[str, float] | None = None,
+                 inputs: Mapping[str, float] | Sequence[float] | None = None
+                 ) -> dict[str, Any]:
+        """Numbers at one state; see :func:`evaluate_reactions`."""
+        return evaluate_reactions(self.system, y, yd, t, parameters, inputs)
+
+
+def _body_rows(system: System) -> dict[str, int]:
+    return {b.name: i for i, b in enumerate(system.bodies)}
+
+
+def _singular_rows(system: System) -> tuple[tuple[int, ...], dict[str, tuple[list[int], Any]]]:
+    """Rows where M̄ vanishes and, per body, its regular rotational axes with the inverse of the
+    inertia tensor restricted to them."""
+    p = len(system.bodies)
+    subs = {se.Symbol(k): v for k, v in system.parameters}
+    singular: list[int] = []
+    inv: dict[str, tuple[list[int], Any]] = {}
+    for i, b in enumerate(system.bodies):
+        if b.mass == 0:
+            singular.extend(range(3 * i, 3 * i + 3))
+        elif abs(float(b.mass.subs(subs))) == 0.0:
+            raise ModelError(f'body "{b.name}": its mass is zero at the default parameters but '
+                             "not identically zero; write mass=0 for a massless body")
+        I = b.inertia
+        regular = [a for a in range(3)
+                   if not all(I[a][c] == 0 and I[c][a] == 0 for c in range(3))]
+        singular.extend(3 * p + 3 * i + a for a in range(3) if a not in regular)
+        if regular:
+            sub = [[I[a][c] for c in regular] for a in regular]
+            num = np.array([[float(x.subs(subs)) for x in r] for r in sub])
+            if abs(np.linalg.det(num)) <= 1e-12 * max(1.0, float(np.abs(num).max())) ** len(regular):
+                raise ModelError(
+                    f'body "{b.name}": its inertia tensor is singular, but not along body axes '
+                    "(no row and column of zeros); give the inertia in a frame whose axes are "
+                    "its principal axes"
+                )
+            inv[b.name] = (regular, _inverse(sub))
+        else:
+            inv[b.name] = ([], None)
+    return tuple(sorted(singular)), inv
+
+
+def _inverse(A: list[list[se.Basic]]) -> list[list[se.Basic]]:
+    n = len(A)
+    if n == 1:
+        return [[1 / A[0][0]]]
+    if n == 2:
+        d = A[0][0] * A[1][1] - A[0][1] * A[1][0]
+        return [[A[1][1] / d, -A[0][1] / d], [-A[1][0] / d, A[0][0] / d]]
+    # 3x3 via the adjugate (constant parameters only: the expressions stay short)
+    c = [[A[(i + 1) % 3][(j + 1) % 3] * A[(i + 2) % 3][(j + 2) % 3]
+          - A[(i + 1) % 3][(j + 2) % 3] * A[(i + 2) % 3][(j + 1) % 3] for j in range(3)]
+         for i in range(3)]
+    d = A[0][0] * c[0][0] + A[0][1] * c[0][1] + A[0][2] * c[0][2]
+    return [[c[j][i] / d for j in range(3)] for i in range(3)]
+
+
+def reactions(ne: NewtonEuler) -> Reactions:
+    """Q̄ from the joints and N̂, k̂, q̂ (METHOD.md §4); checks ``J̄ᵀQ̄ = 0``.
+
+    Parameters
+    ----------
+    ne : NewtonEuler
+        The Newton–Euler equations of the system.
+
+    Returns
+    -------
+    Reactions
+        ``Q_bar`` (6p×q), ``N_hat`` (q×q), ``k_hat``, ``q_hat`` (q×1), ``g_names``.
+
+    Raises
+    ------
+    ModelError
+        When a joint's constrained directions violate the orthogonality relation ``J̄ᵀQ̄ = 0``
+        (checked numerically at random states), naming the joint and the direction.
+    """
+    kin = ne.kinematics
+    system = kin.system
+    bodies = system.bodies
+    p = len(bodies)
+    row = _body_rows(system)
+    params = system.parameter_values
+    # columns of Q̄, sparse: per column {row: expression}
+    cols: list[dict[int, se.Basic]] = []
+    names: list[str] = []
+    joints: list[JointReactions] = []
+    for body, bk in zip(bodies, kin.bodies, strict=True):
+        j = body.joint
+        dirs = constrained_directions(j, system.coordinates, params)
+        S = bk.S.rows
+        R_pc, o_pc = _joint_rotation(j)
+        c_c = body.com
+        i = row[body.name]
+        parent = None if body.parent == WORLD else system.body(body.parent)
+        start = len(cols)
+        for suffix, w in dirs:
+            F, T = w[:3], w[3:]
+            col: dict[int, se.Basic] = {}
+            SF = _mv(S, F)
+            rot_c = _add(T, _scale(_cross(c_c, F), -1))  # lever arm: from the COM to O
+            for a in range(3):
+                col[3 * i + a] = SF[a]
+                col[3 * p + 3 * i + a] = rot_c[a]
+            if parent is not None:
+                k = row[parent.name]
+                RF, RT = _mv(R_pc, F), _mv(R_pc, T)
+                arm = (o_pc[0] - parent.com[0], o_pc[1] - parent.com[1], o_pc[2] - parent.com[2])
+                rot_p = _add(RT, _cross(arm, RF))
+                for a in range(3):
+                    col[3 * k + a] = -SF[a]
+                    col[3 * p + 3 * k + a] = -rot_p[a]
+            cols.append({r: e for r, e in col.items() if e != 0})
+            names.append(f"{j.name}.{suffix}")
+        joints.append(JointReactions(j, body.name, body.parent, tuple(n for n in names[start:]),
+                                     tuple(w for _, w in dirs),
+                                     tuple(range(start, len(cols)))))
+    q = len(cols)
+    n6 = 6 * p
+    Q_rows = [[ZERO] * q for _ in range(n6)]
+    for c, col in enumerate(cols):
+        for r, e in col.items():
+            Q_rows[r][c] = e
+    Q_bar = SymMatrix.from_rows(Q_rows)
+    check_orthogonality(ne, Q_bar, joints)
+    singular, inv = _singular_rows(system)
+    # N̂, k̂, q̂ body by body over the regular rows (M̄ block diagonal)
+    N = [[[] for _ in range(q)] for _ in range(q)]
+    kh: list[list[se.Basic]] = [[] for _ in range(q)]
+    qh: list[list[se.Basic]] = [[] for _ in range(q)]
+    qc, qe = ne.q_c, ne.q_e
+    for i, body in enumerate(bodies):
+        blocks = []
+        if body.mass != 0:
+            mi = 1 / body.mass
+            blocks.append((list(range(3 * i, 3 * i + 3)), [[mi if a == b else ZERO
+                                                            for b in range(3)] for a in range(3)]))
+        regular, Iinv = inv[body.name]
+        if regular:
+            blocks.append(([3 * p + 3 * i + a for a in regular], Iinv))
+        for rows_, Minv in blocks:
+            touching = [c for c in range(q) if any(r in cols[c] for r in rows_)]
+            vecs = {c: [cols[c].get(r, ZERO) for r in rows_] for c in touching}
+            mv = {c: [se.Add(*(Minv[a][b] * vecs[c][b] for b in range(len(rows_))))
+                      for a in range(len(rows_))] for c in touching}
+            cvec = [qc[r] for r in rows_]
+            evec = [qe[r] for r in rows_]
+            for ia, ca in enumerate(touching):
+                for cb in touching[ia:]:
+                    N[ca][cb].append(se.Add(*(x * y for x, y in zip(mv[ca], vecs[cb], strict=True))))
+                if any(x != 0 for x in cvec):
+                    kh[ca].append(se.Add(*(x * y for x, y in zip(mv[ca], cvec, strict=True))))
+                if any(x != 0 for x in evec):
+                    qh[ca].append(se.Add(*(x * y for x, y in zip(mv[ca], evec, strict=True))))
+    N_rows = [[ZERO] * q for _ in range(q)]
+    for a in range(q):
+        for b in range(a, q):
+            e = se.Add(*N[a][b]) if N[a][b] else ZERO
+            N_rows[a][b] = e
+            N_rows[b][a] = e
+    return Reactions(
+        newton_euler=ne, Q_bar=Q_bar, N_hat=SymMatrix.from_rows(N_rows),
+        k_hat=SymMatrix.column([se.Add(*t) if t else ZERO for t in kh]),
+        q_hat=SymMatrix.column([se.Add(*t) if t else ZERO for t in qh]),
+        g_names=tuple(names), joints=tuple(joints), singular_rows=singular,
+    )
+
+
+def check_orthogonality(ne: NewtonEuler, Q_bar: SymMatrix, joints: Sequence[JointReactions],
+                        samples: int = 3, seed: int = 7) -> float:
+    """Check ``J̄ᵀ·Q̄ = 0`` numerically at random states; returns the largest relative residual.
+
+    Coordinates uniform in (−π, π), t in (0, 2), parameters within 10 % of their defaults.
+    Raises :class:`ModelError` naming the joint and the direction of the first column that
+    does work in an admissible motion.
+    """
+    system = ne.system
+    J = ne.J_bar
+    n6, f = J.shape
+    q = Q_bar.shape[1]
+    if q == 0:
+        return 0.0
+    rng = np.random.default_rng(seed)
+    exprs = J.entries() + Q_bar.entries()
+    vals = _sample_values(exprs, system.coordinates, system.parameter_values, rng, samples)
+    Jn = vals[:n6 * f].reshape(n6, f, samples)
+    Qn = vals[n6 * f:].reshape(n6, q, samples)
+    worst = 0.0
+    for s in range(samples):
+        JQ = Jn[:, :, s].T @ Qn[:, :, s]
+        scale = np.abs(Jn[:, :, s]).T @ np.abs(Qn[:, :, s])
+        scale_col = scale.max(axis=0) + 1e-300
+        rel = np.abs(JQ).max(axis=0) / scale_col
+        worst = max(worst, float(rel.max()))
+        bad = np.nonzero(rel > 1e-9)[0]
+        if bad.size:
+            c = int(bad[0])
+            jr = next(j for j in joints if c in j.columns)
+            k = int(np.argmax(np.abs(JQ[:, c])))
+            raise ModelError(
+                f'joint "{jr.joint.name}" (body "{jr.child}"): its constrained direction '
+                f'"{jr.names[jr.columns.index(c)]}" does work in an admissible motion '
+                f"(J̄ᵀQ̄ ≠ 0 in the row of coordinate {system.coordinates[k]}, relative residual "
+                f"{rel[c]:.2e}); the orthogonality relation J̄ᵀ·Q̄ = 0 fails"
+            )
+    return worst
+
+
+# --- reactions of one joint from its sub-tree --------------------------------------------------
+def _subtree(system: System, root: str) -> list[str]:
+    below = {root}
+    for b in system.bodies:  # tree order: parents come first
+        if b.parent in below:
+            below.add(b.name)
+    return [b.name for b in system.bodies if b.name in below]
+
+
+def _subtree_wrench(ne: NewtonEuler, child: str) -> Wrench:
+    """Residual wrench of the sub-tree below (and including) ``child``, at the child frame's
+    origin, in the child frame, with ÿ as symbols."""
+    kin = ne.kinematics
+    system = kin.system
+    ydd = kin.ydd
+    forces = {bf.name: bf for bf in ne.forces}
+    bc = kin[child]
+    Sc = bc.S.rows
+    rO = _v(bc.r_O)
+    F_tot: Vec3 = Z3
+    T_tot: Vec3 = Z3
+    for name in _subtree(system, child):
+        body = system.body(name)
+        bk = kin[name]
+        bf = forces[name]
+        a = _v(bk.a_bar)
+        for j, c in bk.cols_T.items():
+            a = _add(a, _scale(c, ydd[j]))
+        F = (body.mass * a[0] - bf.f[0], body.mass * a[1] - bf.f[1], body.mass * a[2] - bf.f[2])
+        tau: Vec3 = (-bf.l[0], -bf.l[1], -bf.l[2])
+        if body.has_inertia:
+            I = body.inertia
+            al = _v(bk.alpha_bar)
+            for j, c in bk.cols_R.items():
+                al = _add(al, _scale(c, ydd[j]))
+            w = _v(bk.omega)
+            tau = _add(tau, _add(_mv(I, al), _cross(w, _mv(I, w))))
+        Fc = _mtv(Sc, F)
+        r = _v(bk.r)
+        arm = _mtv(Sc, (r[0] - rO[0], r[1] - rO[1], r[2] - rO[2]))
+        tau_c = tau if name == child else _mtv(Sc, _mv(bk.S.rows, tau))  # type: ignore[arg-type]
+        F_tot = _add(F_tot, Fc)
+        T_tot = _add(T_tot, _add(tau_c, _cross(arm, Fc)))
+    return (*F_tot, *T_tot)  # type: ignore[return-value]
+
+
+def _v(m: SymMatrix) -> Vec3:
+    return (m.rows[0][0], m.rows[1][0], m.rows[2][0])
+
+
+def _project(jr: JointReactions, W: Wrench) -> list[se.Basic]:
+    """Components of the wrench W in the joint's constrained directions (orthonormal ones)."""
+    n = len(jr.wrenches)
+    if n:
+        rng = np.random.default_rng(3)
+        E = _sample_values([x for w in jr.wrenches for x in w], (), {}, rng, 3).reshape(n, 6, 3)
+        gram = np.einsum("kas,mas->kms", E, E)
+        if np.abs(gram - np.eye(n)[:, :, None]).max() > 1e-12:
+            raise JourdainError(
+                f'joint "{jr.joint.name}": its constrained directions are not orthonormal; '
+                "use joint_reactions() or evaluate_reactions() instead"
+            )
+    out = []
+    for w in jr.wrenches:
+        out.append(_dot(w[:3], W[:3]) + _dot(w[3:], W[3:]))
+    return out
+
+
+# --- numbers -------------------------------------------------------------------------------------
+@lru_cache(maxsize=32)
+def _reactions_function(system: System) -> tuple[Reactions, Any]:
+    from .numeric import lambdify
+
+    r = reactions(system.newton_euler())
+    return r, lambdify(system, {"Q_bar": r.Q_bar, "N_hat": r.N_hat, "k_hat": r.k_hat,
+                                "q_hat": r.q_hat})
+
+
+def solve_g(Q_bar: np.ndarray, N_hat: np.ndarray, k_hat: np.ndarray, q_hat: np.ndarray,
+            q_c: np.ndarray, q_e: np.ndarray, singular_rows: Sequence[int],
+            names: Sequence[str] = ()) -> tuple[np.ndarray, list[str]]:
+    """Solve ``N̂·g = k̂ − q̂`` (Cholesky; N̂ symmetric positive definite), or with rows of
+    bodies without inertia the bordered system of the module docstring.
+
+    Returns ``g`` (NaN where undetermined) and the names of the undetermined components.
+    """
+    import scipy.linalg as sla
+
+    q = N_hat.shape[0]
+    rhs = k_hat - q_hat
+    s = list(singular_rows)
+    if not s:
+        try:
+            return sla.cho_solve(sla.cho_factor(N_hat), rhs), []
+        except np.linalg.LinAlgError:
+            pass  # not positive definite: redundant directions; the general path says which
+    Qs = Q_bar[s, :]
+    K = np.block([[N_hat, Qs.T], [Qs, np.zeros((len(s), len(s)))]])
+    b = np.concatenate([rhs, q_c[s] - q_e[s]])
+    U, sv, Vt = np.linalg.svd(K)
+    tol = max(K.shape) * np.finfo(float).eps * (sv[0] if sv.size else 0.0) * 1e3
+    rank = int((sv > tol).sum())
+    x = Vt[:rank].T @ ((U[:, :rank].T @ b) / sv[:rank])
+    resid = np.abs(K @ x - b).max()
+    if resid > 1e-8 * max(1.0, np.abs(b).max(), np.abs(K).max() * np.abs(x).max()):
+        raise EvaluationError(
+            "the reaction equations have no solution at this state: applied or gyroscopic loads "
+            "on rows without inertia that no joint can balance (rows "
+            f"{[s[i - q] for i in range(q, q + len(s)) if abs((K @ x - b)[i]) > 1e-8]})"
+        )
+    g = x[:q].copy()
+    null = Vt[rank:, :q]
+    und = np.nonzero(np.abs(null).max(axis=0) > 1e-8)[0] if null.size else np.array([], int)
+    g[und] = np.nan
+    return g, [names[i] for i in und] if names else [str(i) for i in und]
+
+
+def evaluate_reactions(system: System, y: Any, yd: Any, t: float = 0.0,
+                       parameters: Mapping[str, float] | None = None,
+                       inputs: Mapping[str, float] | Sequence[float] | None = None,
+                       eom: Mapping[str, np.ndarray] | None = None) -> dict[str, Any]:
+    """Reaction forces at one state ``y, ẏ, t`` (no ÿ needed).
+
+    Returns a dict with ``Q_bar`` (6p×q), ``N_hat`` (q×q), ``k_hat``, ``q_hat``, ``g`` (q,
+    NaN where undetermined), ``g_names`` (list of str) and ``g_undetermined`` (list of the names
+    of undetermined components; empty for a well-posed model). ``eom``: the output of
+    :func:`jourdain.numeric.evaluate` at the same state, if already at hand.
+    """
+    from .numeric import evaluate as evaluate_eom
+    from .numeric import state_vectors
+
+    args = state_vectors(system, y, yd, t, parameters, inputs)
+    r, fn = _reactions_function(system)
+    out = fn(*args)
+    Q = out["Q_bar"]
+    N = out["N_hat"]
+    kh, qh = out["k_hat"].reshape(-1), out["q_hat"].reshape(-1)
+    if r.singular_rows:
+        if eom is None:
+            eom = evaluate_eom(system, y, yd, t=t, parameters=parameters, inputs=inputs)
+        qc, qe = np.asarray(eom["q_c"]).reshape(-1), np.asarray(eom["q_e"]).reshape(-1)
+    else:
+        qc = qe = np.zeros(Q.shape[0])
+    g, und = solve_g(Q, N, kh, qh, qc, qe, r.singular_rows, r.g_names)
+    return {"Q_bar": Q, "N_hat": N, "k_hat": kh, "q_hat": qh, "g": g,
+            "g_names": list(r.g_names), "g_undetermined": und}
+
+
+@lru_cache(maxsize=32)
+def _frames_function(system: System) -> Any:
+    from .numeric import lambdify
+
+    kin = system.kinematics()
+    mats = {}
+    for i, bk in enumerate(kin.bodies):
+        mats[f"S{i}"] = bk.S
+        mats[f"r{i}"] = bk.r
+        mats[f"rO{i}"] = bk.r_O
+    return lambdify(system, mats)
+
+
+def joint_reactions(system: System, joints: str | Sequence[str], y: Any, yd: Any,
+                    t: float = 0.0, parameters: Mapping[str, float] | None = None,
+                    inputs: Mapping[str, float] | Sequence[float] | None = None
+                    ) -> dict[str, float]:
+    """Reaction components of the named joints only, without forming ``N̂`` or all of ``g``.
+
+    ÿ comes from the equations of motion; the residual ``M̄·J̄·ÿ + q̄^c − q̄^e`` of the sub-tree
+    each joint carries, moved to the joint point and the child frame, is the wrench the joint
+    transmits; its components along the joint's constrained directions (least squares when they
+    are not orthonormal) are returned as ``{"<joint>.<direction>": value}``.
+    """
+    from .numeric import evaluate as evaluate_eom
+    from .numeric import state_vectors
+
+    if isinstance(joints, str):
+        joints = [joints]
+    by_joint = {b.joint.name: b for b in system.bodies}
+    for name in joints:
+        if name not in by_joint:
+            raise ModelError(f'unknown joint "{name}"; joints are: {", ".join(by_joint)}')
+    args = state_vectors(system, y, yd, t, parameters, inputs)
+    eom = evaluate_eom(system, y, yd, t=t, parameters=parameters, inputs=inputs)
+    M = np.atleast_2d(eom["M"])
+    try:
+        ydd = np.linalg.solve(M, eom["q"] - eom["k"])
+    except np.linalg.LinAlgError:
+        from .errors import SingularMassMatrix
+
+        raise SingularMassMatrix("the mass matrix M is singular at this state") from None
+    res = eom["M_bar"] @ (eom["J_bar"] @ ydd) + eom["q_c"] - eom["q_e"]
+    fr = _frames_function(system)(*args)
+    p = len(system.bodies)
+    idx = _body_rows(system)
+    params = system.parameter_values
+    out: dict[str, float] = {}
+    for name in joints:
+        body = by_joint[name]
+        c = idx[body.name]
+        Sc, rO = fr[f"S{c}"], fr[f"rO{c}"].reshape(-1)
+        W = np.zeros(6)
+        for bn in _subtree(system, body.name):
+            i = idx[bn]
+            F = Sc.T @ res[3 * i:3 * i + 3]
+            tau = Sc.T @ (fr[f"S{i}"] @ res[3 * p + 3 * i:3 * p + 3 * i + 3])
+            arm = Sc.T @ (fr[f"r{i}"].reshape(-1) - rO)
+            W[:3] += F
+            W[3:] += tau + np.cross(arm, F)
+        dirs = constrained_directions(body.joint, system.coordinates, params)
+        sym = [x for _, w in dirs for x in w]
+        vals = {**{s: v for s, v in zip(system.y, args[0], strict=True)},
+                system.t: args[2],
+                **{s: v for s, v in zip(system.parameter_symbols, args[3], strict=True)}}
+        E = np.array(graph_values(sym, vals), dtype=float).reshape(len(dirs), 6).T \
+            if dirs else np.zeros((6, 0))
+        gj = np.linalg.lstsq(E, W, rcond=None)[0] if dirs else np.zeros(0)
+        for (suffix, _), v in zip(dirs, gj, strict=True):
+            out[f"{name}.{suffix}"] = float(v)
+    return out
+
+
+def evaluate_keys(system: System, y: Any, yd: Any, t: float, parameters: Any, inputs: Any,
+                  eom: Mapping[str, np.ndarray]) -> dict[str, Any]:
+    """The reaction entries of :meth:`System.evaluate`: ``Q_bar, N_hat, k_hat, q_hat, g,
+    g_names, g_undetermined``."""
+    return evaluate_reactions(system, y, yd, t, parameters, inputs, eom=eom)
+
+
+_ = (Trans, _mm)
