@@ -45,6 +45,7 @@ from .model import (
 )
 from .newton_euler import NewtonEuler, newton_euler
 from .projection import EquationsOfMotion, projection
+from .reactions import JointReactions, Reactions, evaluate_reactions, joint_reactions, reactions
 from .symbolic import SymMatrix
 
 __version__ = "0.1.0"
@@ -54,6 +55,7 @@ __all__ = [
     "EvaluationError", "JourdainError", "ModelError", "SingularMassMatrix",
     "BodyKinematics", "Kinematics", "kinematics", "NewtonEuler", "newton_euler",
     "EquationsOfMotion", "projection", "SymMatrix",
+    "JointReactions", "Reactions", "evaluate_reactions", "joint_reactions", "reactions",
     "WORLD", "Body", "Cylindrical", "Fixed", "Force", "Free", "General", "GeneralizedForce",
     "Gravity", "Joint", "Planar", "Prismatic", "Revolute", "Rot", "RotationalSpringDamper",
     "Spherical", "SpringDamper", "System", "Torque", "Trans", "Universal", "acceleration", "box",

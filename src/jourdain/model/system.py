@@ -31,6 +31,7 @@ if TYPE_CHECKING:
     from ..kinematics import Kinematics
     from ..newton_euler import NewtonEuler
     from ..projection import EquationsOfMotion
+    from ..reactions import Reactions
 
 
 def _symbol_list(items: Iterable[object] | str, what: str) -> tuple[se.Symbol, ...]:
@@ -185,16 +186,27 @@ class System:
 
         return projection(self.newton_euler())
 
+    def reactions(self) -> Reactions:
+        """Reaction forces: Q̄ from the joints, N̂·g = k̂ − q̂ (METHOD §4)."""
+        from ..reactions import reactions
+
+        return reactions(self.newton_euler())
+
     def evaluate(self, y: Any, yd: Any, t: float = 0.0, parameters: Mapping[str, float] | None = None,
                  inputs: Mapping[str, float] | Sequence[float] | None = None) -> dict[str, np.ndarray]:
         """Numbers at one state: a dict from the seed's names to NumPy arrays.
 
-        Keys: ``M_bar, J_bar, q_c, q_e, M, k, q``. ``parameters`` overrides default values by
-        name; ``inputs`` gives the inputs by name (or in the order of :attr:`input_names`).
+        Keys: ``M_bar, J_bar, q_c, q_e, M, k, q``, and the reactions ``Q_bar, N_hat, k_hat,
+        q_hat, g, g_names, g_undetermined`` (:func:`jourdain.reactions.evaluate_reactions`).
+        ``parameters`` overrides default values by name; ``inputs`` gives the inputs by name (or
+        in the order of :attr:`input_names`).
         """
         from ..numeric import evaluate
+        from ..reactions import evaluate_keys
 
-        return evaluate(self, y, yd, t=t, parameters=parameters, inputs=inputs)
+        out = evaluate(self, y, yd, t=t, parameters=parameters, inputs=inputs)
+        out.update(evaluate_keys(self, y, yd, t, parameters, inputs, eom=out))
+        return out
 
     def __repr__(self) -> str:
         return (f"System({self.name!r}: {len(self.bodies)} bodies, f={self.f}, "
