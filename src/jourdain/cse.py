@@ -5,10 +5,11 @@ is used more than once becomes a temporary; nodes used once stay inline. One pas
 distinct nodes, so the cost grows linearly with the size of the graph, where a tree-based CSE
 (SymEngine's or SymPy's ``cse``) effectively expands the graph into trees.
 
-Nodes are identified by SymEngine's cached structural hash: comparing two distinct but equal
-deep nodes with ``==`` walks the whole tree (exponential on a DAG), while the hash is computed
-once per node. Every hash hit is confirmed by a shallow structural check (same type and the same
-children hashes), so a hash collision raises instead of merging two different expressions.
+Nodes are identified by :func:`expr_key`, a structural fingerprint built from SymEngine's cached
+hashes over three levels (node, children, grandchildren). ``==`` cannot be used: comparing two
+distinct but equal deep nodes walks the whole tree (exponential on a DAG). The hash alone cannot
+be used either: SymEngine's hash of a sum ignores the coefficients of its terms, so ``x + y``,
+``2*x + 2*y`` and ``-x - y`` share one hash; their children (``2*x``, ``-x``) do not.
 """
 
 from __future__ import annotations
@@ -40,33 +41,40 @@ def _is_atom(e: Expr) -> bool:
     return not e.args
 
 
+def _key2(e: Expr) -> tuple:
+    args = e.args
+    if not args:
+        return (type(e).__name__, hash(e), str(e))
+    return (type(e).__name__, hash(e), tuple(sorted(hash(a) for a in args)))
+
+
+def expr_key(e: Expr) -> tuple:
+    """Dictionary key identifying an expression by its structure (see the module docstring)."""
+    args = e.args
+    if not args:
+        return (type(e).__name__, hash(e), str(e))
+    return (type(e).__name__, hash(e), tuple(sorted(_key2(a) for a in args)))
+
+
 class Graph:
     """The distinct non-atomic nodes of some expressions, children before parents."""
 
     def __init__(self, exprs: Sequence[Expr]) -> None:
-        self.uses: dict[int, int] = {}
-        self.node: dict[int, Expr] = {}
-        self.children: dict[int, tuple[int, ...]] = {}
-        self.order: list[int] = []  # post-order of keys
+        self.uses: dict[tuple, int] = {}
+        self.node: dict[tuple, Expr] = {}
+        self.children: dict[tuple, tuple[tuple, ...]] = {}
+        self.order: list[tuple] = []  # post-order of keys
         for root in exprs:
             if not _is_atom(root):
                 self._visit(root)
 
-    def key(self, e: Expr) -> int:
-        h = hash(e)
-        known = self.node.get(h)
-        if known is not None and known is not e and type(known) is not type(e):
-            raise JourdainError(f"hash collision between {type(known).__name__} and "
-                                f"{type(e).__name__} nodes in CSE")
-        return h
-
     def _visit(self, root: Expr) -> None:
-        h = hash(root)
+        h = expr_key(root)
         self.uses[h] = self.uses.get(h, 0) + 1
         if h in self.node:
             self._confirm(h, root)
             return
-        stack: list[tuple[Expr, int, bool]] = [(root, h, False)]
+        stack: list[tuple[Expr, tuple, bool]] = [(root, h, False)]
         while stack:
             e, h, done = stack.pop()
             if done:
@@ -76,7 +84,7 @@ class Graph:
                 self._confirm(h, e)
                 continue
             args = e.args
-            hs = tuple(hash(a) for a in args)
+            hs = tuple(expr_key(a) for a in args)
             self.node[h] = e
             self.children[h] = hs
             stack.append((e, h, True))
@@ -87,12 +95,15 @@ class Graph:
                 if ha not in self.node:
                     stack.append((a, ha, False))
 
-    def _confirm(self, h: int, e: Expr) -> None:
+    def _confirm(self, h: tuple, e: Expr) -> None:
         known = self.node[h]
         if known is e:
             return
-        if type(known) is not type(e) or tuple(hash(a) for a in e.args) != self.children[h]:
-            raise JourdainError("hash collision between two different expressions in CSE")
+        # equal Add/Mul nodes may list their terms in different orders (hash-map storage)
+        if type(known) is not type(e) or sorted(expr_key(a) for a in e.args) != sorted(
+            self.children[h]
+        ):
+            raise JourdainError("structural key collision between two different expressions")
 
 
 def _worth_a_temporary(e: Expr) -> bool:
@@ -106,8 +117,8 @@ def cse(exprs: Sequence[Expr], prefix: str = "x") -> CSE:
     """Graph CSE: every non-atomic node used more than once becomes a temporary."""
     exprs = list(exprs)
     g = Graph(exprs)
-    roots = {hash(e) for e in exprs}
-    rebuilt: dict[int, Expr] = {}
+    roots = {expr_key(e) for e in exprs}
+    rebuilt: dict[tuple, Expr] = {}
     temps: list[tuple[se.Symbol, Expr]] = []
     for h in g.order:
         node = g.node[h]
@@ -128,7 +139,7 @@ def cse(exprs: Sequence[Expr], prefix: str = "x") -> CSE:
             rebuilt[h] = sym
         else:
             rebuilt[h] = new
-    outputs = tuple(e if _is_atom(e) else rebuilt[hash(e)] for e in exprs)
+    outputs = tuple(e if _is_atom(e) else rebuilt[expr_key(e)] for e in exprs)
     return CSE(tuple(temps), outputs)
 
 

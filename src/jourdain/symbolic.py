@@ -112,13 +112,16 @@ def to_sympy(expr: Expr, memo: dict | None = None) -> Any:
     """Convert a SymEngine expression to SymPy, visiting shared sub-expressions once."""
     import sympy
 
-    # keyed by SymEngine's cached hash: == on distinct equal deep nodes walks the whole tree
+    # keyed structurally (jourdain.cse.expr_key): == on distinct but equal deep nodes walks the
+    # whole tree, and SymEngine's hash alone confuses x + y with -x - y
+    from .cse import expr_key
+
     if memo is None:
         memo = {}
     stack = [expr]
     while stack:
         node = stack[-1]
-        h = hash(node)
+        h = expr_key(node)
         if h in memo:
             stack.pop()
             continue
@@ -128,14 +131,14 @@ def to_sympy(expr: Expr, memo: dict | None = None) -> Any:
             memo[h] = node._sympy_() if hasattr(node, "_sympy_") else sympy.sympify(str(node))
             stack.pop()
             continue
-        pending = [a for a in args if hash(a) not in memo]
+        pending = [a for a in args if expr_key(a) not in memo]
         if pending:
             stack.extend(pending)
             continue
         f = getattr(sympy, _SYMPY_FUNCS[name])
-        memo[h] = f(*(memo[hash(a)] for a in args))
+        memo[h] = f(*(memo[expr_key(a)] for a in args))
         stack.pop()
-    return memo[hash(expr)]
+    return memo[expr_key(expr)]
 
 
 def count_ops(exprs: Sequence[Expr], cse: bool = True) -> int:
