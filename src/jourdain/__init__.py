@@ -9,6 +9,12 @@ from symengine import atan2, cos, exp, log, pi, sin, sqrt, tan
 
 from .errors import EvaluationError, JourdainError, ModelError, SingularMassMatrix
 from .kinematics import BodyKinematics, Kinematics, kinematics
+from .linearization import (
+    CompiledLinearization,
+    Linearization,
+    TimeVariantError,
+    linearization,
+)
 from .model import (
     WORLD,
     Body,
@@ -55,6 +61,7 @@ __all__ = [
     "EvaluationError", "JourdainError", "ModelError", "SingularMassMatrix",
     "BodyKinematics", "Kinematics", "kinematics", "NewtonEuler", "newton_euler",
     "EquationsOfMotion", "projection", "SymMatrix",
+    "CompiledLinearization", "Linearization", "TimeVariantError", "linearization",
     "JointReactions", "Reactions", "evaluate_reactions", "joint_reactions", "reactions",
     "WORLD", "Body", "Cylindrical", "Fixed", "Force", "Free", "General", "GeneralizedForce",
     "Gravity", "Joint", "Planar", "Prismatic", "Revolute", "Rot", "RotationalSpringDamper",

@@ -29,6 +29,7 @@ from .forces import (
 
 if TYPE_CHECKING:
     from ..kinematics import Kinematics
+    from ..linearization import Linearization
     from ..newton_euler import NewtonEuler
     from ..projection import EquationsOfMotion
     from ..reactions import Reactions
@@ -191,6 +192,13 @@ class System:
         from ..reactions import reactions
 
         return reactions(self.newton_euler())
+
+    def linearize(self, nominal: Mapping[Any, Any] | Any) -> Linearization:
+        """Linearization M̃·η̈ + P·η̇ + Q·η = h + B·Δu about a nominal motion (METHOD §5);
+        see :func:`jourdain.linearization.linearization`."""
+        from ..linearization import linearization
+
+        return linearization(self.equations_of_motion(), nominal)
 
     def evaluate(self, y: Any, yd: Any, t: float = 0.0, parameters: Mapping[str, float] | None = None,
                  inputs: Mapping[str, float] | Sequence[float] | None = None) -> dict[str, np.ndarray]:

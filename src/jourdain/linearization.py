@@ -1,0 +1,377 @@
+"""Linearization about a nominal motion (METHOD.md §5) and its physical split (§6).
+
+With ``y = y_s(t) + η`` and inputs ``u = u_s(t) + Δu``, the equations of motion
+``M(y,t)·ÿ + k(y,ẏ,t) = q(y,ẏ,u,t)`` become, to first order in ``η`` and ``Δu``,
+
+    M̃(t)·η̈ + P(t)·η̇ + Q(t)·η = h(t) + B(t)·Δu
+
+    M̃ = M|_s                         P = (∂k/∂ẏ − ∂q/∂ẏ)|_s
+    Q = (∂(M·ÿ_s)/∂y + ∂k/∂y − ∂q/∂y)|_s
+    h = (q − k − M·ÿ_s)|_s             B = ∂q/∂u|_s
+
+All are derived at once as the value and the gradient of the residual
+``r = M·ÿ + k − q`` at the nominal point (:func:`jourdain.differentiate.jet`): ``Q = ∂r/∂y``,
+``P = ∂r/∂ẏ``, ``B = −∂r/∂u`` and ``h = −r``, with ``ÿ`` replaced by ``ÿ_s`` (which gives the
+position term ``∂(M·ÿ_s)/∂y`` of the note in METHOD.md §5). M is never inverted.
+
+For a time-invariant result (M̃, P, Q, B free of t) the matrices split into damping ``D``,
+gyroscopic ``G``, stiffness ``K`` and circulatory ``N`` parts (§6):
+``D = ½(P + Pᵀ)``, ``G = ½(P − Pᵀ)``, ``K = ½(Q + Qᵀ)``, ``N = ½(Q − Qᵀ)``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import symengine as se
+
+from .differentiate import evaluate_float, free_symbol_names, jet
+from .errors import EvaluationError, JourdainError, ModelError
+from .model.expressions import as_expr
+from .symbolic import SymMatrix
+
+if TYPE_CHECKING:
+    from .model.system import System
+    from .numeric import CompiledFunction
+    from .projection import EquationsOfMotion
+
+ZERO = se.Integer(0)
+HALF = se.Rational(1, 2)
+
+
+class TimeVariantError(JourdainError):
+    """An operation that needs a time-invariant linear system got a time-variant one."""
+
+
+@dataclass(frozen=True)
+class Linearization:
+    """Result of :func:`linearization`: ``M̃·η̈ + P·η̇ + Q·η = h + B·Δu`` (METHOD.md §5).
+
+    Attributes
+    ----------
+    equations_of_motion : EquationsOfMotion
+        The stage it came from.
+    y_s, yd_s, ydd_s : SymMatrix (f×1)
+        The nominal motion, its velocity and acceleration (expressions in ``t`` and the
+        parameters).
+    u_s : SymMatrix (m×1)
+        Nominal inputs (zero unless given).
+    M_tilde : SymMatrix (f×f)
+        ``M(y_s, t)``, symmetric.
+    P : SymMatrix (f×f)
+        Velocity matrix ``(∂k/∂ẏ − ∂q/∂ẏ)|_s``.
+    Q : SymMatrix (f×f)
+        Position matrix ``(∂(M·ÿ_s)/∂y + ∂k/∂y − ∂q/∂y)|_s``.
+    h : SymMatrix (f×1)
+        Excitation ``(q − k − M·ÿ_s)|_s``: zero when the nominal motion solves the equations of
+        motion.
+    B : SymMatrix (f×m)
+        Input matrix ``∂q/∂u|_s`` for the input deviations ``Δu`` (m = number of inputs).
+    time_dependence : tuple of str
+        Names of the matrices among M̃, P, Q, B that depend on t explicitly (empty for a
+        time-invariant result).
+    """
+
+    equations_of_motion: EquationsOfMotion
+    y_s: SymMatrix
+    yd_s: SymMatrix
+    ydd_s: SymMatrix
+    u_s: SymMatrix
+    M_tilde: SymMatrix
+    P: SymMatrix
+    Q: SymMatrix
+    h: SymMatrix
+    B: SymMatrix
+    time_dependence: tuple[str, ...]
+
+    # --- context -----------------------------------------------------------------------------
+    @property
+    def system(self) -> System:
+        return self.equations_of_motion.system
+
+    @property
+    def f(self) -> int:
+        return self.system.f
+
+    @property
+    def nominal(self) -> dict[str, se.Basic]:
+        """The nominal motion by coordinate name (and nominal inputs by input name)."""
+        out = {n: self.y_s[i] for i, n in enumerate(self.system.coordinate_names)}
+        out.update({n: self.u_s[i] for i, n in enumerate(self.system.input_names)})
+        return out
+
+    # --- time dependence and the split of §6 ---------------------------------------------------
+    @property
+    def is_time_invariant(self) -> bool:
+        """True when M̃, P, Q and B do not depend on t (h may: a time-dependent excitation)."""
+        return not self.time_dependence
+
+    def _require_time_invariant(self, what: str) -> None:
+        dep = self.time_dependence
+        if dep:
+            raise TimeVariantError(
+                f"{what}: the linearization about the nominal motion "
+                f"{_describe_nominal(self)} is time-variant ({', '.join(dep)} depend on t); the "
+                "split into D, G, K, N (METHOD.md §6) holds for time-invariant systems only. "
+                "Use M_tilde, P, Q, h as functions of t (evaluate(t=...))."
+            )
+
+    @property
+    def D(self) -> SymMatrix:
+        """Damping matrix ``D = ½(P + Pᵀ)`` (symmetric); time-invariant results only."""
+        self._require_time_invariant("D")
+        return _sym_part(self.P, +1)
+
+    @property
+    def G(self) -> SymMatrix:
+        """Gyroscopic matrix ``G = ½(P − Pᵀ)`` (skew-symmetric); time-invariant results only."""
+        self._require_time_invariant("G")
+        return _sym_part(self.P, -1)
+
+    @property
+    def K(self) -> SymMatrix:
+        """Stiffness matrix ``K = ½(Q + Qᵀ)`` (symmetric); time-invariant results only."""
+        self._require_time_invariant("K")
+        return _sym_part(self.Q, +1)
+
+    @property
+    def N(self) -> SymMatrix:
+        """Circulatory matrix ``N = ½(Q − Qᵀ)`` (skew-symmetric); time-invariant results only."""
+        self._require_time_invariant("N")
+        return _sym_part(self.Q, -1)
+
+    @property
+    def is_conservative(self) -> bool:
+        """True when ``D = 0``, ``N = 0`` and ``h = 0`` (METHOD.md §6).
+
+        Entries that are not zero as written are tested numerically (an identity test): at the
+        default parameter values and at two random perturbations of them (each value scaled by a
+        factor in [0.7, 1.3]), and for h at several times; zero means below 1e-9 relative to the
+        size of P, Q. Time-invariant results only.
+        """
+        self._require_time_invariant("is_conservative")
+        names = ("D", "N", "h")
+        exprs = {"D": self.D.entries(), "N": self.N.entries(), "h": self.h.entries()}
+        if all(e.is_Number and e == 0 for n in names for e in exprs[n]):
+            return True
+        rng = np.random.default_rng(20240601)
+        base = self.system.parameter_values
+        trials = [base] + [{k: v * rng.uniform(0.7, 1.3) for k, v in base.items()}
+                           for _ in range(2)]
+        for values in trials:
+            for t in (0.0, 0.37, 1.91):
+                num = self.evaluate(t=t, parameters=values)
+                scale = max(1.0, np.abs(num["P"]).max(), np.abs(num["Q"]).max(),
+                            np.abs(num["M_tilde"]).max())
+                for n in names:
+                    if np.abs(num[n]).max(initial=0.0) > 1e-9 * scale:
+                        return False
+        return True
+
+    # --- numbers -----------------------------------------------------------------------------
+    def evaluate(self, t: float = 0.0,
+                 parameters: Mapping[str, float] | None = None) -> dict[str, np.ndarray]:
+        """NumPy arrays of ``M_tilde, P, Q, h, B`` (h 1-D) at time ``t``, and of ``D, G, K, N``
+        for a time-invariant result (for a time-variant one these keys are left out).
+
+        ``parameters`` overrides default parameter values by name. One evaluation walks the
+        expression graph once in floating point (no compilation); for many evaluations use
+        :meth:`compile`.
+        """
+        from .numeric import parameter_vector
+
+        tv = _time(t)
+        p = parameter_vector(self.system, parameters)
+        values = {str(s): float(v) for s, v in zip(self.system.parameter_symbols, p, strict=True)}
+        values["t"] = tv
+        blocks = self._blocks()
+        flat = [e for m in blocks.values() for e in m.entries()]
+        nums = evaluate_float(flat, values)
+        out: dict[str, np.ndarray] = {}
+        i = 0
+        for name, m in blocks.items():
+            n, c = m.shape
+            out[name] = np.asarray(nums[i:i + n * c], dtype=float).reshape(n, c)
+            i += n * c
+        return self._finish(out)
+
+    def compile(self) -> CompiledLinearization:
+        """Machine code for ``M_tilde, P, Q, h, B`` as functions of t and the parameters
+        (:func:`jourdain.numeric.lambdify`), for repeated evaluation (sweeps, time-variant
+        systems)."""
+        from .numeric import lambdify
+
+        return CompiledLinearization(self, lambdify(self.system, self._blocks()))
+
+    def _blocks(self) -> dict[str, SymMatrix]:
+        out = {"M_tilde": self.M_tilde, "P": self.P, "Q": self.Q, "h": self.h}
+        if self.system.inputs:
+            out["B"] = self.B
+        return out
+
+    def _finish(self, out: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+        bad = [k for k, v in out.items() if not np.all(np.isfinite(v))]
+        if bad:
+            raise EvaluationError(f"the linearization has non-finite entries in {bad} at these "
+                                  "parameter values (a singular position of the nominal motion?)")
+        out["h"] = out["h"].reshape(-1)
+        if "B" not in out:
+            out["B"] = np.zeros((self.f, 0))
+        if self.is_time_invariant:
+            P, Q = out["P"], out["Q"]
+            out["D"] = 0.5 * (P + P.T)
+            out["G"] = 0.5 * (P - P.T)
+            out["K"] = 0.5 * (Q + Q.T)
+            out["N"] = 0.5 * (Q - Q.T)
+        return out
+
+    def __repr__(self) -> str:
+        kind = "time-invariant" if self.is_time_invariant else "time-variant"
+        return (f"Linearization({self.system.name!r} about {_describe_nominal(self)}: f={self.f}, "
+                f"inputs={self.system.input_names}, {kind})")
+
+
+@dataclass(frozen=True)
+class CompiledLinearization:
+    """Compiled ``M_tilde, P, Q, h, B`` of a :class:`Linearization`; call with ``(t,
+    parameters)`` for the same dict as :meth:`Linearization.evaluate`."""
+
+    linearization: Linearization
+    function: CompiledFunction
+
+    def __call__(self, t: float = 0.0,
+                 parameters: Mapping[str, float] | None = None) -> dict[str, np.ndarray]:
+        from .numeric import parameter_vector
+
+        system = self.linearization.system
+        p = parameter_vector(system, parameters)
+        f = system.f
+        out = self.function(np.zeros(f), np.zeros(f), _time(t), p, np.zeros(len(system.inputs)))
+        return self.linearization._finish(dict(out))
+
+
+def linearization(eom: EquationsOfMotion, nominal: Mapping[Any, Any] | Any) -> Linearization:
+    """Linearize ``M·ÿ + k = q`` about a nominal motion (METHOD.md §5).
+
+    Parameters
+    ----------
+    eom : EquationsOfMotion
+        Result of :func:`jourdain.projection`.
+    nominal : mapping
+        ``{coordinate: y_s}`` for every coordinate (names or symbols as keys), each a number or
+        an expression in ``t`` and the system's parameters: constants for an equilibrium,
+        ``Omega*t`` for a steady rotation, any ``y_s(t)`` for a reference trajectory. Inputs may
+        be given too (``{"F": F_s}``); inputs not given are zero. An object with a ``nominal``
+        attribute (e.g. :class:`jourdain.Equilibrium`) is accepted as well.
+
+    Returns
+    -------
+    Linearization
+        ``M_tilde, P, Q, h, B`` symbolic in the parameters (and t for a time-variant result).
+
+    Raises
+    ------
+    ModelError
+        A coordinate without a nominal value, an unknown name, or a symbol in a nominal value
+        that is neither ``t`` nor a parameter of the system.
+    """
+    system = eom.system
+    if hasattr(nominal, "nominal") and not isinstance(nominal, Mapping):
+        nominal = nominal.nominal
+    if not isinstance(nominal, Mapping):
+        raise ModelError(f"nominal motion: expected a mapping from coordinate names to values, "
+                         f"got {type(nominal).__name__}")
+    y_names = system.coordinate_names
+    u_names = system.input_names
+    given: dict[str, se.Basic] = {}
+    for key, value in nominal.items():
+        name = str(key)
+        if name not in y_names and name not in u_names:
+            raise ModelError(f'nominal motion: "{name}" is neither a coordinate ({y_names}) nor '
+                             f"an input ({u_names})")
+        if name in given:
+            raise ModelError(f'nominal motion: "{name}" is given twice')
+        given[name] = as_expr(value, f'nominal motion of "{name}"')
+    missing = [n for n in y_names if n not in given]
+    if missing:
+        raise ModelError(f"nominal motion: no value for coordinate(s) {missing} (give every "
+                         "coordinate, e.g. 0 for an equilibrium at the origin)")
+    allowed = {"t"} | {k for k, _ in system.parameters}
+    for name, e in given.items():
+        bad = free_symbol_names([e]) - allowed
+        if bad:
+            raise ModelError(
+                f'nominal motion of "{name}": unknown symbol(s) {sorted(bad)}; a nominal motion '
+                "may depend on t and on the parameters of the system only (declare a speed such "
+                "as Omega as a parameter of the System)"
+            )
+    t = system.t
+    f = system.f
+    y_s = [given[n] for n in y_names]
+    yd_s = [se.diff(e, t) for e in y_s]
+    ydd_s = [se.diff(e, t) for e in yd_s]
+    u_s = [given.get(n, ZERO) for n in u_names]
+
+    # the residual r = M·ÿ + k − q; its gradient at the nominal point gives Q, P, −B
+    M, k, q = eom.M, eom.k, eom.q
+    ydd = system.ydd
+    r = [se.Add(*(M[i, j] * ydd[j] for j in range(f))) + k[i] - q[i] for i in range(f)]
+    upper = [(i, j) for i in range(f) for j in range(i, f)]
+    variables = [*system.y, *system.yd, *system.inputs]
+    point: dict[se.Symbol, se.Basic] = {}
+    point.update(zip(system.y, y_s, strict=True))
+    point.update(zip(system.yd, yd_s, strict=True))
+    point.update(zip(ydd, ydd_s, strict=True))
+    point.update(zip(system.inputs, u_s, strict=True))
+    J = jet(r + [M[i, j] for i, j in upper], variables, point, n_gradients=f)
+
+    Q = J.jacobian(f, 0)[:f]
+    P = J.jacobian(f, f)[:f]
+    m = len(u_names)
+    B = [[-e if not (e.is_Number and e == 0) else ZERO for e in row]
+         for row in J.jacobian(m, 2 * f)[:f]]
+    h = [-v for v in J.values[:f]]
+    Mt = [[ZERO] * f for _ in range(f)]
+    for (i, j), v in zip(upper, J.values[f:], strict=True):
+        Mt[i][j] = v
+        Mt[j][i] = v
+    matrices = {"M_tilde": Mt, "P": P, "Q": Q, "B": B}
+    dependence = tuple(n for n, rows in matrices.items()
+                       if "t" in free_symbol_names([e for row in rows for e in row]))
+    return Linearization(
+        equations_of_motion=eom, time_dependence=dependence,
+        y_s=SymMatrix.column(y_s), yd_s=SymMatrix.column(yd_s), ydd_s=SymMatrix.column(ydd_s),
+        u_s=SymMatrix.column(u_s) if m else SymMatrix(()),
+        M_tilde=SymMatrix.from_rows(Mt), P=SymMatrix.from_rows(P), Q=SymMatrix.from_rows(Q),
+        h=SymMatrix.column(h), B=SymMatrix(tuple(tuple(row) for row in B)),
+    )
+
+
+def _sym_part(A: SymMatrix, sign: int) -> SymMatrix:
+    n = A.shape[0]
+    rows = [[ZERO] * n for _ in range(n)]
+    for i in range(n):
+        for j in range(n):
+            a, b = A[i, j], A[j, i]
+            e = a + b if sign > 0 else a - b
+            rows[i][j] = ZERO if e.is_Number and e == 0 else HALF * e
+    return SymMatrix.from_rows(rows)
+
+
+def _describe_nominal(lin: Linearization) -> str:
+    parts = [f"{n} = {lin.y_s[i]}" for i, n in enumerate(lin.system.coordinate_names)]
+    text = ", ".join(parts)
+    return text if len(text) < 120 else text[:117] + "..."
+
+
+def _time(t: float) -> float:
+    try:
+        tv = float(t)
+    except (TypeError, ValueError):
+        raise EvaluationError(f"t must be a number, got {t!r}") from None
+    if not np.isfinite(tv):
+        raise EvaluationError(f"t = {t!r} is not finite")
+    return tv
