@@ -146,7 +146,7 @@ _JOINT_KEYS: dict[str, set[str]] = {
     "planar": {"coordinates", "normal"},
     "free": {"coordinates", "sequence"},
     "fixed": set(),
-    "general": {"steps", "coordinates"},
+    "general": {"steps", "coordinates", "constrained"},
 }
 _JOINT_COMMON = {"type", "name", "position", "orientation"}
 _FORCE_KEYS: dict[str, set[str]] = {
@@ -216,6 +216,7 @@ class _Loader:
         self.descriptions: dict[str, str] = {}
         self.body_names: list[str] = []
         self.joint_of_body: dict[str, str] = {}
+        self.driven: dict[str, str] = {}
 
     # --- errors ---------------------------------------------------------------------------
     def fail(self, path: Path, message: str) -> ModelFileError:
@@ -509,7 +510,18 @@ class _Loader:
             if bname == WORLD:
                 raise self.fail((*path, bname), '"world" is the inertial frame, not a body name')
         self.body_names = list(tbl)
-        return [self.read_body(bname, spec) for bname, spec in tbl.items()]
+        bodies = [self.read_body(bname, spec) for bname, spec in tbl.items()]
+        parents = {b.name: b.parent for b in bodies}
+        for b in bodies:
+            seen = [b.name]
+            while parents.get(seen[-1], WORLD) != WORLD:
+                nxt = parents[seen[-1]]
+                if nxt in seen:
+                    chain = " → ".join([*seen[seen.index(nxt):], nxt])
+                    raise self.fail((*path, b.name, "parent"), f"the parents form a cycle "
+                                    f"({chain}); every chain of parents must end at \"world\"")
+                seen.append(nxt)
+        return bodies
 
     def read_body(self, bname: str, spec: object) -> Body:
         p: Path = ("bodies", bname)
@@ -677,18 +689,51 @@ class _Loader:
             else:
                 used = set().union(*(_free(s) for s in steps)) & set(self.coords)
                 driven = [se.Symbol(c) for c in self.coords if c in used]
-            return General(jname, steps, coordinates=driven, **kw)
+            constrained = None
+            if "constrained" in spec:
+                constrained = self.constrained(spec["constrained"], (*p, "constrained"), params)
+            return General(jname, steps, coordinates=driven, constrained=constrained, **kw)
         except ModelFileError:
             raise
         except ModelError as exc:
             raise self.fail(p, str(exc)) from None
 
-    def coordinate(self, value: object, path: Path) -> str:
+    def constrained(self, value: object, path: Path, params: set[str]) -> list[Any]:
+        """Constrained directions of a general joint: "F_x" … "T_z" or
+        { name = "T_a", wrench = [F_x, F_y, F_z, T_x, T_y, T_z] } (child frame)."""
+        if not isinstance(value, list):
+            raise self.fail(path, f'expected an array of directions such as ["F_x", "T_y"], got '
+                            f"{_type_name(value)}")
+        out: list[Any] = []
+        units = ("F_x", "F_y", "F_z", "T_x", "T_y", "T_z")
+        for i, item in enumerate(value):
+            ip = (*path, i)
+            if isinstance(item, str):
+                if item not in units:
+                    raise self.fail(ip, f'expected one of {", ".join(units)} or a table '
+                                    f'{{ name = "T_a", wrench = [...] }}, got "{item}"')
+                out.append(item)
+                continue
+            tb = self.table(item, ip, {"name", "wrench"})
+            nm = self.name(self.require(tb, "name", ip), (*ip, "name"), "direction")
+            w = self.vector(self.require(tb, "wrench", ip), (*ip, "wrench"),
+                            params | set(self.coords), "constrained directions (coordinates "
+                            "and parameters)", n=6)
+            out.append((nm, w))
+        return out
+
+    def coordinate(self, value: object, path: Path, drive: bool = True) -> str:
         s = self.string(value, path)
         if s not in self.coords:
             raise self.fail(path, f'"{s}" is not a declared coordinate'
                             f"{self.suggest(s, self.coords)}; coordinates are "
                             f"{', '.join(self.coords)}")
+        if drive and path[0] == "bodies":
+            other = self.driven.get(s)
+            if other is not None and other != path[1]:
+                raise self.fail(path, f'coordinate "{s}" is already driven by the joint of body '
+                                f'"{other}"; each coordinate belongs to one joint')
+            self.driven[s] = str(path[1])
         return s
 
     def orientation(self, value: object, path: Path, params: set[str], ctx: str) -> Any:

@@ -203,5 +203,9 @@ def line_of(lines: dict[Path, int], path: Path) -> int | None:
     while p:
         if p in lines:
             return lines[p]
+        # a table created implicitly by a header such as [a.b] has no line of its own
+        below = [ln for q, ln in lines.items() if q[:len(p)] == p]
+        if below:
+            return min(below)
         p = p[:-1]
     return None
