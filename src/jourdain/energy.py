@@ -1,0 +1,120 @@
+"""Kinetic and potential energy of a system, from the body velocities and positions.
+
+``T = ½ Σ_i (m_i v_iᵀ v_i + ω_iᵀ I_i ω_i)`` with ``v_i = J_Ti·ẏ + v̄_i`` (inertial frame, centre
+of mass) and ``ω_i = J_Ri·ẏ + ω̄_i`` (body frame, where ``I_i`` is constant), so rheonomic terms
+are included. ``V`` is the potential of gravity (``-Σ m_i gᵀ r_i``), of linear spring–dampers
+(``½ c (L - L₀)²``) and of generalized forces linear in their own coordinate
+(``Q = a + b·y`` gives ``V = -(a·y + ½ b·y²)``, e.g. rotational springs). Every other applied
+force is non-conservative; its work is what the simulation's energy balance reports.
+
+These expressions are computed independently of ``M`` and ``k``, so the energy along a simulated
+motion checks the equations of motion as well as the integrator.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import symengine as se
+
+from .kinematics import Kinematics
+from .model.bodies import WORLD
+from .model.expressions import free_names
+from .model.forces import Force, GeneralizedForce, Gravity, SpringDamper, Torque, rate
+
+ZERO = se.Integer(0)
+
+
+@dataclass(frozen=True)
+class Energy:
+    """Result of :func:`energy`.
+
+    Attributes
+    ----------
+    T : kinetic energy, an expression in y, ẏ, t and parameters
+    V : potential energy of the conservative force elements, in y, t and parameters
+    conservative : True when no force does work other than through ``V`` and the kinematics
+        does not depend on time explicitly (then ``T + V`` is constant along a motion)
+    nonconservative : names of the force elements whose work is not in ``V``
+    """
+
+    kinematics: Kinematics
+    T: se.Basic
+    V: se.Basic
+    conservative: bool
+    nonconservative: tuple[str, ...]
+
+
+def _dot(a: tuple, b: tuple) -> se.Basic:
+    return se.Add(*(x * y for x, y in zip(a, b, strict=True)))
+
+
+def energy(kin: Kinematics) -> Energy:
+    """Kinetic energy ``T`` and potential energy ``V`` of ``kin.system`` (see module docs)."""
+    sys = kin.system
+    yd = kin.yd
+    T_terms: list[se.Basic] = []
+    pos: dict[str, tuple] = {}
+    for body, bk in zip(sys.bodies, kin.bodies, strict=True):
+        v = tuple(
+            se.Add(*(bk.J_T[i, j] * yd[j] for j in bk.cols_T), bk.v_bar[i, 0]) for i in range(3)
+        )
+        w = tuple(bk.omega[i, 0] for i in range(3))
+        pos[body.name] = tuple(bk.r[i, 0] for i in range(3))
+        if body.mass != 0:
+            T_terms.append(body.mass * _dot(v, v))
+        Iw = tuple(se.Add(*(body.inertia[i][j] * w[j] for j in range(3))) for i in range(3))
+        T_terms.append(_dot(w, Iw))
+    T = se.Rational(1, 2) * se.Add(*T_terms)
+
+    V_terms: list[se.Basic] = []
+    noncons: list[str] = []
+    rates = {str(r) for r in yd}
+    inputs = set(sys.input_names)
+    for fe in sys.forces:
+        if isinstance(fe, Gravity):
+            for body in sys.bodies:
+                if body.mass != 0:
+                    V_terms.append(-body.mass * _dot(fe.vector, pos[body.name]))
+        elif isinstance(fe, SpringDamper):
+            if fe.law is not None or fe.damping != 0:
+                noncons.append(fe.name)
+            if fe.law is None:
+                ra = _point(kin, fe.body_a, fe.point_a)
+                rb = _point(kin, fe.body_b, fe.point_b)
+                d = tuple(b - a for a, b in zip(ra, rb, strict=True))
+                L = se.sqrt(_dot(d, d))
+                V_terms.append(se.Rational(1, 2) * fe.stiffness * (L - fe.rest_length) ** 2)
+        elif isinstance(fe, GeneralizedForce):
+            c = fe.coordinate
+            damping = fe.value.diff(rate(c))
+            spring = fe.value.subs({rate(c): 0}) if damping != 0 else fe.value
+            b = spring.diff(c)
+            names = free_names([spring])
+            linear = (not (free_names([b]) & (set(sys.coordinate_names) | rates | inputs | {"t"}))
+                      and not (names & (rates | inputs | {"t"}))
+                      and not (names & set(sys.coordinate_names) - {str(c)}))
+            if linear:
+                a = spring.subs({c: 0})
+                V_terms.append(-(a * c + se.Rational(1, 2) * b * c**2))
+            if not linear or damping != 0:
+                noncons.append(fe.name)
+        elif isinstance(fe, Force | Torque):
+            noncons.append(fe.name)
+    rheonomic = False
+    for body in sys.bodies:
+        j = body.joint
+        exprs = [*j.position, *(x for row in j.orientation for x in row)]
+        for s in j.steps:
+            exprs.extend([s.angle] if hasattr(s, "angle") else list(s.vector))
+        if "t" in free_names(exprs):
+            rheonomic = True
+    V = se.Add(*V_terms) if V_terms else ZERO
+    return Energy(kin, T, V, not noncons and not rheonomic, tuple(noncons))
+
+
+def _point(kin: Kinematics, body: str, p: tuple) -> tuple:
+    if body == WORLD:
+        return tuple(p)
+    r, _, _, _ = kin[body].point(tuple(p))
+    return r

@@ -1,0 +1,575 @@
+"""Time integration of the equations of motion ``M(y,t)·ÿ + k(y,ẏ,t) = q(y,ẏ,t)``.
+
+:func:`simulate` integrates from ``y(t0) = y0, ẏ(t0) = ẏ0`` and returns a
+:class:`~jourdain.results.Results`. The default methods ``"DOP853"`` and ``"RK45"``
+(Dormand–Prince 8(5,3) and 5(4), adaptive steps, continuous extension) run their step loop in C
+(:mod:`jourdain.numeric.integrator_c`), calling the generated ``M, k, q`` code and a Cholesky
+factorization of ``M`` in every evaluation, without returning to Python between steps. The
+stiff methods ``"Radau"``, ``"BDF"`` and ``"LSODA"`` use :func:`scipy.integrate.solve_ivp` with the
+same compiled right-hand side (one call from Python per evaluation).
+
+Inputs ``u(t)`` are given per input name as
+
+- a number (constant),
+- a table ``(times, values)`` (linear interpolation, held constant outside; runs in C),
+- an expression in ``t``, the coordinates, their rates and the parameters (compiled into the C
+  loop; state feedback is allowed),
+- a Python callable ``u(t) -> float`` (called back from C at every evaluation: much slower).
+
+Events are :class:`Event` objects holding an expression in ``t``, ``y``, ``ẏ``, parameters and
+inputs; the run records the times at which it crosses zero (located on the continuous extension)
+and stops at the first crossing of a terminal event.
+
+The run goes in chunks so that a long run shows progress, can write its results as it goes
+(``output=``) and, when interrupted (Ctrl-C, an exception in an input callable), keeps what was
+computed: the results say ``interrupted`` and why.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import math
+import numbers
+import sys
+import time
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from functools import lru_cache
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import symengine as se
+
+from .errors import EvaluationError, JourdainError, SingularMassMatrix
+from .model.expressions import as_expr
+from .numeric import CompiledFunction, lambdify, mkq_function, parameter_vector
+from .numeric.build import build, content_key
+from .numeric.integrator_c import source as integrator_source
+from .results import Results
+from .symbolic import SymMatrix
+
+if TYPE_CHECKING:
+    from .model.system import System
+
+EXPLICIT = {"DOP853": 1, "RK45": 0, "DOPRI5": 0}
+SCIPY_METHODS = ("Radau", "BDF", "LSODA")
+
+_DONE, _CONTINUE, _EVENT = 0, 1, 2
+_ESINGULAR, _ENAN, _ESTEP, _ECALLBACK, _ENOMEM = -1, -2, -3, -4, -5
+
+
+class IntegrationError(JourdainError, RuntimeError):
+    """The integration failed: a NaN in the state, a step size below the round-off limit."""
+
+
+@dataclass(frozen=True)
+class Event:
+    """A zero crossing to record (and to stop at, when ``terminal``).
+
+    Parameters
+    ----------
+    expr : expression in t, coordinates, rates, parameters and inputs
+    direction : +1 records rising crossings only, -1 falling ones, 0 both
+    terminal : stop the run at the first crossing
+    name : label in the results (default: the expression as text)
+    """
+
+    expr: Any
+    direction: int = 0
+    terminal: bool = False
+    name: str | None = None
+
+    @property
+    def label(self) -> str:
+        return self.name if self.name is not None else str(self.expr)
+
+
+class _Problem(ctypes.Structure):
+    _fields_ = [
+        ("f", ctypes.c_long), ("nu", ctypes.c_long), ("nev", ctypes.c_long),
+        ("mkq", ctypes.c_void_p), ("uexpr", ctypes.c_void_p), ("events", ctypes.c_void_p),
+        ("ucb", ctypes.c_void_p), ("p", ctypes.c_void_p), ("u_const", ctypes.c_void_p),
+        ("u_kind", ctypes.c_void_p), ("tab_off", ctypes.c_void_p), ("tab_t", ctypes.c_void_p),
+        ("tab_v", ctypes.c_void_p), ("ev_dir", ctypes.c_void_p), ("ev_term", ctypes.c_void_p),
+        ("method", ctypes.c_int), ("rtol", ctypes.c_double), ("atol", ctypes.c_void_p),
+        ("h_max", ctypes.c_double), ("h_first", ctypes.c_double),
+    ]
+
+
+_CALLBACK = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, ctypes.POINTER(ctypes.c_double),
+                             ctypes.POINTER(ctypes.c_double), ctypes.POINTER(ctypes.c_double))
+
+
+@lru_cache(maxsize=1)
+def integrator_library() -> ctypes.CDLL:
+    """The compiled integrator (built once, cached on disk like the model code)."""
+    src = integrator_source()
+    lib = build(content_key("integrator", src), src)
+    vp, lg, db = ctypes.c_void_p, ctypes.c_long, ctypes.c_double
+    lib.jd_integrate.restype = ctypes.c_int
+    lib.jd_integrate.argtypes = [vp, db, vp, vp, vp, vp, vp, vp, lg, vp, vp, vp, lg, vp, vp, vp,
+                                 vp, lg, vp, lg, vp]
+    lib.jd_rhs.restype = ctypes.c_int
+    lib.jd_rhs.argtypes = [vp, db, vp, vp, vp]
+    return lib
+
+
+def _ptr(a: np.ndarray | None) -> int | None:
+    return None if a is None else a.ctypes.data
+
+
+class _Setup:
+    """Everything the C loop needs, with the arrays kept alive while it runs."""
+
+    def __init__(self, system: System, mkq: CompiledFunction, p: np.ndarray,
+                 inputs: Mapping[str, Any] | None, events: Sequence[Event], method: int,
+                 rtol: float, atol: np.ndarray, max_step: float, first_step: float) -> None:
+        f, nu = system.f, len(system.inputs)
+        self.system = system
+        self.p = np.ascontiguousarray(p, dtype=float)
+        self.u_const = np.zeros(max(nu, 1))
+        self.u_kind = np.zeros(max(nu, 1), dtype=np.intc)
+        self.tab_off = np.zeros(nu + 1, dtype=np.int_)
+        tab_t: list[np.ndarray] = []
+        tab_v: list[np.ndarray] = []
+        self.callables: dict[int, Callable[..., Any]] = {}
+        self.callback_error: BaseException | None = None
+        exprs: list[se.Basic] = [se.Integer(0)] * nu
+        names = system.input_names
+        inputs = dict(inputs or {})
+        unknown = set(inputs) - set(names)
+        if unknown:
+            raise EvaluationError(f"unknown input(s) {sorted(unknown)}; inputs are {names}")
+        missing = [n for n in names if n not in inputs]
+        if missing:
+            raise EvaluationError(
+                f"input(s) {missing} not given: pass inputs={{{', '.join(repr(m) + ': 0.0' for m in missing)}}}"
+                " or a function of time, an expression in t or a table (times, values)")
+        state_names = set(system.coordinate_names) | {f"{n}_d" for n in system.coordinate_names}
+        allowed = state_names | {"t"} | {k for k, _ in system.parameters}
+        n_tab = 0
+        for i, name in enumerate(names):
+            v = inputs[name]
+            if isinstance(v, numbers.Real) and not isinstance(v, bool):
+                if not math.isfinite(float(v)):
+                    raise EvaluationError(f'input "{name}" = {v!r} is not finite')
+                self.u_const[i] = float(v)
+            elif isinstance(v, tuple) and len(v) == 2:
+                tt = np.asarray(v[0], dtype=float).reshape(-1)
+                vv = np.asarray(v[1], dtype=float).reshape(-1)
+                if tt.size < 2 or tt.size != vv.size:
+                    raise EvaluationError(f'input "{name}": a table needs two arrays of the same '
+                                          f"length >= 2, got {tt.size} and {vv.size}")
+                if not (np.all(np.isfinite(tt)) and np.all(np.isfinite(vv))):
+                    raise EvaluationError(f'input "{name}": table contains NaN or inf')
+                if np.any(np.diff(tt) <= 0):
+                    raise EvaluationError(f'input "{name}": table times must increase strictly')
+                self.u_kind[i] = 1
+                tab_t.append(tt)
+                tab_v.append(vv)
+                n_tab += tt.size
+            elif callable(v) and not isinstance(v, se.Basic):
+                self.u_kind[i] = 3
+                self.callables[i] = v
+            else:
+                try:
+                    e = as_expr(v, f'input "{name}"')
+                except JourdainError as exc:
+                    raise EvaluationError(str(exc)) from None
+                bad = {str(s) for s in e.free_symbols} - allowed
+                if bad:
+                    raise EvaluationError(
+                        f'input "{name}": expression {e} uses {sorted(bad)}; input expressions '
+                        "may use t, coordinates, rates and parameters")
+                self.u_kind[i] = 2
+                exprs[i] = e
+            self.tab_off[i + 1] = n_tab
+        self.tab_t = np.concatenate(tab_t) if tab_t else np.zeros(1)
+        self.tab_v = np.concatenate(tab_v) if tab_v else np.zeros(1)
+        self.uexpr = (lambdify(system, {"u": SymMatrix.column(exprs)})
+                      if np.any(self.u_kind == 2) else None)
+        allowed_ev = allowed | set(names)
+        ev_exprs = []
+        for ev in events:
+            if not isinstance(ev, Event):
+                raise EvaluationError(f"events: expected jourdain.Event objects, got {ev!r}")
+            try:
+                e = as_expr(ev.expr, f"event {ev.label}")
+            except JourdainError as exc:
+                raise EvaluationError(str(exc)) from None
+            bad = {str(s) for s in e.free_symbols} - allowed_ev
+            if bad:
+                raise EvaluationError(f"event {ev.label}: unknown symbol(s) {sorted(bad)}")
+            if ev.direction not in (-1, 0, 1):
+                raise EvaluationError(f"event {ev.label}: direction must be -1, 0 or +1")
+            ev_exprs.append(e)
+        self.events = list(events)
+        self.ev_fn = lambdify(system, {"g": SymMatrix.column(ev_exprs)}) if ev_exprs else None
+        self.ev_dir = np.array([ev.direction for ev in events] or [0], dtype=np.intc)
+        self.ev_term = np.array([int(ev.terminal) for ev in events] or [0], dtype=np.intc)
+        self.atol = np.ascontiguousarray(atol, dtype=float)
+        self.mkq = mkq
+        self._cb = _CALLBACK(self._callback) if self.callables else None
+        self.problem = _Problem(
+            f, nu, len(ev_exprs), mkq.address, self.uexpr.address if self.uexpr else None,
+            self.ev_fn.address if self.ev_fn else None,
+            ctypes.cast(self._cb, ctypes.c_void_p).value if self._cb else None,
+            _ptr(self.p), _ptr(self.u_const), _ptr(self.u_kind), _ptr(self.tab_off),
+            _ptr(self.tab_t), _ptr(self.tab_v), _ptr(self.ev_dir), _ptr(self.ev_term), method,
+            float(rtol), _ptr(self.atol), float(max_step), float(first_step))
+
+    def _callback(self, t: float, y: Any, yd: Any, u: Any) -> int:
+        try:
+            for i, fn in self.callables.items():
+                v = float(fn(t))
+                u[i] = v
+            return 0
+        except BaseException as exc:  # noqa: BLE001 - reported by simulate(), never swallowed
+            self.callback_error = exc
+            return 1
+
+    def inputs_at(self, t: np.ndarray, x: np.ndarray) -> np.ndarray:
+        """Input values at output times (for the results)."""
+        f, nu = self.system.f, len(self.system.inputs)
+        U = np.zeros((len(t), nu))
+        if nu == 0:
+            return U
+        for i in range(nu):
+            k = self.u_kind[i]
+            if k == 0:
+                U[:, i] = self.u_const[i]
+            elif k == 1:
+                a, b = self.tab_off[i], self.tab_off[i + 1]
+                U[:, i] = np.interp(t, self.tab_t[a:b], self.tab_v[a:b])
+            elif k == 3:
+                fn = self.callables[i]
+                U[:, i] = [float(fn(tt)) for tt in t]
+        if self.uexpr is not None:
+            ue = self.uexpr.batch(x[:, :f], x[:, f:2 * f], t, self.p, None)["u"][:, :, 0]
+            mask = self.u_kind[:nu] == 2
+            U[:, mask] = ue[:, mask]
+        return U
+
+
+def _error(code: int, setup: _Setup, fail: np.ndarray) -> JourdainError:
+    sysm = setup.system
+    f = sysm.f
+    t = fail[0]
+    state = ", ".join(f"{n}={v:.6g}" for n, v in zip(sysm.coordinate_names, fail[1:1 + f],
+                                                       strict=True))
+    rates = ", ".join(f"{n}_d={v:.6g}" for n, v in zip(sysm.coordinate_names,
+                                                       fail[1 + f:1 + 2 * f], strict=True))
+    where = f"at t = {t:.9g}, state {state}; rates {rates}"
+    if code == _ESINGULAR:
+        return SingularMassMatrix(f"the mass matrix M of {sysm.name!r} is not positive definite "
+                                  f"{where}")
+    if code == _ENAN:
+        return IntegrationError(f"NaN or inf in the state or its derivative {where} (check the "
+                                "parameters and inputs)")
+    if code == _ESTEP:
+        return IntegrationError(f"step size fell below the round-off limit {where}; the motion "
+                                "may be singular or very stiff (try method='Radau')")
+    if code == _ECALLBACK:
+        return IntegrationError(f"an input function raised {setup.callback_error!r} {where}")
+    return IntegrationError(f"integrator failed with code {code}")
+
+
+def simulate(system: System, t_span: tuple[float, float], y0: Any, yd0: Any,
+             parameters: Mapping[str, float] | None = None,
+             inputs: Mapping[str, Any] | None = None, method: str = "DOP853",
+             rtol: float = 1e-6, atol: float | Sequence[float] = 1e-8,
+             t_eval: Sequence[float] | None = None, events: Sequence[Event] = (),
+             max_step: float = math.inf, first_step: float | None = None,
+             progress: bool | Callable[[float, float], None] = False,
+             output: str | None = None, raise_on_interrupt: bool = False) -> Results:
+    """Integrate ``M(y,t)·ÿ + k(y,ẏ,t) = q(y,ẏ,t)`` over ``t_span`` from ``y0, ẏ0``.
+
+    Parameters
+    ----------
+    system : System
+    t_span : (t0, t1) with t1 > t0
+    y0, yd0 : initial coordinates and rates (f each, in the order of ``system.coordinates``)
+    parameters : overrides of parameter values by name (no recompilation)
+    inputs : input name -> number, table ``(times, values)``, expression or callable (see module)
+    method : "DOP853" (default), "RK45" (step loop in C) or "Radau", "BDF", "LSODA" (SciPy)
+    rtol, atol : tolerances; the local error of each state component stays below
+        ``atol + rtol·|x|``; ``atol`` may be a vector of length 2f (y then ẏ)
+    t_eval : output times (continuous extension); default: every accepted step
+    events : :class:`Event` objects
+    max_step, first_step : step size limits
+    progress : True prints the progress to stderr; a callable gets ``(t, t1)``
+    output : path of a results file (``.h5``) written as the run goes
+    raise_on_interrupt : re-raise KeyboardInterrupt after keeping the results
+
+    Returns
+    -------
+    Results
+        ``t`` (N,), ``y``, ``yd``, ``ydd`` (N, f), ``u`` (N, inputs), ``W`` (N,) the work of the
+        generalized applied forces, ``events``, ``status`` and counters.
+
+    Raises
+    ------
+    SingularMassMatrix
+        ``M`` lost positive definiteness (the time and state are in the message).
+    IntegrationError
+        a NaN/inf in the state, a step size underflow, a failing input function.
+    EvaluationError
+        bad arguments (wrong sizes, NaN initial values, unknown names).
+    """
+    from .numeric import _vector
+
+    f = system.f
+    try:
+        t0, t1 = (float(v) for v in t_span)
+    except (TypeError, ValueError):
+        raise EvaluationError(f"t_span must be (t0, t1), got {t_span!r}") from None
+    if not (math.isfinite(t0) and math.isfinite(t1)) or t1 <= t0:
+        raise EvaluationError(f"t_span must be finite with t1 > t0, got {t_span!r}")
+    yv = _vector(y0, f, "y0", system.coordinate_names)
+    ydv = _vector(yd0, f, "yd0", [f"{n}_d" for n in system.coordinate_names])
+    if not (rtol > 0 and math.isfinite(rtol)):
+        raise EvaluationError(f"rtol must be positive, got {rtol!r}")
+    a = np.asarray(atol, dtype=float).reshape(-1)
+    if a.size == 1:
+        a = np.full(2 * f, a[0])
+    if a.size != 2 * f or not np.all(a > 0) or not np.all(np.isfinite(a)):
+        raise EvaluationError(f"atol must be a positive number or {2 * f} positive numbers")
+    atol_x = np.concatenate([a, [a.min()]])
+    if method not in EXPLICIT and method not in SCIPY_METHODS:
+        raise EvaluationError(f"unknown method {method!r}; methods are "
+                              f"{sorted(EXPLICIT) + list(SCIPY_METHODS)}")
+    te = None
+    if t_eval is not None:
+        te = np.ascontiguousarray(t_eval, dtype=float).reshape(-1)
+        if te.size == 0 or np.any(np.diff(te) < 0) or te[0] < t0 or te[-1] > t1:
+            raise EvaluationError("t_eval must be sorted and lie within t_span")
+    p = parameter_vector(system, parameters)
+    mkq = mkq_function(system)
+    setup = _Setup(system, mkq, p, inputs, events, EXPLICIT.get(method, 1), rtol, atol_x,
+                   max_step, first_step or 0.0)
+    x0 = np.concatenate([yv, ydv, [0.0]])
+    wall = time.perf_counter()
+    if method in EXPLICIT:
+        run = _run_c(setup, t0, t1, x0, te, progress, output)
+    else:
+        run = _run_scipy(setup, method, t0, t1, x0, te, rtol, atol_x, max_step, first_step)
+    run["wall_time"] = time.perf_counter() - wall
+    res = _results(setup, run, method, rtol, a, p)
+    if output is not None:
+        res.save(output)
+    if res.interrupted and raise_on_interrupt and isinstance(run.get("exception"),
+                                                             KeyboardInterrupt):
+        raise run["exception"]
+    return res
+
+
+def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray | None,
+           progress: bool | Callable[[float, float], None], output: str | None) -> dict:
+    lib = integrator_library()
+    system = setup.system
+    n = 2 * system.f + 1
+    nev = len(setup.events)
+    st = np.array([t0, 0.0])
+    x = x0.copy()
+    k0 = np.zeros(n)
+    g_old = np.zeros(max(nev, 1))
+    cnt = np.zeros(5, dtype=np.int_)
+    i_eval = np.zeros(1, dtype=np.int_)
+    n_out = np.zeros(1, dtype=np.int_)
+    n_ev = np.zeros(1, dtype=np.int_)
+    fail = np.zeros(n + 1)
+    ev_cap = 10000
+    ev_t = np.zeros(ev_cap)
+    ev_x = np.zeros((ev_cap, n))
+    ev_i = np.zeros(ev_cap, dtype=np.int_)
+    if te is not None:
+        cap = te.size
+        out_t = np.zeros(cap)
+        out_x = np.zeros((cap, n))
+        chunks_t: list[np.ndarray] = []
+        chunks_x: list[np.ndarray] = []
+    else:
+        cap = 4096
+        chunks_t = [np.array([t0])]
+        chunks_x = [x0[None, :].copy()]
+    writer = (_Writer(output, system)
+              if output and str(output).lower().endswith((".h5", ".hdf5")) else None)
+    status = "finished"
+    message = "reached the end of t_span"
+    exception: BaseException | None = None
+    max_steps = 20000
+    t_last_report = time.perf_counter()
+    try:
+        while True:
+            if te is None:
+                out_t = np.zeros(cap)
+                out_x = np.zeros((cap, n))
+                n_out[0] = 0
+            code = lib.jd_integrate(
+                ctypes.byref(setup.problem), t1, st.ctypes.data, x.ctypes.data, k0.ctypes.data,
+                g_old.ctypes.data, cnt.ctypes.data, _ptr(te), 0 if te is None else te.size,
+                i_eval.ctypes.data, out_t.ctypes.data, out_x.ctypes.data, cap,
+                n_out.ctypes.data, ev_t.ctypes.data, ev_x.ctypes.data, ev_i.ctypes.data, ev_cap,
+                n_ev.ctypes.data, max_steps, fail.ctypes.data)
+            if te is None:
+                chunks_t.append(out_t[:n_out[0]])
+                chunks_x.append(out_x[:n_out[0]])
+                if writer:
+                    writer.append(chunks_t[-1], chunks_x[-1])
+            if code < 0:
+                if code == _ECALLBACK and isinstance(setup.callback_error, KeyboardInterrupt):
+                    raise setup.callback_error
+                err = _error(code, setup, fail)
+                if code == _ECALLBACK:
+                    status, message, exception = "interrupted", str(err), setup.callback_error
+                    break
+                raise err
+            if code == _EVENT:
+                k = int(ev_i[n_ev[0] - 1])
+                status = "event"
+                message = f"terminal event {setup.events[k].label!r} at t = {st[0]:.9g}"
+                break
+            if code == _DONE:
+                break
+            now = time.perf_counter()
+            if progress and now - t_last_report > 0.5:
+                t_last_report = now
+                if callable(progress):
+                    progress(float(st[0]), t1)
+                else:
+                    print(f"\rsimulating {system.name}: t = {st[0]:.4g} of {t1:.4g} "
+                          f"({100 * (st[0] - t0) / (t1 - t0):.0f} %)", end="", file=sys.stderr)
+    except KeyboardInterrupt as exc:
+        status = "interrupted"
+        message = f"interrupted by the user (Ctrl-C) at t = {st[0]:.9g}; results up to there kept"
+        exception = exc
+    finally:
+        if writer:
+            writer.handle.close()
+    if progress is True:
+        print(file=sys.stderr)
+    if te is not None:
+        t_out, x_out = out_t[:n_out[0]], out_x[:n_out[0]]
+    else:
+        t_out, x_out = np.concatenate(chunks_t), np.concatenate(chunks_x)
+    m = int(n_ev[0])
+    return {"t": t_out, "x": x_out, "status": status, "message": message,
+            "exception": exception, "nfev": int(cnt[0]), "nstep": int(cnt[1]),
+            "naccept": int(cnt[2]), "nreject": int(cnt[3]),
+            "events": (ev_t[:m].copy(), ev_x[:m].copy(), ev_i[:m].copy())}
+
+
+def _run_scipy(setup: _Setup, method: str, t0: float, t1: float, x0: np.ndarray,
+               te: np.ndarray | None, rtol: float, atol: np.ndarray, max_step: float,
+               first_step: float | None) -> dict:
+    from scipy.integrate import solve_ivp
+
+    lib = integrator_library()
+    n = x0.size
+    fail = np.zeros(n + 1)
+    nfev = [0]
+
+    def fun(t: float, x: np.ndarray) -> np.ndarray:
+        xc = np.ascontiguousarray(x, dtype=float)
+        dx = np.empty(n)
+        nfev[0] += 1
+        code = lib.jd_rhs(ctypes.byref(setup.problem), float(t), xc.ctypes.data, dx.ctypes.data,
+                          fail.ctypes.data)
+        if code:
+            if code == _ECALLBACK and setup.callback_error is not None:
+                raise setup.callback_error
+            raise _error(code, setup, fail)
+        return dx
+
+    ev_funcs = []
+    f = setup.system.f
+    for k, ev in enumerate(setup.events):
+        def g(t: float, x: np.ndarray, k: int = k) -> float:
+            u = setup.inputs_at(np.array([t]), x[None, :])[0]
+            return float(setup.ev_fn(x[:f], x[f:2 * f], t, setup.p, u)["g"][k, 0])
+        g.terminal = ev.terminal  # type: ignore[attr-defined]
+        g.direction = ev.direction  # type: ignore[attr-defined]
+        ev_funcs.append(g)
+    status, message, exception = "finished", "reached the end of t_span", None
+    kw: dict[str, Any] = {"max_step": max_step}
+    if first_step:
+        kw["first_step"] = first_step
+    try:
+        sol = solve_ivp(fun, (t0, t1), x0, method=method, t_eval=te, rtol=rtol, atol=atol,
+                        events=ev_funcs or None, **kw)
+    except KeyboardInterrupt as exc:
+        raise IntegrationError(f"{method} run interrupted; the SciPy methods keep no partial "
+                               "results (use DOP853 or RK45 for that)") from exc
+    if sol.status == -1:
+        raise IntegrationError(f"{method}: {sol.message}")
+    ev_t, ev_x, ev_i = [], [], []
+    if ev_funcs:
+        for k, (tt, xx) in enumerate(zip(sol.t_events, sol.y_events, strict=True)):
+            ev_t.extend(tt)
+            ev_x.extend(xx)
+            ev_i.extend([k] * len(tt))
+        order = np.argsort(ev_t)
+        ev_t = list(np.asarray(ev_t)[order])
+        ev_x = list(np.asarray(ev_x).reshape(-1, n)[order])
+        ev_i = list(np.asarray(ev_i)[order])
+    if sol.status == 1:
+        status, message = "event", f"terminal event at t = {sol.t[-1]:.9g}"
+    return {"t": sol.t, "x": sol.y.T, "status": status, "message": message,
+            "exception": exception, "nfev": nfev[0], "nstep": len(sol.t), "naccept": len(sol.t),
+            "nreject": 0,
+            "events": (np.asarray(ev_t, dtype=float), np.asarray(ev_x, dtype=float).reshape(-1, n),
+                       np.asarray(ev_i, dtype=int))}
+
+
+def _results(setup: _Setup, run: dict, method: str, rtol: float, atol: np.ndarray,
+             p: np.ndarray) -> Results:
+    system = setup.system
+    f = system.f
+    t, x = run["t"], run["x"]
+    U = setup.inputs_at(t, x) if len(t) else np.zeros((0, len(system.inputs)))
+    ydd = accelerations(setup.mkq, x[:, :f], x[:, f:2 * f], t, p, U)
+    ev_t, ev_x, ev_i = run["events"]
+    events = {ev.label: [] for ev in setup.events}
+    for tt, xx, k in zip(ev_t, ev_x, ev_i, strict=True):
+        events[setup.events[int(k)].label].append((float(tt), xx[:f].copy(), xx[f:2 * f].copy()))
+    return Results(
+        system=system, t=t, y=x[:, :f].copy(), yd=x[:, f:2 * f].copy(), ydd=ydd, u=U,
+        W=x[:, 2 * f].copy(), parameters=dict(zip((k for k, _ in system.parameters), p.tolist(),
+                                                  strict=True)),
+        method=method, rtol=rtol, atol=atol, status=run["status"], message=run["message"],
+        nfev=run["nfev"], nsteps=run["nstep"], n_accepted=run["naccept"],
+        n_rejected=run["nreject"], wall_time=run["wall_time"],
+        events={k: _event_arrays(v, f) for k, v in events.items()},
+        exception=run["exception"])
+
+
+def _event_arrays(items: list, f: int) -> dict[str, np.ndarray]:
+    return {"t": np.array([i[0] for i in items]),
+            "y": np.array([i[1] for i in items]).reshape(-1, f),
+            "yd": np.array([i[2] for i in items]).reshape(-1, f)}
+
+
+def accelerations(mkq: CompiledFunction, y: np.ndarray, yd: np.ndarray, t: np.ndarray,
+                  p: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """``ÿ = M⁻¹(q - k)`` at many states (one batched evaluation, one batched solve)."""
+    n, f = y.shape
+    if n == 0:
+        return np.zeros((0, f))
+    out = mkq.batch(y, yd, t, p, u if u.shape[1] else None)
+    M, k, q = out["M"], out["k"][:, :, 0], out["q"][:, :, 0]
+    return np.linalg.solve(M, (q - k)[:, :, None])[:, :, 0]
+
+
+class _Writer:
+    """Appends accepted steps to an HDF5 results file while the run goes."""
+
+    def __init__(self, path: str, system: System) -> None:
+        from .results import open_incremental
+
+        self.path = path
+        self.handle = open_incremental(path, system)
+
+    def append(self, t: np.ndarray, x: np.ndarray) -> None:
+        from .results import append_incremental
+
+        append_incremental(self.handle, t, x)
