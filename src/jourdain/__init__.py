@@ -7,6 +7,7 @@ equations of motion M·ÿ + k = q.
 
 from symengine import atan2, cos, exp, log, pi, sin, sqrt, tan
 
+from .energy import Energy, energy
 from .errors import EvaluationError, JourdainError, ModelError, SingularMassMatrix
 from .kinematics import BodyKinematics, Kinematics, kinematics
 from .linearization import (
@@ -52,6 +53,8 @@ from .model import (
 from .newton_euler import NewtonEuler, newton_euler
 from .projection import EquationsOfMotion, projection
 from .reactions import JointReactions, Reactions, evaluate_reactions, joint_reactions, reactions
+from .results import Results
+from .simulate import Event, IntegrationError, simulate
 from .symbolic import SymMatrix
 
 __version__ = "0.1.0"
@@ -63,6 +66,7 @@ __all__ = [
     "EquationsOfMotion", "projection", "SymMatrix",
     "CompiledLinearization", "Linearization", "TimeVariantError", "linearization",
     "JointReactions", "Reactions", "evaluate_reactions", "joint_reactions", "reactions",
+    "Results", "Event", "IntegrationError", "simulate", "Energy", "energy",
     "WORLD", "Body", "Cylindrical", "Fixed", "Force", "Free", "General", "GeneralizedForce",
     "Gravity", "Joint", "Planar", "Prismatic", "Revolute", "Rot", "RotationalSpringDamper",
     "Spherical", "SpringDamper", "System", "Torque", "Trans", "Universal", "acceleration", "box",

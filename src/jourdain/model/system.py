@@ -216,6 +216,19 @@ class System:
         out.update(evaluate_keys(self, y, yd, t, parameters, inputs, eom=out))
         return out
 
+    def simulate(self, t_span: tuple[float, float], y0: Any, yd0: Any,
+                 parameters: Mapping[str, float] | None = None,
+                 inputs: Mapping[str, Any] | None = None, method: str = "DOP853",
+                 rtol: float = 1e-6, atol: Any = 1e-8, t_eval: Any = None,
+                 **options: Any) -> Any:
+        """Integrate the equations of motion from ``y0, ẏ0`` over ``t_span``; returns a
+        :class:`jourdain.results.Results` (see :func:`jourdain.simulate.simulate` for the
+        methods, inputs, events and options)."""
+        from ..simulate import simulate
+
+        return simulate(self, t_span, y0, yd0, parameters=parameters, inputs=inputs,
+                        method=method, rtol=rtol, atol=atol, t_eval=t_eval, **options)
+
     def __repr__(self) -> str:
         return (f"System({self.name!r}: {len(self.bodies)} bodies, f={self.f}, "
                 f"coordinates={self.coordinate_names}, parameters={list(dict(self.parameters))}, "
