@@ -43,8 +43,8 @@ import symengine as se
 from .errors import EvaluationError, JourdainError, SingularMassMatrix
 from .model.expressions import as_expr
 from .numeric import CompiledFunction, lambdify, mkq_function, parameter_vector
-from .numeric.build import build, content_key
 from .numeric.integrator_c import source as integrator_source
+from .numeric.toolchain import build, content_key
 from .results import Results
 from .symbolic import SymMatrix
 
@@ -243,7 +243,11 @@ class _Setup:
                 U[:, i] = np.interp(t, self.tab_t[a:b], self.tab_v[a:b])
             elif k == 3:
                 fn = self.callables[i]
-                U[:, i] = [float(fn(tt)) for tt in t]
+                for j, tt in enumerate(t):
+                    try:
+                        U[j, i] = float(fn(tt))
+                    except BaseException:  # noqa: BLE001 - the run already reported it
+                        U[j, i] = np.nan
         if self.uexpr is not None:
             ue = self.uexpr.batch(x[:, :f], x[:, f:2 * f], t, self.p, None)["u"][:, :, 0]
             mask = self.u_kind[:nu] == 2

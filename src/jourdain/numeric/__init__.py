@@ -23,7 +23,7 @@ import symengine as se
 
 from ..errors import EvaluationError
 from ..symbolic import SymMatrix
-from .build import CompilerError, build, cache_dir, cached_library, content_key
+from .toolchain import CompilerError, build, cache_dir, cached_library, content_key
 from .ccode import HEADER, argument_names, function_source
 
 if TYPE_CHECKING:

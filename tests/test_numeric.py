@@ -1,0 +1,129 @@
+"""Compiled evaluation (generated C): against SymEngine's own evaluator, batched against
+single-state calls, the on-disk cache, and bad input."""
+
+import numpy as np
+import pytest
+import symengine as se
+
+import jourdain as jd
+from jourdain import numeric
+from jourdain.models import n_link_pendulum_on_cart, spatial_chain
+from jourdain.numeric import ccode
+from jourdain.numeric import toolchain as build
+from jourdain.symbolic import SymMatrix
+
+
+@pytest.fixture
+def cache(tmp_path, monkeypatch):
+    monkeypatch.setenv("JOURDAIN_CACHE", str(tmp_path / "cache"))
+    numeric.clear_cache()
+    build._loaded.clear()
+    yield tmp_path / "cache"
+    numeric.clear_cache()
+
+
+def _reference(system, exprs, y, yd, t, p, u):
+    """SymEngine's own (non-compiled) evaluator on the same expressions."""
+    args = list(numeric.arguments(system))
+    fn = se.Lambdify(args, exprs, backend="lambda", cse=False, real=True)
+    return np.asarray(fn(np.concatenate([y, yd, [t], p, u])), dtype=float).reshape(-1)
+
+
+@pytest.mark.parametrize("model", [lambda: n_link_pendulum_on_cart(3), lambda: spatial_chain(3)])
+def test_generated_code_against_symengine(model, rng):
+    s = model()
+    eom = s.equations_of_motion()
+    fn = numeric.lambdify(s, {"M": eom.M, "k": eom.k, "q": eom.q})
+    exprs = [*eom.M.entries(), *eom.k.entries(), *eom.q.entries()]
+    p0 = numeric.parameter_vector(s, None)
+    for _ in range(3):
+        y, yd = rng.uniform(-2, 2, s.f), rng.uniform(-2, 2, s.f)
+        p = p0 * rng.uniform(0.5, 1.5, p0.size)  # new parameter values, same library
+        u = rng.uniform(-1, 1, len(s.inputs))
+        got = fn(y, yd, 0.3, p, u)
+        flat = np.concatenate([got["M"].ravel(), got["k"].ravel(), got["q"].ravel()])
+        np.testing.assert_allclose(flat, _reference(s, exprs, y, yd, 0.3, p, u), rtol=1e-12,
+                                   atol=1e-12)
+
+
+def test_sign_flipped_subexpressions_stay_distinct():
+    """SymEngine's hash of a sum ignores its overall sign (hash(a-b) == hash(b-a)); the graph
+    CSE must not merge such nodes, also deep inside products."""
+    x, y, c = se.symbols("x y c")
+    assert hash(x - y) == hash(y - x)  # the trap this test is about
+    exprs = [x - y, y - x, (x - y) * c, (y - x) * c, se.sin((x - y) * c) + se.cos((y - x) * c)]
+    names = {"x": "y[0]", "y": "y[1]", "c": "p[0]"}
+    src = ccode.HEADER + ccode.function_source("jd_fn", exprs, names)
+    lib = build.build(build.content_key("test-sign", src), src)
+    import ctypes
+
+    out = np.zeros(5)
+    yv, ydv, pv, uv = np.array([2.0, 0.5]), np.zeros(2), np.array([3.0]), np.zeros(1)
+    lib.jd_fn.argtypes = [ctypes.c_void_p] * 2 + [ctypes.c_double] + [ctypes.c_void_p] * 3
+    lib.jd_fn(yv.ctypes.data, ydv.ctypes.data, 0.0, pv.ctypes.data, uv.ctypes.data,
+              out.ctypes.data)
+    np.testing.assert_allclose(out, [1.5, -1.5, 4.5, -4.5, np.sin(4.5) + np.cos(-4.5)],
+                               rtol=1e-15)
+
+
+def test_batch_equals_single_state(rng):
+    s = n_link_pendulum_on_cart(4)
+    fn = numeric.mkq_function(s)
+    n = 50
+    Y, YD = rng.uniform(-3, 3, (n, s.f)), rng.uniform(-3, 3, (n, s.f))
+    T = rng.uniform(0, 1, n)
+    P = numeric.parameter_vector(s, None) * rng.uniform(0.5, 2, (n, 1))  # per-state parameters
+    U = rng.uniform(-5, 5, (n, 1))
+    batch = fn.batch(Y, YD, T, P, U)
+    for i in range(n):
+        one = fn(Y[i], YD[i], T[i], P[i], U[i])
+        for name in ("M", "k", "q"):
+            np.testing.assert_array_equal(batch[name][i], one[name])
+    shared = fn.batch(Y, YD, 0.0, P[0], U[0])
+    np.testing.assert_array_equal(shared["M"][7], fn(Y[7], YD[7], 0.0, P[0], U[0])["M"])
+
+
+def test_cache_is_keyed_by_content_and_safe_to_delete(cache, monkeypatch):
+    s = n_link_pendulum_on_cart(2)
+    fn = numeric.mkq_function(s)
+    files = sorted(p.name for p in cache.iterdir())
+    assert f"{fn.key}.so" in files and f"{fn.key}.c" in files
+    # a second process-level load finds the library without generating code again
+    numeric.clear_cache()
+    build._loaded.clear()
+
+    def no_codegen(*a, **k):
+        raise AssertionError("code was generated again although it is cached")
+
+    monkeypatch.setattr(numeric, "function_source", no_codegen)
+    fn2 = numeric.mkq_function(s)
+    assert fn2.key == fn.key
+    # a different model gets a different key; deleting the cache forces a rebuild
+    monkeypatch.undo()
+    monkeypatch.setenv("JOURDAIN_CACHE", str(cache))
+    assert numeric.mkq_function(n_link_pendulum_on_cart(3)).key != fn.key
+    numeric.clear_cache(disk=True)
+    build._loaded.clear()
+    assert not any(cache.iterdir())
+    fn3 = numeric.mkq_function(s)
+    y = np.full(s.f, 0.4)
+    np.testing.assert_array_equal(fn3(y, y, 0, numeric.parameter_vector(s, None), [0.0])["M"],
+                                  fn(y, y, 0, numeric.parameter_vector(s, None), [0.0])["M"])
+
+
+def test_evaluate_errors():
+    s = n_link_pendulum_on_cart(2)
+    with pytest.raises(jd.EvaluationError, match="NaN"):
+        s.evaluate([0, np.nan, 0], [0, 0, 0], inputs={"F": 0})
+    with pytest.raises(jd.EvaluationError, match="inputs contain NaN"):
+        s.evaluate([0, 0, 0], [0, 0, 0], inputs={"F": float("nan")})
+    with pytest.raises(jd.EvaluationError, match="3 entries"):
+        s.evaluate([0, 0], [0, 0, 0], inputs={"F": 0})
+    with pytest.raises(jd.EvaluationError, match='unknown parameter'):
+        s.evaluate([0, 0, 0], [0, 0, 0], parameters={"mass": 1}, inputs={"F": 0})
+    fn = numeric.mkq_function(s)
+    with pytest.raises(jd.EvaluationError, match="shape"):
+        fn.batch(np.zeros((4, 3)), np.zeros((4, 2)))
+    z = se.Symbol("zeta")
+    with pytest.raises(jd.EvaluationError, match='"zeta"'):
+        numeric.lambdify(s, {"bad": SymMatrix.column([z * s.y[0]])})

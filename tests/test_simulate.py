@@ -1,0 +1,186 @@
+"""Simulation: closed forms (pendulum period with the complete elliptic integral), energy
+conservation, events, inputs of every kind, stiff methods, and clear errors."""
+
+import math
+
+import numpy as np
+import pytest
+import symengine as se
+from scipy.special import ellipk
+
+import jourdain as jd
+from jourdain.models import n_link_pendulum_on_cart, spatial_chain
+from jourdain.simulate import Event, IntegrationError
+
+
+def pendulum(damping: float = 0.0) -> jd.System:
+    """Point mass m on a massless rod of length l; phi from the downward vertical."""
+    phi, m, l, g = jd.symbols("phi m l g")
+    bob = jd.Body("bob", "world", jd.Revolute("pivot", phi, "z"), mass=m, com=(0, -l, 0),
+                  inertia=jd.point_mass())
+    forces = [jd.Gravity((0, -g, 0))]
+    if damping:
+        forces.append(jd.RotationalSpringDamper("friction", phi, damping=damping))
+    return jd.System([phi], [bob], forces, parameters={"m": 1.5, "l": 0.8, "g": 9.81},
+                     units={"phi": "rad", "m": "kg", "l": "m", "g": "m/s^2"}, name="pendulum")
+
+
+def test_pendulum_period_from_90_degrees_elliptic_integral():
+    """T = 4 sqrt(l/g) K(k²), k = sin(φ0/2) (exact large-amplitude period)."""
+    s = pendulum()
+    phi = s.y[0]
+    l, g = 0.8, 9.81
+    T_exact = 4 * math.sqrt(l / g) * ellipk(math.sin(math.pi / 4) ** 2)
+    res = s.simulate((0, 3.5 * T_exact), [math.pi / 2], [0.0], rtol=1e-11, atol=1e-11,
+                     events=[Event(phi, direction=+1, name="upward zero crossing")])
+    times = res.events["upward zero crossing"]["t"]
+    # released at rest at +90°: φ first crosses zero going down at T/4, upward at 3T/4
+    assert len(times) == 3
+    np.testing.assert_allclose(times[0], 0.75 * T_exact, rtol=1e-9)
+    np.testing.assert_allclose(np.diff(times), T_exact, rtol=1e-9)
+    # energy of a conservative model is conserved; the drift is reported
+    assert res.conservative and res.energy_drift < 1e-9
+
+
+def test_spatial_chain_6_energy_conservation():
+    s = spatial_chain(6)
+    rng = np.random.default_rng(3)
+    y0, yd0 = rng.uniform(-1, 1, s.f), rng.uniform(-1, 1, s.f)
+    res = s.simulate((0, 2.0), y0, yd0, rtol=1e-12, atol=1e-12)
+    assert res.conservative
+    assert res.energy_drift < 1e-8
+    # the work of the applied forces (gravity) integrated with the motion is -ΔV
+    np.testing.assert_allclose(res.W, -(res.potential_energy - res.potential_energy[0]),
+                               atol=1e-8 * np.abs(res.potential_energy).max())
+    # ÿ of the results solves M ÿ + k = q at every output point
+    i = len(res.t) // 2
+    out = s.evaluate(res.y[i], res.yd[i], res.t[i])
+    np.testing.assert_allclose(out["M"] @ res.ydd[i], out["q"] - out["k"], rtol=1e-9, atol=1e-9)
+
+
+def test_damped_pendulum_energy_balance():
+    s = pendulum(damping=0.3)
+    res = s.simulate((0, 5), [1.0], [0.0], rtol=1e-10, atol=1e-10, t_eval=np.linspace(0, 5, 501))
+    assert not res.conservative and res.energy_drift is None
+    # the friction torque -d·φ̇ does the work -∫ d φ̇² dt (trapezoid on the dense output)
+    w_ref = -np.concatenate([[0], np.cumsum(np.diff(res.t) * 0.3 * 0.5 * (
+        res.yd[1:, 0] ** 2 + res.yd[:-1, 0] ** 2))])
+    np.testing.assert_allclose(res.work_nonconservative, w_ref, atol=2e-4)
+    assert res.energy_balance_error < 1e-8
+
+
+def test_dense_output_and_methods_agree():
+    s = n_link_pendulum_on_cart(2)
+    y0 = [0.1, math.pi + 0.2, math.pi - 0.2]
+    te = np.linspace(0, 3, 31)
+    ref = s.simulate((0, 3), y0, [0, 0, 0], inputs={"F": 0.0}, rtol=1e-12, atol=1e-12, t_eval=te)
+    np.testing.assert_array_equal(ref.t, te)
+    for method, tol in (("DOP853", 1e-6), ("RK45", 1e-5), ("Radau", 1e-5), ("BDF", 1e-3)):
+        r = s.simulate((0, 3), y0, [0, 0, 0], inputs={"F": 0.0}, method=method, rtol=1e-8,
+                       atol=1e-8, t_eval=te)
+        np.testing.assert_allclose(r.y, ref.y, atol=tol, err_msg=method)
+
+
+def test_inputs_constant_expression_table_callable_agree():
+    s = n_link_pendulum_on_cart(1)
+    t = se.Symbol("t")
+    y0, yd0 = [0.0, math.pi + 0.1], [0.0, 0.0]
+    kw = {"rtol": 1e-10, "atol": 1e-10, "t_eval": np.linspace(0, 2, 21)}
+    expr = s.simulate((0, 2), y0, yd0, inputs={"F": 2 * se.sin(3 * t)}, **kw)
+    call = s.simulate((0, 2), y0, yd0, inputs={"F": lambda tt: 2 * math.sin(3 * tt)}, **kw)
+    tt = np.linspace(0, 2, 4001)
+    table = s.simulate((0, 2), y0, yd0, inputs={"F": (tt, 2 * np.sin(3 * tt))}, **kw)
+    np.testing.assert_allclose(call.y, expr.y, atol=1e-9)
+    np.testing.assert_allclose(table.y, expr.y, atol=1e-5)
+    np.testing.assert_allclose(expr.u[:, 0], 2 * np.sin(3 * expr.t), atol=1e-15)
+    const = s.simulate((0, 2), y0, yd0, inputs={"F": 0.0}, **kw)
+    assert np.abs(const.y - expr.y).max() > 1e-3  # the force does act
+    # state feedback compiled into the loop: a damper on the cart, F = -c·q0_d
+    c = 4.0
+    fb = s.simulate((0, 2), y0, [1.0, 0.0], inputs={"F": -c * s.yd[0]}, **kw)
+    np.testing.assert_allclose(fb.u[:, 0], -c * fb.yd[:, 0], rtol=1e-12)
+
+
+def test_terminal_event_stops_the_run():
+    s = pendulum()
+    phi = s.y[0]
+    res = s.simulate((0, 10), [1.0], [0.0], rtol=1e-10, atol=1e-10,
+                     events=[Event(phi, direction=-1, terminal=True, name="bottom")])
+    assert res.status == "event" and "bottom" in res.message
+    t_hit = res.events["bottom"]["t"][0]
+    assert res.t[-1] == t_hit and abs(res.y[-1, 0]) < 1e-9
+    # quarter period of a 1 rad pendulum
+    T = 4 * math.sqrt(0.8 / 9.81) * ellipk(math.sin(0.5) ** 2)
+    np.testing.assert_allclose(t_hit, T / 4, rtol=1e-8)
+
+
+def test_singular_mass_matrix_names_time_and_state():
+    """A Cardan joint at gimbal lock (second angle ±90°) has a singular M."""
+    a, b, c = jd.symbols("a b c")
+    body = jd.Body("ball", "world", jd.Spherical("socket", [a, b, c], "xyz"), mass=1.0,
+                   com=(0, 0, -0.5), inertia=jd.box(1.0, 0.1, 0.2, 0.3))
+    s = jd.System([a, b, c], [body], [jd.Gravity((0, 0, -9.81))], name="ball")
+    with pytest.raises(jd.SingularMassMatrix, match=r"t = 0.*b=1\.5708"):
+        s.simulate((0, 1), [0.1, math.pi / 2, 0.2], [0, 0, 0])
+
+
+def test_nan_and_bad_arguments_give_clear_errors():
+    s = n_link_pendulum_on_cart(1)
+    y0 = [0.0, 3.0]
+    with pytest.raises(jd.EvaluationError, match="NaN"):
+        s.simulate((0, 1), [0.0, np.nan], [0, 0], inputs={"F": 0.0})
+    with pytest.raises(jd.EvaluationError, match="not finite"):
+        s.simulate((0, 1), y0, [0, 0], inputs={"F": float("nan")})
+    with pytest.raises(jd.EvaluationError, match="'F': 0.0"):
+        s.simulate((0, 1), y0, [0, 0])
+    with pytest.raises(jd.EvaluationError, match="unknown method"):
+        s.simulate((0, 1), y0, [0, 0], inputs={"F": 0.0}, method="Euler")
+    with pytest.raises(jd.EvaluationError, match="t1 > t0"):
+        s.simulate((1, 0), y0, [0, 0], inputs={"F": 0.0})
+    with pytest.raises(IntegrationError, match=r"NaN.*t = 0\.5"):
+        s.simulate((0, 1), y0, [0, 0], inputs={"F": lambda t: np.nan if t >= 0.5 else 0.0})
+    with pytest.raises(jd.EvaluationError, match="unknown symbol"):
+        s.simulate((0, 1), y0, [0, 0], inputs={"F": 0.0}, events=[Event(se.Symbol("zz"))])
+
+
+def test_exception_in_input_function_keeps_results():
+    s = n_link_pendulum_on_cart(1)
+
+    def force(t: float) -> float:
+        if t > 0.5:
+            raise RuntimeError("sensor failed")
+        return 1.0
+
+    res = s.simulate((0, 2), [0.0, 3.0], [0, 0], inputs={"F": force}, max_step=0.05)
+    assert res.interrupted and "sensor failed" in res.message
+    assert 0.4 < res.t[-1] <= 0.5 and len(res.t) > 9
+    np.testing.assert_array_equal(res.u[:, 0], 1.0)
+
+
+def test_ctrl_c_keeps_results(tmp_path):
+    s = n_link_pendulum_on_cart(1)
+
+    def force(t: float) -> float:
+        if t > 0.7:
+            raise KeyboardInterrupt
+        return 0.0
+
+    out = tmp_path / "run.h5"
+    res = s.simulate((0, 2), [0.0, 3.0], [0, 0], inputs={"F": force}, output=str(out))
+    assert res.interrupted and "Ctrl-C" in res.message
+    assert 0.5 < res.t[-1] <= 0.7
+    back = jd.Results.load(out)
+    assert back.status == "interrupted"
+    np.testing.assert_array_equal(back.y, res.y)
+    with pytest.raises(KeyboardInterrupt):
+        s.simulate((0, 2), [0.0, 3.0], [0, 0], inputs={"F": force}, raise_on_interrupt=True)
+
+
+def test_progress_and_chunked_output():
+    s = n_link_pendulum_on_cart(1)
+    seen = []
+    # tiny steps: several chunks of the C loop, the same numbers as one run
+    res = s.simulate((0, 20), [0.0, 3.0], [0, 0], inputs={"F": 0.0}, max_step=5e-4,
+                     progress=lambda t, t1: seen.append(t))
+    assert res.status == "finished" and res.t[-1] == 20.0
+    assert len(res.t) > 40000 and np.all(np.diff(res.t) > 0)
