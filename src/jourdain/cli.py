@@ -241,27 +241,31 @@ def cmd_eom(args: argparse.Namespace) -> int:
 
 def evaluate_all(model: Any, y: np.ndarray, yd: np.ndarray, t: float,
                  parameters: dict[str, float], inputs: dict[str, float]
-                 ) -> tuple[dict[str, np.ndarray], dict[str, str]]:
-    """Every matrix and vector of the method at one state, and why some are missing."""
+                 ) -> tuple[dict[str, np.ndarray], dict[str, Any], dict[str, str]]:
+    """Every matrix and vector of the method at one state.
+
+    Returns the arrays by the seed's names, extra information (``g_names``,
+    ``g_undetermined``) and, for what is missing, the reason.
+    """
     system = model.system
-    values = dict(system.evaluate(y, yd, t=t, parameters=parameters or None,
-                                  inputs=inputs or None))
+    out = dict(system.evaluate(y, yd, t=t, parameters=parameters or None,
+                               inputs=inputs or None))
+    values = {k: np.asarray(v, float) for k, v in out.items() if isinstance(v, np.ndarray)}
+    extra = {k: v for k, v in out.items() if not isinstance(v, np.ndarray)}
     missing: dict[str, str] = {}
-    reaction_names = ("Q_bar", "N_hat", "k_hat", "q_hat", "g")
-    try:
-        values.update(_reactions_at(system, y, yd, t, parameters, inputs))
-    except NotAvailable as exc:
-        missing.update({k: str(exc) for k in reaction_names})
+    for k in ("Q_bar", "N_hat", "k_hat", "q_hat", "g"):
+        if k not in values:
+            missing[k] = "the reaction forces are not available yet in this version of jourdain"
     lin_names = ("M_tilde", "P", "Q", "h", "D", "G", "K", "N")
     try:
         values.update(_linearization_at(model, y, yd, t, parameters, inputs))
     except NotAvailable as exc:
         missing.update({k: str(exc) for k in lin_names})
-    return values, missing
+    return values, extra, missing
 
 
 def _reactions_at(system: Any, y: Any, yd: Any, t: float, parameters: dict[str, float],
-                  inputs: dict[str, float]) -> dict[str, np.ndarray]:
+                  inputs: dict[str, float]) -> dict[str, Any]:
     _capability(system, "reactions", "the reaction forces (jourdain reactions)")
     from .io import capabilities as integration
 
@@ -276,12 +280,20 @@ def _linearization_at(model: Any, y: Any, yd: Any, t: float, parameters: dict[st
     return integration.linearization_at(model, y, yd, t, parameters, inputs)
 
 
+def _json_array(v: np.ndarray) -> Any:
+    """Nested lists with NaN (an undetermined reaction) as null."""
+    a = np.asarray(v, float)
+    if a.ndim == 0:
+        return float(a) if np.isfinite(a) else None
+    return [_json_array(x) for x in a]
+
+
 def cmd_eval(args: argparse.Namespace) -> int:
     model = _load(args.model)
     system = model.system
     params = _overrides(system, args.set)
     y, yd, t, inputs = _state(model, args.at)
-    values, missing = evaluate_all(model, y, yd, t, params, inputs)
+    values, extra, missing = evaluate_all(model, y, yd, t, params, inputs)
     pv = system.parameter_values
     pv.update(params)
     if args.json:
@@ -289,7 +301,9 @@ def cmd_eval(args: argparse.Namespace) -> int:
             "format": EVAL_FORMAT, "model": system.name, "file": model.path,
             "coordinates": system.coordinate_names, "t": t, "y": y.tolist(), "yd": yd.tolist(),
             "parameters": pv, "inputs": inputs,
-            "values": {k: np.asarray(v, float).tolist() for k, v in values.items()},
+            "values": {k: _json_array(v) for k, v in values.items()},
+            "g_names": list(extra.get("g_names", [])),
+            "g_undetermined": list(extra.get("g_undetermined", [])),
             "not_available": missing,
         }
         print(json.dumps(out, indent=1))
@@ -300,6 +314,8 @@ def cmd_eval(args: argparse.Namespace) -> int:
     print(f"{system.name} at t={t:g}, {state}, {rates}")
     for k, v in values.items():
         print(f"\n{k} =\n{np.asarray(v)}")
+    if extra.get("g_names"):
+        print("\ng components: " + ", ".join(extra["g_names"]))
     if missing:
         print("\nnot available yet: " + ", ".join(missing))
     return EXIT_OK
@@ -313,15 +329,17 @@ def cmd_reactions(args: argparse.Namespace) -> int:
     values = _reactions_at(system, y, yd, t, params, inputs)
     from .io import capabilities as integration
 
-    labels = integration.reaction_labels(system)
+    labels = list(values.get("g_names") or integration.reaction_labels(system))
     g = np.asarray(values["g"], float).reshape(-1)
     if args.json:
-        print(json.dumps({"t": t, "y": y.tolist(), "yd": yd.tolist(),
-                          "labels": labels, "g": g.tolist()}, indent=1))
+        print(json.dumps({"t": t, "y": y.tolist(), "yd": yd.tolist(), "g_names": labels,
+                          "g": _json_array(g),
+                          "g_undetermined": list(values.get("g_undetermined", []))}, indent=1))
         return EXIT_OK
-    print(f"{system.name}: generalized reaction forces g from N̂·g = k̂ − q̂ at t={t:g}")
+    print(f"{system.name}: reaction forces g from N̂·g = k̂ − q̂ at t={t:g}")
+    print("  (components in the child body frame at the joint point)")
     for lab, v in zip(labels, g, strict=False):
-        print(f"  {lab:<24} {v: .6g}")
+        print(f"  {lab:<24} {v: .6g}" if np.isfinite(v) else f"  {lab:<24} undetermined")
     return EXIT_OK
 
 
@@ -349,16 +367,18 @@ def cmd_simulate(args: argparse.Namespace) -> int:
 
     params = _overrides(system, args.set)
     res = integration.simulate(model, params, t_end=args.t_end, samples=args.samples)
-    out = Path(args.out) if args.out else None
-    if out is not None:
+    names = system.coordinate_names
+    if args.out:
+        out = Path(args.out)
         out.parent.mkdir(parents=True, exist_ok=True)
         integration.write_csv(res, system, out)
-        print(f"wrote {out} ({len(res['t'])} samples, t = 0 … {res['t'][-1]:g})")
+        print(f"wrote {out} ({len(res.t)} samples, t = {res.t[0]:g} … {res.t[-1]:g})")
     else:
-        names = system.coordinate_names
-        print(f"{system.name}: simulated t = 0 … {res['t'][-1]:g} ({len(res['t'])} samples)")
-        print("final state: " + ", ".join(f"{n}={v:.6g}" for n, v in
-                                            zip(names, res["y"][-1], strict=True)))
+        print(f"{system.name}: simulated t = {res.t[0]:g} … {res.t[-1]:g} ({len(res.t)} samples)")
+    print("final state: " + ", ".join(f"{n}={v:.6g}" for n, v in
+                                        zip(names, res.y[-1], strict=True)))
+    print("final rates: " + ", ".join(f"{n}_d={v:.6g}" for n, v in
+                                        zip(names, res.yd[-1], strict=True)))
     return EXIT_OK
 
 
@@ -449,7 +469,7 @@ def build_parser() -> argparse.ArgumentParser:
              cmd_simulate)
     p.add_argument("--t-end", type=float, metavar="T", help="end time (default: [simulation])")
     p.add_argument("--samples", type=int, metavar="N", help="output samples")
-    p.add_argument("--out", metavar="FILE.csv", help="write t, y, ẏ as CSV")
+    p.add_argument("--out", metavar="FILE", help="write the results (.csv, or .h5 for HDF5)")
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", help=set_help)
 
     p = _sub(subs, "run", "everything for a model, written as a self-contained HTML report "

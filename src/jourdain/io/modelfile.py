@@ -98,7 +98,7 @@ class SimulationSettings:
 
     t_end: float = 5.0
     samples: int = 501
-    method: str = "RK45"
+    method: str = "DOP853"
     rtol: float = 1e-8
     atol: float = 1e-10
     y0: tuple[float, ...] = ()
@@ -917,7 +917,7 @@ class _Loader:
                 raise self.fail((*p, "samples"), "expected at least 2 samples")
             kw["samples"] = int(n)
         if "method" in spec:
-            methods = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
+            methods = ("DOP853", "RK45", "Radau", "BDF", "LSODA")
             m = self.string(spec["method"], (*p, "method"))
             if m not in methods:
                 raise self.fail((*p, "method"), f'unknown method "{m}"'

@@ -1,0 +1,186 @@
+"""Glue between model files and the later stages: reactions, linearization, simulation.
+
+The command line and the report call these functions with a loaded :class:`ModelFile`; each
+uses only the public API of :class:`~jourdain.System` (``evaluate``, ``linearize``,
+``simulate``) and the analysis functions.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import symengine as se
+
+from ..errors import JourdainError
+from .modelfile import ModelFile, NominalMotion
+
+T = se.Symbol("t")
+
+
+def reactions_at(system: Any, y: Any, yd: Any, t: float, parameters: Mapping[str, float],
+                 inputs: Mapping[str, float]) -> dict[str, Any]:
+    """``Q_bar, N_hat, k_hat, q_hat, g`` (and ``g_names``, ``g_undetermined``) at one state."""
+    out = system.evaluate(y, yd, t=t, parameters=dict(parameters) or None,
+                          inputs=dict(inputs) or None)
+    keys = ("Q_bar", "N_hat", "k_hat", "q_hat", "g", "g_names", "g_undetermined")
+    return {k: out[k] for k in keys if k in out}
+
+
+def reaction_labels(system: Any) -> list[str]:
+    """Names of the components of g: ``<joint>.F_x`` … in the child body frame."""
+    return list(system.reactions().g_names)
+
+
+def state_nominal(system: Any, y: Any, yd: Any, t: float,
+                  inputs: Mapping[str, float]) -> dict[str, se.Basic]:
+    """The nominal motion through the state (y, ẏ) at time t with ÿ_s = 0:
+    ``y_s(τ) = y + ẏ·(τ − t)``."""
+    out: dict[str, se.Basic] = {}
+    for name, a, b in zip(system.coordinate_names, y, yd, strict=True):
+        out[name] = se.Float(float(a)) + se.Float(float(b)) * (T - se.Float(float(t))) \
+            if b != 0 else se.Float(float(a))
+    for name in system.input_names:
+        out[name] = se.Float(float(inputs.get(name, 0.0)))
+    return out
+
+
+def split(P: np.ndarray, Q: np.ndarray) -> dict[str, np.ndarray]:
+    """D, G, K, N: the symmetric and skew-symmetric parts of P and Q (METHOD §6)."""
+    return {"D": 0.5 * (P + P.T), "G": 0.5 * (P - P.T), "K": 0.5 * (Q + Q.T),
+            "N": 0.5 * (Q - Q.T)}
+
+
+def linearization_at(model: ModelFile, y: Any, yd: Any, t: float,
+                     parameters: Mapping[str, float], inputs: Mapping[str, float]
+                     ) -> dict[str, np.ndarray]:
+    """``M_tilde, P, Q, h`` about the state (y, ẏ) at time t (nominal ÿ_s = 0), and ``D, G, K,
+    N``, the symmetric and skew parts of P and Q at that instant."""
+    system = model.system
+    lin = system.linearize(state_nominal(system, y, yd, t, inputs))
+    num = lin.evaluate(t=t, parameters=dict(parameters) or None)
+    out = {k: num[k] for k in ("M_tilde", "P", "Q", "h")}
+    out.update(split(out["P"], out["Q"]))
+    return out
+
+
+def nominal_mapping(system: Any, nominal: NominalMotion) -> dict[str, se.Basic]:
+    return dict(zip(system.coordinate_names, nominal.y, strict=True))
+
+
+def linear_analysis(model: ModelFile, about: str | None,
+                    parameters: Mapping[str, float] | None = None, t: float = 0.0
+                    ) -> dict[str, Any]:
+    """Linearize about a nominal motion of the model file and analyse it.
+
+    Returns a dict: ``nominal`` (the NominalMotion), ``linearization``, ``numbers`` (M_tilde, P,
+    Q, h, B and, time-invariant, D, G, K, N at ``t``), ``time_invariant``, ``conservative``
+    (None when time-variant), ``modes`` and ``stability`` (None when time-variant or not
+    available), ``h_norm``.
+    """
+    system = model.system
+    nominal = model.nominal_motion(about)
+    lin = system.linearize(nominal_mapping(system, nominal))
+    params = dict(parameters or {}) or None
+    num = lin.evaluate(t=t, parameters=params)
+    res: dict[str, Any] = {"nominal": nominal, "linearization": lin, "numbers": num,
+                           "time_invariant": lin.is_time_invariant, "t": t,
+                           "h_norm": float(np.abs(num["h"]).max(initial=0.0))}
+    res["conservative"] = None
+    res["modes"] = res["stability"] = None
+    if lin.is_time_invariant:
+        D, N = num["D"], num["N"]
+        scale = max(1.0, float(np.abs(num["P"]).max()), float(np.abs(num["Q"]).max()),
+                    float(np.abs(num["M_tilde"]).max()))
+        res["conservative"] = bool(np.abs(D).max(initial=0) <= 1e-9 * scale
+                                   and np.abs(N).max(initial=0) <= 1e-9 * scale
+                                   and res["h_norm"] <= 1e-9 * scale)
+        try:
+            from ..analysis.modes import modes, stability
+
+            res["modes"] = modes(lin, t=t, parameters=params)
+            res["stability"] = stability(lin, t=t, parameters=params)
+        except ImportError:
+            pass
+    return res
+
+
+def jsonable(res: Mapping[str, Any]) -> dict[str, Any]:
+    """The result of :func:`linear_analysis` as JSON-ready data."""
+    out: dict[str, Any] = {
+        "nominal": res["nominal"].name,
+        "nominal_y": [str(e) for e in res["nominal"].y],
+        "t": res["t"], "time_invariant": res["time_invariant"],
+        "conservative": res["conservative"], "h_norm": res["h_norm"],
+        "matrices": {k: np.asarray(v, float).tolist() for k, v in res["numbers"].items()},
+    }
+    m = res.get("modes")
+    if m is not None:
+        out["eigenvalues"] = [[float(z.real), float(z.imag)] for z in m.eigenvalues]
+        out["natural_frequencies_hz"] = _finite_list(m.frequencies_hz)
+        out["damping_ratios"] = _finite_list(m.damping_ratios)
+    s = res.get("stability")
+    if s is not None:
+        out["stability"] = {"verdict": s.verdict, "reason": s.reason,
+                            "max_real_part": float(s.max_real_part)}
+    return out
+
+
+def _finite_list(a: np.ndarray) -> list[float | None]:
+    return [float(x) if np.isfinite(x) else None for x in np.asarray(a, float)]
+
+
+def linear_text(res: Mapping[str, Any]) -> str:
+    """A plain-text account of :func:`linear_analysis`."""
+    lin = res["linearization"]
+    num = res["numbers"]
+    nominal = res["nominal"]
+    lines = [f"{lin.system.name}: linearized about \"{nominal.name}\""
+             + (f" ({nominal.description})" if nominal.description else ""),
+             "  y_s(t) = " + ", ".join(f"{n} = {e}" for n, e in
+                                       zip(lin.system.coordinate_names, nominal.y, strict=True)),
+             "  M̃·η̈ + P·η̇ + Q·η = h" + (" + B·Δu" if lin.system.inputs else ""),
+             "  time-invariant" if res["time_invariant"] else
+             f"  time-variant (depends on t: {', '.join(lin.time_dependence)}); numbers at "
+             f"t = {res['t']:g}"]
+    keys = ["M_tilde", "P", "Q", "h"] + (["B"] if lin.system.inputs else [])
+    if res["time_invariant"]:
+        keys += ["D", "G", "K", "N"]
+    for k in keys:
+        lines.append(f"\n{k} =\n{np.asarray(num[k])}")
+    if res["conservative"] is not None:
+        lines.append("\nconservative (D = 0, N = 0, h = 0): " + ("yes" if res["conservative"]
+                                                                else "no"))
+    if res["modes"] is not None:
+        lines.append("\neigenvalues of the state-space system:\n" + str(res["modes"]))
+    if res["stability"] is not None:
+        lines.append(f"\nstability: {res['stability']}")
+    return "\n".join(lines)
+
+
+SIM_METHODS = ("DOP853", "RK45", "Radau", "BDF", "LSODA")
+
+
+def simulate(model: ModelFile, parameters: Mapping[str, float] | None = None,
+             t_end: float | None = None, samples: int | None = None) -> Any:
+    """Integrate the model from its [simulation] initial state; returns a
+    :class:`jourdain.results.Results`."""
+    system = model.system
+    sim = model.simulation
+    t1 = float(t_end if t_end is not None else sim.t_end)
+    if not t1 > 0:
+        raise JourdainError(f"the end time must be positive, got {t1}")
+    n = int(samples if samples is not None else sim.samples)
+    inputs: dict[str, Any] = {name: 0.0 for name in system.input_names}
+    inputs.update(dict(sim.inputs))
+    return system.simulate((0.0, t1), list(sim.y0), list(sim.yd0),
+                           parameters=dict(parameters or {}) or None,
+                           inputs=inputs or None, method=sim.method, rtol=sim.rtol,
+                           atol=sim.atol, t_eval=np.linspace(0.0, t1, n))
+
+
+def write_csv(results: Any, system: Any, path: Path) -> Path:
+    """Save a simulation as CSV (the format of :meth:`jourdain.results.Results.save`)."""
+    return results.save(path)
