@@ -5,23 +5,79 @@ is used more than once becomes a temporary; nodes used once stay inline. One pas
 distinct nodes, so the cost grows linearly with the size of the graph, where a tree-based CSE
 (SymEngine's or SymPy's ``cse``) effectively expands the graph into trees.
 
-Nodes are identified by :func:`expr_key`, a structural fingerprint built from SymEngine's cached
-hashes over three levels (node, children, grandchildren). ``==`` cannot be used: comparing two
-distinct but equal deep nodes walks the whole tree (exponential on a DAG). The hash alone cannot
-be used either: SymEngine's hash of a sum ignores the coefficients of its terms, so ``x + y``,
-``2*x + 2*y`` and ``-x - y`` share one hash; their children (``2*x``, ``-x``) do not.
+Node identity (:class:`NodeIds`): the address of the C++ object a SymEngine wrapper holds. Two
+wrappers of one shared node hold the same address. Neither alternative works: ``==`` is exact but
+walks distinct-but-equal deep nodes as trees (exponential on a DAG), and SymEngine's hash of a sum
+ignores the coefficients of its terms (``x + y``, ``2*x + 2*y`` and ``-x - y`` share one hash), so
+hash keys would merge different expressions. Where the address cannot be read (another Python
+implementation or SymEngine build, detected at import), identity falls back to the hash confirmed
+by ``==``: exact, only slower.
+
+An address identifies a node only while the node is alive; every structure here keeps the wrappers
+it has keyed, and reuses the argument tuples it read (``.args`` of a sum builds fresh ``c*term``
+nodes on each call, with new addresses).
 """
 
 from __future__ import annotations
 
+import ctypes
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import symengine as se
 
-from .errors import JourdainError
-
 Expr = se.Basic
+
+# A SymEngine wrapper (a Cython object) holds one reference-counted pointer to its C++ node right
+# after the Python object header.
+_POINTER_OFFSET = object.__basicsize__
+_read_pointer = ctypes.c_void_p.from_address
+
+
+def _pointer(e: Expr) -> int:
+    return _read_pointer(id(e) + _POINTER_OFFSET).value  # type: ignore[return-value]
+
+
+def _pointers_work() -> bool:
+    """Check the wrapper layout on a probe: shared children give equal addresses, others not."""
+    try:
+        if se.Basic.__basicsize__ != _POINTER_OFFSET + ctypes.sizeof(ctypes.c_void_p):
+            return False
+        a, b = se.Symbol("_probe_a"), se.Symbol("_probe_b")
+        e = se.sin(a + b) * (a - b)
+        x1, y1 = e.args
+        x2, y2 = e.args
+        twin = se.sin(a + b) * (a - b)
+        return (_pointer(x1) == _pointer(x2) and _pointer(y1) == _pointer(y2)
+                and _pointer(x1) != _pointer(y1) and _pointer(e) != _pointer(twin)
+                and _pointer(e) != 0)
+    except Exception:  # noqa: BLE001 - any failure means: do not use addresses
+        return False
+
+
+POINTERS = _pointers_work()
+
+
+class NodeIds:
+    """Integer identities of SymEngine nodes (see the module docstring). Keeps every node it has
+    identified alive, so that an address cannot be reused while this object exists."""
+
+    def __init__(self) -> None:
+        self._alive: list[Expr] = []
+        self._by_hash: dict[int, list[tuple[Expr, int]]] = {}
+
+    def __call__(self, e: Expr) -> int:
+        self._alive.append(e)
+        if POINTERS:
+            return _pointer(e)
+        h = hash(e)
+        bucket = self._by_hash.setdefault(h, [])
+        for known, key in bucket:
+            if known == e:
+                return key
+        key = (h << 8) + len(bucket)
+        bucket.append((e, key))
+        return key
 
 
 @dataclass(frozen=True)
@@ -41,69 +97,51 @@ def _is_atom(e: Expr) -> bool:
     return not e.args
 
 
-def _key2(e: Expr) -> tuple:
-    args = e.args
-    if not args:
-        return (type(e).__name__, hash(e), str(e))
-    return (type(e).__name__, hash(e), tuple(sorted(hash(a) for a in args)))
-
-
-def expr_key(e: Expr) -> tuple:
-    """Dictionary key identifying an expression by its structure (see the module docstring)."""
-    args = e.args
-    if not args:
-        return (type(e).__name__, hash(e), str(e))
-    return (type(e).__name__, hash(e), tuple(sorted(_key2(a) for a in args)))
-
-
 class Graph:
-    """The distinct non-atomic nodes of some expressions, children before parents."""
+    """The distinct non-atomic nodes of some expressions, children before parents.
+
+    ``order``: node ids in post-order; ``node[i]``: the node; ``args[i]``: its arguments as
+    read once, with ``arg_ids[i]`` their ids (None for atoms); ``uses[i]``: number of parents
+    (and roots) that refer to it; ``root_ids``: the ids of the given expressions (None for atoms).
+    """
 
     def __init__(self, exprs: Sequence[Expr]) -> None:
-        self.uses: dict[tuple, int] = {}
-        self.node: dict[tuple, Expr] = {}
-        self.children: dict[tuple, tuple[tuple, ...]] = {}
-        self.order: list[tuple] = []  # post-order of keys
+        self.ids = NodeIds()
+        self.uses: dict[int, int] = {}
+        self.node: dict[int, Expr] = {}
+        self.args: dict[int, tuple[Expr, ...]] = {}
+        self.arg_ids: dict[int, tuple[int | None, ...]] = {}
+        self.order: list[int] = []
+        roots: list[int | None] = []
         for root in exprs:
-            if not _is_atom(root):
-                self._visit(root)
-
-    def _visit(self, root: Expr) -> None:
-        h = expr_key(root)
-        self.uses[h] = self.uses.get(h, 0) + 1
-        if h in self.node:
-            self._confirm(h, root)
-            return
-        stack: list[tuple[Expr, tuple, bool]] = [(root, h, False)]
-        while stack:
-            e, h, done = stack.pop()
-            if done:
-                self.order.append(h)
+            if _is_atom(root):
+                roots.append(None)
                 continue
-            if h in self.node:
-                self._confirm(h, e)
+            r = self.ids(root)
+            roots.append(r)
+            self.uses[r] = self.uses.get(r, 0) + 1
+            if r in self.node:
                 continue
-            args = e.args
-            hs = tuple(expr_key(a) for a in args)
-            self.node[h] = e
-            self.children[h] = hs
-            stack.append((e, h, True))
-            for a, ha in zip(args, hs, strict=True):
-                if _is_atom(a):
+            stack: list[tuple[Expr, int, bool]] = [(root, r, False)]
+            while stack:
+                e, i, done = stack.pop()
+                if done:
+                    self.order.append(i)
                     continue
-                self.uses[ha] = self.uses.get(ha, 0) + 1
-                if ha not in self.node:
-                    stack.append((a, ha, False))
-
-    def _confirm(self, h: tuple, e: Expr) -> None:
-        known = self.node[h]
-        if known is e:
-            return
-        # equal Add/Mul nodes may list their terms in different orders (hash-map storage)
-        if type(known) is not type(e) or sorted(expr_key(a) for a in e.args) != sorted(
-            self.children[h]
-        ):
-            raise JourdainError("structural key collision between two different expressions")
+                if i in self.node:
+                    continue
+                # in a DAG a node already expanded is finished: it cannot be its own ancestor
+                args = e.args
+                ids = tuple(None if _is_atom(a) else self.ids(a) for a in args)
+                self.node[i], self.args[i], self.arg_ids[i] = e, args, ids
+                stack.append((e, i, True))
+                for a, ia in zip(args, ids, strict=True):
+                    if ia is None:
+                        continue
+                    self.uses[ia] = self.uses.get(ia, 0) + 1
+                    if ia not in self.node:
+                        stack.append((a, ia, False))
+        self.root_ids: tuple[int | None, ...] = tuple(roots)
 
 
 def _worth_a_temporary(e: Expr) -> bool:
@@ -117,29 +155,22 @@ def cse(exprs: Sequence[Expr], prefix: str = "x") -> CSE:
     """Graph CSE: every non-atomic node used more than once becomes a temporary."""
     exprs = list(exprs)
     g = Graph(exprs)
-    roots = {expr_key(e) for e in exprs}
-    rebuilt: dict[tuple, Expr] = {}
+    roots = {r for r in g.root_ids if r is not None}
+    rebuilt: dict[int, Expr] = {}
     temps: list[tuple[se.Symbol, Expr]] = []
-    for h in g.order:
-        node = g.node[h]
-        args = node.args
-        changed = False
-        new_args = []
-        for a, ha in zip(args, g.children[h], strict=True):
-            r = rebuilt.get(ha)
-            if r is None or _is_atom(a):
-                new_args.append(a)
-            else:
-                new_args.append(r)
-                changed = True
+    for i in g.order:
+        node = g.node[i]
+        new_args = [a if ia is None else rebuilt[ia]
+                    for a, ia in zip(g.args[i], g.arg_ids[i], strict=True)]
+        changed = any(n is not a for n, a in zip(new_args, g.args[i], strict=True))
         new = node.func(*new_args) if changed else node
-        if g.uses[h] > 1 and h not in roots and _worth_a_temporary(node):
+        if g.uses[i] > 1 and i not in roots and _worth_a_temporary(node):
             sym = se.Symbol(f"{prefix}{len(temps)}")
             temps.append((sym, new))
-            rebuilt[h] = sym
+            rebuilt[i] = sym
         else:
-            rebuilt[h] = new
-    outputs = tuple(e if _is_atom(e) else rebuilt[expr_key(e)] for e in exprs)
+            rebuilt[i] = new
+    outputs = tuple(e if r is None else rebuilt[r] for e, r in zip(exprs, g.root_ids, strict=True))
     return CSE(tuple(temps), outputs)
 
 
@@ -167,4 +198,4 @@ def tree_ops(e: Expr) -> int:
 def graph_ops(exprs: Sequence[Expr]) -> int:
     """Operations of some expressions counting each distinct node of their graph once."""
     g = Graph(list(exprs))
-    return sum(node_ops(g.node[h]) for h in g.order)
+    return sum(node_ops(g.node[i]) for i in g.order)

@@ -14,7 +14,6 @@ from dataclasses import dataclass
 
 import symengine as se
 
-from .cse import expr_key
 from .kinematics import _add, _cross, _dot, _mv, _scale
 from .newton_euler import NewtonEuler
 from .symbolic import SymMatrix
@@ -54,8 +53,9 @@ def projection(ne: NewtonEuler) -> EquationsOfMotion:
     system = kin.system
     f = len(kin.y)
     # translational part: group bodies by identical Jacobian columns
-    # groups are keyed by the columns' structural keys (jourdain.cse.expr_key): == on distinct
-    # but equal deep expressions would walk whole trees; the stored column represents the group
+    # Bodies down a chain inherit the very same column tuples from their parents, so groups are
+    # keyed by object identity: exact and O(1), where == on deep expressions may walk whole trees
+    # and SymEngine's hash confuses x + y with -x - y. The stored column keeps the id valid.
     mass_of_pair: dict[tuple[int, int], dict[tuple, tuple[tuple, tuple, list]]] = {}
     force_of_col: list[dict[tuple, tuple[tuple, list]]] = [dict() for _ in range(f)]
     gyro_of_col: list[dict[tuple, tuple[tuple, list]]] = [dict() for _ in range(f)]
@@ -118,8 +118,8 @@ def projection(ne: NewtonEuler) -> EquationsOfMotion:
     return EquationsOfMotion(ne, SymMatrix.from_rows(M), SymMatrix.column(k), SymMatrix.column(q))
 
 
-def _h(v: tuple) -> tuple:
-    return tuple(expr_key(x) for x in v)
+def _h(v: tuple) -> int:
+    return id(v)
 
 
 def _sum(vecs: list) -> tuple:

@@ -284,7 +284,17 @@ def _derived_directions(joint: Joint, coordinates: Sequence[se.Symbol],
         if all(np.linalg.matrix_rank(trial[:, :, s], tol=1e-9) == len(chosen) + 1
                for s in range(samples)):
             chosen.append(c)
-    if len(chosen) < need:
+    extra: list[tuple[str, Wrench]] = []
+    if len(chosen) < need and J.shape[0] and np.ptp(J, axis=2).max() < 1e-12:
+        # constant relative twist (a screw, a slanted slider): complete the basis with the
+        # orthonormal complement of the twist and the directions chosen so far
+        A = np.concatenate([J[:, :, 0], Wc[chosen, :, 0]]) if chosen else J[:, :, 0]
+        _, sv, Vt = np.linalg.svd(A)
+        rank_A = int((sv > 1e-9 * max(1.0, sv[0])).sum())
+        for k, v in enumerate(Vt[rank_A:rank_A + need - len(chosen)], start=1):
+            v = np.where(np.abs(v) < 1e-15, 0.0, v)
+            extra.append((f"W_{k}", tuple(se.Float(float(x)) if x else ZERO for x in v)))  # type: ignore[misc]
+    if len(chosen) + len(extra) < need:
         raise ModelError(
             f'joint "{joint.name}": cannot derive its {need} constrained directions from its '
             f"steps (found {[candidates[c][0] for c in chosen]}); give them with "
@@ -298,7 +308,7 @@ def _derived_directions(joint: Joint, coordinates: Sequence[se.Symbol],
             if np.ptp(norm) < 1e-12 * norm.max():  # constant length: normalize symbolically
                 w = tuple(x / se.Float(float(norm[0])) if float(norm[0]) != 1.0 else x for x in w)
         out.append((name, w))
-    return out  # type: ignore[return-value]
+    return out + extra  # type: ignore[return-value]
 
 
 # --- numeric evaluation of expression graphs ----------------------------------------------------
@@ -312,8 +322,8 @@ def graph_values(exprs: Sequence[se.Basic], values: Mapping[se.Basic, Any]) -> l
     distinct node of the shared expression graph evaluated once."""
     from . import cse as _cse
 
-    key = getattr(_cse, "expr_key", hash)  # the Graph's node identity
-    g = _cse.Graph(list(exprs))
+    exprs = list(exprs)
+    g = _cse.Graph(exprs)
     given = {k: np.asarray(v, dtype=float) for k, v in values.items()}
 
     def atom(a: se.Basic) -> Any:
@@ -326,8 +336,8 @@ def graph_values(exprs: Sequence[se.Basic], values: Mapping[se.Basic, Any]) -> l
     val: dict[Any, Any] = {}
     for h in g.order:
         node = g.node[h]
-        args = [val[ka] if a.args else atom(a)
-                for a, ka in zip(node.args, g.children[h], strict=True)]
+        args = [atom(a) if ka is None else val[ka]
+                for a, ka in zip(g.args[h], g.arg_ids[h], strict=True)]
         name = type(node).__name__
         if name == "Add":
             r = args[0]
@@ -346,7 +356,7 @@ def graph_values(exprs: Sequence[se.Basic], values: Mapping[se.Basic, Any]) -> l
         else:
             r = np.vectorize(lambda *xs, f=node.func: float(f(*(se.Float(x) for x in xs))))(*args)
         val[h] = r
-    return [val[key(e)] if e.args else atom(e) for e in exprs]
+    return [atom(e) if r is None else val[r] for e, r in zip(exprs, g.root_ids, strict=True)]
 
 
 def _sample_values(exprs: list[se.Basic], coordinates: Sequence[se.Symbol],

@@ -70,8 +70,8 @@ class SymMatrix:
         """The matrix as a :class:`sympy.Matrix` (shared sub-expressions converted once)."""
         import sympy
 
-        memo: dict = {}
-        return sympy.Matrix([[to_sympy(e, memo) for e in r] for r in self.rows])
+        n, m = self.shape
+        return sympy.Matrix(n, m, to_sympy_many(self.entries()))
 
     def subs(self, mapping: dict) -> SymMatrix:
         return SymMatrix(tuple(tuple(e.subs(mapping) for e in r) for r in self.rows))
@@ -109,36 +109,37 @@ _SYMPY_FUNCS = {
 
 
 def to_sympy(expr: Expr, memo: dict | None = None) -> Any:
-    """Convert a SymEngine expression to SymPy, visiting shared sub-expressions once."""
+    """Convert a SymEngine expression to SymPy, visiting shared sub-expressions once.
+
+    ``memo`` is accepted for compatibility and not used: node identities are only valid within
+    one graph, so convert many expressions together with :func:`to_sympy_many`.
+    """
+    del memo
+    return to_sympy_many([expr])[0]
+
+
+def to_sympy_many(exprs: Sequence[Expr]) -> list[Any]:
+    """Convert SymEngine expressions to SymPy; nodes shared between them are converted once.
+
+    One :class:`jourdain.cse.Graph` over all of them: node ids are only meaningful within one
+    graph, which keeps every node it has seen alive.
+    """
     import sympy
 
-    # keyed structurally (jourdain.cse.expr_key): == on distinct but equal deep nodes walks the
-    # whole tree, and SymEngine's hash alone confuses x + y with -x - y
-    from .cse import expr_key
+    from .cse import Graph
 
-    if memo is None:
-        memo = {}
-    stack = [expr]
-    while stack:
-        node = stack[-1]
-        h = expr_key(node)
-        if h in memo:
-            stack.pop()
-            continue
-        args = node.args
+    g = Graph(list(exprs))
+    memo: dict[int, Any] = {}
+    for i in g.order:
+        node = g.node[i]
+        args = [a._sympy_() if ia is None else memo[ia]
+                for a, ia in zip(g.args[i], g.arg_ids[i], strict=True)]
         name = type(node).__name__
-        if not args or name not in _SYMPY_FUNCS:
-            memo[h] = node._sympy_() if hasattr(node, "_sympy_") else sympy.sympify(str(node))
-            stack.pop()
-            continue
-        pending = [a for a in args if expr_key(a) not in memo]
-        if pending:
-            stack.extend(pending)
-            continue
-        f = getattr(sympy, _SYMPY_FUNCS[name])
-        memo[h] = f(*(memo[expr_key(a)] for a in args))
-        stack.pop()
-    return memo[expr_key(expr)]
+        if name in _SYMPY_FUNCS:
+            memo[i] = getattr(sympy, _SYMPY_FUNCS[name])(*args)
+        else:
+            memo[i] = node._sympy_()
+    return [e._sympy_() if r is None else memo[r] for e, r in zip(exprs, g.root_ids, strict=True)]
 
 
 def count_ops(exprs: Sequence[Expr], cse: bool = True) -> int:
