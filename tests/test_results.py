@@ -1,0 +1,115 @@
+"""Results: energies and reaction forces along a motion against closed forms, files that other
+tools read (HDF5 via h5py, CSV), plots with labelled axes."""
+
+import csv
+import math
+
+import matplotlib
+import numpy as np
+import pytest
+
+import jourdain as jd
+from jourdain.models import double_pendulum, n_link_pendulum_on_cart
+from tests.test_simulate import pendulum
+
+matplotlib.use("Agg")
+
+
+@pytest.fixture(scope="module")
+def run():
+    s = pendulum()
+    return s, s.simulate((0, 2), [1.2], [0.5], rtol=1e-10, atol=1e-10,
+                         t_eval=np.linspace(0, 2, 41))
+
+
+def test_energies_and_positions_closed_form(run):
+    s, res = run
+    m, l, g = 1.5, 0.8, 9.81
+    phi, w = res.y[:, 0], res.yd[:, 0]
+    np.testing.assert_allclose(res.kinetic_energy, 0.5 * m * l**2 * w**2, rtol=1e-12)
+    np.testing.assert_allclose(res.potential_energy, -m * g * l * np.cos(phi), rtol=1e-12)
+    r = res.positions("bob", "com")
+    np.testing.assert_allclose(r, np.c_[l * np.sin(phi), -l * np.cos(phi), 0 * phi], atol=1e-14)
+    np.testing.assert_allclose(res.positions("bob"), 0.0, atol=1e-15)  # the pivot
+
+
+def test_reaction_force_closed_form(run):
+    """The pivot force on the bob is m(a − g) with a = l(φ̈ cos φ − φ̇² sin φ, φ̈ sin φ + φ̇² cos φ)."""
+    _, res = run
+    m, l, gr = 1.5, 0.8, 9.81
+    phi, w, a = res.y[:, 0], res.yd[:, 0], res.ydd[:, 0]
+    acc = l * np.c_[a * np.cos(phi) - w**2 * np.sin(phi), a * np.sin(phi) + w**2 * np.cos(phi)]
+    F = m * (acc - np.array([0.0, -gr]))
+    names = res.g_names
+    Fx, Fy = res.g[:, names.index("pivot.F_x")], res.g[:, names.index("pivot.F_y")]
+    # components in the joint frame; the magnitude does not depend on the frame
+    np.testing.assert_allclose(np.hypot(Fx, Fy), np.hypot(F[:, 0], F[:, 1]), rtol=1e-9)
+
+
+def test_kinetic_energy_matches_mass_matrix():
+    """T from body velocities equals ½ ẏᵀ M ẏ (M from the projection) for a scleronomic model."""
+    s = double_pendulum()
+    res = s.simulate((0, 1), [0.5, -0.4], [1.0, 2.0], t_eval=np.linspace(0, 1, 5))
+    for i in range(5):
+        M = s.evaluate(res.y[i], res.yd[i])["M"]
+        assert res.kinetic_energy[i] == pytest.approx(0.5 * res.yd[i] @ M @ res.yd[i], rel=1e-12)
+
+
+def test_hdf5_round_trip_readable_by_h5py(run, tmp_path):
+    import h5py
+
+    _, res = run
+    path = res.save(tmp_path / "pendulum.h5")
+    with h5py.File(path) as h:  # what another tool sees
+        assert h.attrs["format"] == "jourdain-results"
+        np.testing.assert_array_equal(h["t"][()], res.t)
+        assert h["y"].attrs["columns"] == '["phi"]'
+        np.testing.assert_array_equal(h["T"][()], res.kinetic_energy)
+    back = jd.Results.load(path)
+    for k in ("t", "y", "yd", "ydd", "u", "W"):
+        np.testing.assert_array_equal(getattr(back, k), getattr(res, k))
+    np.testing.assert_array_equal(back.kinetic_energy, res.kinetic_energy)
+    assert back.parameters == res.parameters and back.units["phi"] == "rad"
+    with pytest.raises(jd.JourdainError, match="needs the system"):
+        _ = back.g
+    with_system = jd.Results.load(path, system=pendulum())
+    np.testing.assert_allclose(with_system.g, res.g)
+
+
+def test_csv_round_trip_readable_by_csv_module(tmp_path):
+    s = n_link_pendulum_on_cart(1)
+    res = s.simulate((0, 1), [0.0, 3.0], [0, 0], inputs={"F": 1.0}, t_eval=[0, 0.5, 1])
+    path = res.save(tmp_path / "cart.csv")
+    rows = [r for r in csv.reader(line for line in path.open() if not line.startswith("#"))]
+    assert rows[0][:6] == ["t", "q0", "q1", "q0_d", "q1_d", "q0_dd"]
+    assert "F" in rows[0] and "T" in rows[0]
+    assert float(rows[2][0]) == 0.5 and float(rows[2][2]) == res.y[1, 1]
+    back = jd.Results.load(path)
+    np.testing.assert_array_equal(back.y, res.y)
+    np.testing.assert_array_equal(back.u, res.u)
+    with pytest.raises(jd.EvaluationError, match="unknown results file type"):
+        res.save(tmp_path / "cart.xlsx")
+
+
+def test_plots_have_labelled_axes(run):
+    _, res = run
+    ax = res.plot()
+    assert ax.get_xlabel() == "t [s]" and ax.get_ylabel() == "coordinates [rad]"
+    assert ax.get_legend().get_texts()[0].get_text() == "phi [rad]"
+    ax = res.plot("yd")
+    assert ax.get_ylabel() == "rates [rad/s]"
+    ax = res.plot("energy")
+    assert ax.get_ylabel() == "energy [J]"
+    ax = res.plot_phase("phi")
+    assert ax.get_xlabel() == "phi [rad]" and ax.get_ylabel() == "phi_d [rad/s]"
+    with pytest.raises(jd.EvaluationError, match="unknown coordinate"):
+        res.plot_phase("theta")
+
+
+def test_conservative_run_reports_drift(run):
+    _, res = run
+    E = res.total_energy
+    assert res.energy_drift == pytest.approx(np.abs(E - E[0]).max() / max(abs(E[0]),
+                                             res.kinetic_energy.max()))
+    assert res.energy_drift < 1e-9
+    assert math.isfinite(res.wall_time) and res.nfev > 0
