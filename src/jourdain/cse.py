@@ -5,7 +5,7 @@ is used more than once becomes a temporary; nodes used once stay inline. One pas
 distinct nodes, so the cost grows linearly with the size of the graph, where a tree-based CSE
 (SymEngine's or SymPy's ``cse``) effectively expands the graph into trees.
 
-Node identity (:class:`NodeIds`): the address of the C++ object a SymEngine wrapper holds. Two
+Object identity (:class:`NodeIds`): the address of the C++ object a SymEngine wrapper holds. Two
 wrappers of one shared node hold the same address. Neither alternative works: ``==`` is exact but
 walks distinct-but-equal deep nodes as trees (exponential on a DAG), and SymEngine's hash of a sum
 ignores the coefficients of its terms (``x + y``, ``2*x + 2*y`` and ``-x - y`` share one hash), so
@@ -100,9 +100,15 @@ def _is_atom(e: Expr) -> bool:
 class Graph:
     """The distinct non-atomic nodes of some expressions, children before parents.
 
+    Nodes are *hash-consed*: a node's id is given by its type and the ids of its arguments
+    (sorted for the commutative + and *; atoms by type and text), so equal sub-expressions built
+    separately get one id, without ever comparing expressions with ``==``. Objects are first
+    recognised by their address (:class:`NodeIds`) so each shared object is read once.
+
     ``order``: node ids in post-order; ``node[i]``: the node; ``args[i]``: its arguments as
-    read once, with ``arg_ids[i]`` their ids (None for atoms); ``uses[i]``: number of parents
-    (and roots) that refer to it; ``root_ids``: the ids of the given expressions (None for atoms).
+    read once, with ``arg_ids[i]`` their ids (None for atoms); ``uses[i]``: number of references
+    from distinct parents and from the roots; ``root_ids``: the ids of the given expressions (None
+    for atoms).
     """
 
     def __init__(self, exprs: Sequence[Expr]) -> None:
@@ -112,35 +118,51 @@ class Graph:
         self.args: dict[int, tuple[Expr, ...]] = {}
         self.arg_ids: dict[int, tuple[int | None, ...]] = {}
         self.order: list[int] = []
+        canon: dict[int, int] = {}  # object id -> node id
+        by_structure: dict[tuple, int] = {}
+        pending: dict[int, tuple[tuple[Expr, ...], tuple[int | None, ...]]] = {}
         roots: list[int | None] = []
         for root in exprs:
             if _is_atom(root):
                 roots.append(None)
                 continue
             r = self.ids(root)
-            roots.append(r)
-            self.uses[r] = self.uses.get(r, 0) + 1
-            if r in self.node:
-                continue
             stack: list[tuple[Expr, int, bool]] = [(root, r, False)]
             while stack:
-                e, i, done = stack.pop()
+                e, p, done = stack.pop()
                 if done:
-                    self.order.append(i)
+                    args, pids = pending.pop(p)
+                    cids = tuple(None if q is None else canon[q] for q in pids)
+                    parts = [(1, type(a).__name__, str(a)) if c is None else (0, c, "")
+                             for a, c in zip(args, cids, strict=True)]
+                    name = type(e).__name__
+                    if name in ("Add", "Mul"):
+                        parts.sort()
+                    key = (name, tuple(parts))
+                    c = by_structure.get(key)
+                    if c is None:
+                        c = len(self.order)
+                        by_structure[key] = c
+                        self.node[c], self.args[c], self.arg_ids[c] = e, args, cids
+                        self.order.append(c)
+                        for ci in cids:
+                            if ci is not None:
+                                self.uses[ci] = self.uses.get(ci, 0) + 1
+                    canon[p] = c
                     continue
-                if i in self.node:
+                if p in canon or p in pending:
+                    # in a DAG an object being expanded cannot be reached again below itself
                     continue
-                # in a DAG a node already expanded is finished: it cannot be its own ancestor
                 args = e.args
-                ids = tuple(None if _is_atom(a) else self.ids(a) for a in args)
-                self.node[i], self.args[i], self.arg_ids[i] = e, args, ids
-                stack.append((e, i, True))
-                for a, ia in zip(args, ids, strict=True):
-                    if ia is None:
-                        continue
-                    self.uses[ia] = self.uses.get(ia, 0) + 1
-                    if ia not in self.node:
-                        stack.append((a, ia, False))
+                pids = tuple(None if _is_atom(a) else self.ids(a) for a in args)
+                pending[p] = (args, pids)
+                stack.append((e, p, True))
+                for a, q in zip(args, pids, strict=True):
+                    if q is not None and q not in canon and q not in pending:
+                        stack.append((a, q, False))
+            c = canon[r]
+            self.uses[c] = self.uses.get(c, 0) + 1
+            roots.append(c)
         self.root_ids: tuple[int | None, ...] = tuple(roots)
 
 
