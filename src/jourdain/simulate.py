@@ -382,18 +382,18 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
     n_out = np.zeros(1, dtype=np.int_)
     n_ev = np.zeros(1, dtype=np.int_)
     fail = np.zeros(n + 1)
-    ev_cap = 10000
-    ev_t = np.zeros(ev_cap)
-    ev_x = np.zeros((ev_cap, n))
-    ev_i = np.zeros(ev_cap, dtype=np.int_)
+    ev_cap = 100000 if nev else 1  # crossings recorded (the message says if more were dropped)
+    ev_t = np.empty(ev_cap)
+    ev_x = np.empty((ev_cap, n))
+    ev_i = np.empty(ev_cap, dtype=np.int_)
     if te is not None:
         cap = te.size
-        out_t = np.zeros(cap)
-        out_x = np.zeros((cap, n))
+        out_t = np.empty(cap)
+        out_x = np.empty((cap, n))
         chunks_t: list[np.ndarray] = []
         chunks_x: list[np.ndarray] = []
     else:
-        cap = 4096
+        cap = 1024
         chunks_t = [np.array([t0])]
         chunks_x = [x0[None, :].copy()]
     writer = (_Writer(output, system)
@@ -406,8 +406,8 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
     try:
         while True:
             if te is None:
-                out_t = np.zeros(cap)
-                out_x = np.zeros((cap, n))
+                out_t = np.empty(cap)
+                out_x = np.empty((cap, n))
                 n_out[0] = 0
             code = lib.jd_integrate(
                 ctypes.byref(setup.problem), t1, st.ctypes.data, x.ctypes.data, k0.ctypes.data,
@@ -457,6 +457,8 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
     else:
         t_out, x_out = np.concatenate(chunks_t), np.concatenate(chunks_x)
     m = int(n_ev[0])
+    if nev and m == ev_cap:
+        message += f"; only the first {ev_cap} event crossings were recorded"
     return {"t": t_out, "x": x_out, "status": status, "message": message,
             "exception": exception, "nfev": int(cnt[0]), "nstep": int(cnt[1]),
             "naccept": int(cnt[2]), "nreject": int(cnt[3]),

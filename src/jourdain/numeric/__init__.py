@@ -23,8 +23,8 @@ import symengine as se
 
 from ..errors import EvaluationError
 from ..symbolic import SymMatrix
-from .toolchain import CompilerError, build, cache_dir, cached_library, content_key
 from .ccode import HEADER, argument_names, function_source
+from .toolchain import CompilerError, build, cache_dir, cached_library, content_key
 
 if TYPE_CHECKING:
     from ..model.system import System

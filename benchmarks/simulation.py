@@ -1,0 +1,336 @@
+"""Simulation benchmark, in one run, side by side with the peers:
+
+1. ``n_link_pendulum_on_cart(n)``, n = 2, 4, 8, 10 s of motion released from the hanging position
+   (link angles π+0.3 … π−0.3, at rest), rtol = atol = 1e-8: jourdain (``System.simulate``,
+   DOP853, step loop in C) against PyDy (``generate_ode_function``, Cython backend,
+   ``linear_sys_solver="sympy"`` and ``"numpy"``, integrated with SciPy's ``odeint``).
+   Reported: derivation, code generation and integration times, right-hand-side evaluations,
+   and the distance of each final state from a reference computed by jourdain at 1e-12 (itself
+   checked against ``odeint`` at 1e-12 on PyDy's function).
+2. Batched ``M`` and ``k`` (and ``q``) evaluation per state against Pinocchio's ``crba`` +
+   ``nonLinearEffects`` per call, for ``spatial_chain(6)`` and a 7-joint arm, with a check that
+   the numbers agree (``M`` = crba, ``k − q`` = nonLinearEffects).
+
+Usage::
+
+    python benchmarks/simulation.py             # everything
+    python benchmarks/simulation.py --n 2 4     # some sizes
+    python benchmarks/simulation.py --quick     # n = 2, PyDy's lambdify backend (a smoke test)
+    python benchmarks/simulation.py --json out.json
+
+PyDy's symbolic linear solver can take long for large n; it is
+skipped above ``--sympy-max-n`` (default 10) and the skip is printed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
+
+import jourdain as jd  # noqa: E402
+from jourdain import numeric  # noqa: E402
+from jourdain.models import n_link_pendulum_on_cart, spatial_chain, spatial_chain_data  # noqa: E402
+from jourdain.numeric import toolchain  # noqa: E402
+from jourdain.simulate import integrator_library  # noqa: E402
+
+TOL = 1e-8
+T_END = 10.0
+
+
+def best_of(fn, repeat: int = 7, min_time: float = 0.2) -> float:
+    """Best wall time of ``fn()`` over ``repeat`` rounds (each round loops to ``min_time``)."""
+    best = math.inf
+    for _ in range(repeat):
+        k, t0 = 0, time.perf_counter()
+        while True:
+            fn()
+            k += 1
+            el = time.perf_counter() - t0
+            if el >= min_time / repeat:
+                break
+        best = min(best, el / k)
+    return best
+
+
+def initial_state(n: int) -> tuple[np.ndarray, np.ndarray]:
+    y0 = np.concatenate([[0.0], np.linspace(math.pi + 0.3, math.pi - 0.3, n)])
+    return y0, np.zeros(n + 1)
+
+
+# --- jourdain ------------------------------------------------------------------------------------
+def bench_jourdain(n: int) -> dict:
+    t0 = time.perf_counter()
+    s = n_link_pendulum_on_cart(n)
+    eom = s.equations_of_motion()
+    t_derive = time.perf_counter() - t0
+    # code generation with an empty cache: CSE, C source, cc, load
+    with tempfile.TemporaryDirectory() as d:
+        old = os.environ.get("JOURDAIN_CACHE")
+        os.environ["JOURDAIN_CACHE"] = d
+        toolchain._loaded.clear()
+        t0 = time.perf_counter()
+        numeric.lambdify(s, {"M": eom.M, "k": eom.k, "q": eom.q})
+        t_codegen = time.perf_counter() - t0
+        if old is None:
+            del os.environ["JOURDAIN_CACHE"]
+        else:
+            os.environ["JOURDAIN_CACHE"] = old
+        toolchain._loaded.clear()
+    numeric.clear_cache()
+    t0 = time.perf_counter()
+    numeric.mkq_function(s)  # what a later session pays: the library comes from the cache
+    t_cached = time.perf_counter() - t0
+    y0, yd0 = initial_state(n)
+    kw = {"inputs": {"F": 0.0}, "rtol": TOL, "atol": TOL}
+    res = s.simulate((0, T_END), y0, yd0, **kw)
+    t_sim = best_of(lambda: s.simulate((0, T_END), y0, yd0, **kw))
+    ref = s.simulate((0, T_END), y0, yd0, inputs={"F": 0.0}, rtol=1e-12, atol=1e-12)
+    return {"system": s, "derive": t_derive, "codegen": t_codegen, "codegen_cached": t_cached,
+            "integrate": t_sim, "nfev": res.nfev, "steps": res.n_accepted,
+            "x_final": np.concatenate([res.y[-1], res.yd[-1]]),
+            "x_ref": np.concatenate([ref.y[-1], ref.yd[-1]])}
+
+
+# --- PyDy ----------------------------------------------------------------------------------------
+def pydy_problem(n: int):
+    import sympy as sp
+    from sympy.physics.mechanics import dynamicsymbols
+    from sympy.physics.mechanics.models import n_link_pendulum_on_cart as sympy_model
+
+    t0 = time.perf_counter()
+    kane = sympy_model(n, cart_force=True, joint_torques=False)
+    M, F = kane.mass_matrix_full, kane.forcing_full
+    t_derive = time.perf_counter() - t0
+    t = dynamicsymbols._t
+    consts = sorted((M.free_symbols | F.free_symbols) - {t}, key=str)
+    return kane, M, F, consts, [sp.Function("F")(t)], t_derive
+
+
+def bench_pydy(n: int, solver: str, generator: str, params: dict) -> dict:
+    from pydy.codegen.ode_function_generators import generate_ode_function
+    from scipy.integrate import odeint
+
+    kane, M, F, consts, specified, t_derive = pydy_problem(n)
+    with tempfile.TemporaryDirectory() as d:
+        t0 = time.perf_counter()
+        kw = {"tmp_dir": d} if generator == "cython" else {}
+        rhs = generate_ode_function(F, kane.q, kane.u, consts, mass_matrix=M,
+                                    specifieds=specified, generator=generator,
+                                    linear_sys_solver=solver, **kw)
+        t_codegen = time.perf_counter() - t0
+        p = np.array([params[str(c)] for c in consts])
+        y0, yd0 = initial_state(n)
+        x0 = np.concatenate([y0, yd0])
+        tt = np.array([0.0, T_END])
+        args = (np.array([0.0]), p)
+        # one output interval: mxstep must allow all the steps of 10 s
+        kw_ode = {"rtol": TOL, "atol": TOL, "mxstep": 10**6}
+        x, info = odeint(rhs, x0, tt, args=args, full_output=True, **kw_ode)
+        t_int = best_of(lambda: odeint(rhs, x0, tt, args=args, **kw_ode), repeat=5)
+        x_ref = odeint(rhs, x0, tt, args=args, rtol=1e-12, atol=1e-12, mxstep=10**6)[-1]
+    return {"derive": t_derive, "codegen": t_codegen, "integrate": t_int,
+            "nfev": int(info["nfe"][-1]), "x_final": x[-1], "x_ref_odeint": x_ref}
+
+
+# --- Pinocchio -----------------------------------------------------------------------------------
+ARM_AXES = ("z", "y", "z", "y", "z", "y", "z")
+ARM_OFFSETS = ((0, 0, 0.333), (0, 0, 0.0), (0, 0, 0.316), (0.0825, 0, 0), (-0.0825, 0, 0.384),
+               (0, 0, 0), (0.088, 0, 0.107))
+ARM_MASSES = (4.97, 0.65, 3.23, 3.59, 1.23, 1.67, 0.74)
+
+
+def arm_data() -> list[dict]:
+    """A 7-joint revolute arm with the link lengths and masses of a common research arm and
+    full inertia tensors."""
+    rng = np.random.default_rng(7)
+    out = []
+    for i in range(7):
+        a, b = rng.uniform(0.005, 0.03, 2)
+        c = rng.uniform(abs(a - b) + 0.002, a + b - 0.002)
+        Qm, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+        inertia = Qm @ np.diag([a, b, c]) @ Qm.T
+        out.append({"joint": "revolute", "axes": (ARM_AXES[i],), "mass": ARM_MASSES[i],
+                    "com": np.round(rng.uniform(-0.05, 0.05, 3), 4),
+                    "inertia": 0.5 * (inertia + inertia.T),
+                    "offset": np.array(ARM_OFFSETS[i], dtype=float)})
+    return out
+
+
+def arm_system(data: list[dict]) -> jd.System:
+    import symengine as se
+
+    coords, bodies, params = [], [], {"g": 9.81}
+    comp = "xyz"
+    for i, d in enumerate(data):
+        q = se.Symbol(f"q{i}")
+        coords.append(q)
+        pos = (0, 0, 0) if i == 0 else tuple(se.Symbol(f"d{c}{i - 1}") for c in comp)
+        m = se.Symbol(f"m{i}")
+        com = tuple(se.Symbol(f"c{c}{i}") for c in comp)
+        I = [[se.Symbol(f"I{i}{comp[min(a, b)]}{comp[max(a, b)]}") for b in range(3)]
+             for a in range(3)]
+        bodies.append(jd.Body(f"link{i}", "world" if i == 0 else f"link{i - 1}",
+                              jd.Revolute(f"joint{i}", q, d["axes"][0], position=pos), mass=m,
+                              com=com, inertia=I))
+        params[f"m{i}"] = float(d["mass"])
+        for a in range(3):
+            params[f"c{comp[a]}{i}"] = float(d["com"][a])
+            params[f"d{comp[a]}{i}"] = float(d["offset"][a])
+            for b in range(a, 3):
+                params[f"I{i}{comp[a]}{comp[b]}"] = float(d["inertia"][a, b])
+    return jd.System(coords, bodies, [jd.Gravity((0, 0, -se.Symbol("g")))], parameters=params,
+                     name="7-joint arm")
+
+
+def pinocchio_model(data: list[dict]):
+    import pinocchio as pin
+
+    axis = {"x": pin.JointModelRX, "y": pin.JointModelRY, "z": pin.JointModelRZ}
+    model = pin.Model()
+    parent = 0
+    offset = np.zeros(3)
+    for i, d in enumerate(data):
+        seq = {"revolute": list(d["axes"][:1]), "universal": list(d["axes"]),
+               "spherical": ["x", "y", "z"]}[d["joint"]]
+        for k, a in enumerate(seq):
+            placement = pin.SE3(np.eye(3), offset) if k == 0 else pin.SE3.Identity()
+            parent = model.addJoint(parent, axis[a](), placement, f"joint{i}_{k}")
+        model.appendBodyToJoint(parent, pin.Inertia(float(d["mass"]), np.asarray(d["com"]),
+                                                    np.asarray(d["inertia"])), pin.SE3.Identity())
+        offset = np.asarray(d["offset"], dtype=float)
+    model.gravity.linear = np.array([0.0, 0.0, -9.81])
+    return model
+
+
+def bench_batched(name: str, system: jd.System, data: list[dict], n_states: int = 2000) -> dict:
+    import pinocchio as pin
+
+    eom = system.equations_of_motion()
+    fn = numeric.lambdify(system, {"M": eom.M, "k": eom.k, "q": eom.q})
+    model = pinocchio_model(data)
+    pdata = model.createData()
+    rng = np.random.default_rng(1)
+    Y = rng.uniform(-math.pi, math.pi, (n_states, system.f))
+    YD = rng.uniform(-2, 2, (n_states, system.f))
+    p = numeric.parameter_vector(system, None)
+    out = np.empty((n_states, fn.size))
+    t_batch = best_of(lambda: fn.batch(Y, YD, 0.0, p, None, out=out)) / n_states
+    y0, yd0, u0 = Y[0].copy(), YD[0].copy(), np.zeros(1)
+    flat = np.empty(fn.size)
+    t_single = best_of(lambda: fn.raw(y0, yd0, 0.0, p, u0, flat))
+
+    def pin_loop() -> None:
+        for i in range(n_states):
+            pin.crba(model, pdata, Y[i])
+            pin.nonLinearEffects(model, pdata, Y[i], YD[i])
+
+    t_pin = best_of(pin_loop, repeat=5) / n_states
+    res = fn.batch(Y[:20], YD[:20], 0.0, p, None)
+    err = 0.0
+    for i in range(20):
+        Mp = pin.crba(model, pdata, Y[i])
+        Mp = np.triu(Mp) + np.triu(Mp, 1).T
+        nle = pin.nonLinearEffects(model, pdata, Y[i], YD[i])
+        err = max(err, np.abs(res["M"][i] - Mp).max(),
+                  np.abs((res["k"][i] - res["q"][i])[:, 0] - nle).max())
+    return {"name": name, "f": system.f, "batch_per_state": t_batch, "single_call": t_single,
+            "pinocchio_per_call": t_pin, "max_difference": err}
+
+
+def main(argv: list[str] | None = None) -> dict:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--n", type=int, nargs="+", default=[2, 4, 8])
+    ap.add_argument("--quick", action="store_true",
+                    help="n = 2 and PyDy's lambdify backend only (smoke test)")
+    ap.add_argument("--sympy-max-n", type=int, default=10)
+    ap.add_argument("--no-pinocchio", action="store_true")
+    ap.add_argument("--json", type=str, default=None)
+    args = ap.parse_args(argv)
+    ns = [2] if args.quick else args.n
+    t0 = time.perf_counter()
+    integrator_library()
+    print(f"integrator library (compiled once per machine, cached): "
+          f"{time.perf_counter() - t0:.3f} s\n")
+    report: dict = {"tolerance": TOL, "t_end": T_END, "pendulum": [], "batched": []}
+    print(f"n-link pendulum on a cart, {T_END:g} s from the hanging position, rtol = atol = "
+          f"{TOL:g}")
+    hdr = (f"{'n':>2} {'tool':<32} {'derive s':>9} {'codegen s':>10} {'integrate ms':>13} "
+           f"{'rhs evals':>10} {'|x-x_ref|':>10} {'speed-up':>9}")
+    print(hdr)
+    print("-" * len(hdr))
+    for n in ns:
+        J = bench_jourdain(n)
+        params = J["system"].parameter_values
+        x_ref = J["x_ref"]
+        rows = [("jourdain DOP853 (C loop)", J)]
+        configs = [("lambdify", "numpy")] if args.quick else [("cython", "sympy"),
+                                                               ("cython", "numpy")]
+        skipped = []
+        for gen, solver in configs:
+            if solver == "sympy" and n > args.sympy_max_n:
+                skipped.append(f"PyDy {gen}/{solver} (n > --sympy-max-n={args.sympy_max_n})")
+                continue
+            try:
+                P = bench_pydy(n, solver, gen, params)
+            except Exception as exc:  # noqa: BLE001 - a peer failing is reported, not fatal
+                skipped.append(f"PyDy {gen}/{solver}: {type(exc).__name__}: {exc}")
+                continue
+            rows.append((f"PyDy {gen}/{solver} + odeint", P))
+        pydy_times = [r[1]["integrate"] for r in rows[1:]]
+        fastest = min(pydy_times) if pydy_times else math.nan
+        entry = {"n": n, "tools": {}}
+        for label, r in rows:
+            d = float(np.abs(r["x_final"] - x_ref).max())
+            speed = fastest / r["integrate"]
+            print(f"{n:>2} {label:<32} {r['derive']:>9.3f} {r['codegen']:>10.3f} "
+                  f"{1e3 * r['integrate']:>13.3f} {r['nfev']:>10d} {d:>10.2e} {speed:>8.1f}x")
+            entry["tools"][label] = {k: (float(v) if np.isscalar(v) else None)
+                                     for k, v in r.items() if k in ("derive", "codegen",
+                                                                    "integrate", "nfev")}
+            entry["tools"][label]["final_state_error"] = d
+        odeint_refs = [r[1]["x_ref_odeint"] for r in rows[1:]]
+        if odeint_refs:
+            dref = float(np.abs(odeint_refs[0] - x_ref).max())
+            print(f"   reference (jourdain 1e-12) vs odeint 1e-12 on PyDy's function: {dref:.2e}")
+            entry["reference_check"] = dref
+        print(f"   jourdain code generation from a warm cache: {J['codegen_cached']:.4f} s")
+        for sk in skipped:
+            print(f"   skipped: {sk}")
+        report["pendulum"].append(entry)
+    if not args.no_pinocchio:
+        try:
+            import pinocchio  # noqa: F401
+        except ImportError:
+            print("\nPinocchio not installed: batched comparison skipped")
+        else:
+            print("\nBatched M, k, q evaluation per state vs Pinocchio crba + nonLinearEffects "
+                  "per call")
+            print(f"{'model':<22} {'f':>3} {'batch us/state':>15} {'single call us':>15} "
+                  f"{'pinocchio us':>13} {'ratio':>7} {'max diff':>9}")
+            cases = [("spatial_chain(6)", spatial_chain(6), spatial_chain_data(6))]
+            ad = arm_data()
+            cases.append(("7-joint arm", arm_system(ad), ad))
+            for name, system, data in cases:
+                b = bench_batched(name, system, data)
+                ratio = b["pinocchio_per_call"] / b["batch_per_state"]
+                print(f"{name:<22} {b['f']:>3} {1e6 * b['batch_per_state']:>15.3f} "
+                      f"{1e6 * b['single_call']:>15.3f} {1e6 * b['pinocchio_per_call']:>13.3f} "
+                      f"{ratio:>6.1f}x {b['max_difference']:>9.1e}")
+                report["batched"].append({**b, "ratio": ratio})
+    if args.json:
+        Path(args.json).write_text(json.dumps(report, indent=2))
+    return report
+
+
+if __name__ == "__main__":
+    main()
