@@ -2,11 +2,12 @@
 
 :func:`simulate` integrates from ``y(t0) = y0, ẏ(t0) = ẏ0`` and returns a
 :class:`~jourdain.results.Results`. The default methods ``"DOP853"`` and ``"RK45"``
-(Dormand–Prince 8(5,3) and 5(4), adaptive steps, continuous extension) run their step loop in C
-(:mod:`jourdain.numeric.integrator_c`), calling the generated ``M, k, q`` code and a Cholesky
-factorization of ``M`` in every evaluation, without returning to Python between steps. The
-stiff methods ``"Radau"``, ``"BDF"`` and ``"LSODA"`` use :func:`scipy.integrate.solve_ivp` with the
-same compiled right-hand side (one call from Python per evaluation).
+(Dormand–Prince 8(5,3) and 5(4), adaptive steps, continuous extension) and the stiff method
+``"Radau"`` (Radau IIA, order 5) run their step loop in C (:mod:`jourdain.numeric.integrator_c`),
+calling the generated ``M, k, q`` code and a Cholesky factorization of ``M`` in every
+evaluation, without returning to Python between steps. ``"BDF"``, ``"LSODA"`` and
+``"scipy:<method>"`` use :func:`scipy.integrate.solve_ivp` with the same compiled right-hand
+side (one call from Python per evaluation).
 
 Inputs ``u(t)`` are given per input name as
 
@@ -51,8 +52,10 @@ from .symbolic import SymMatrix
 if TYPE_CHECKING:
     from .model.system import System
 
-EXPLICIT = {"DOP853": 1, "RK45": 0, "DOPRI5": 0}
-SCIPY_METHODS = ("Radau", "BDF", "LSODA")
+#: methods whose step loop runs in C, and their codes in the C library
+C_METHODS = {"DOP853": 1, "RK45": 0, "DOPRI5": 0, "Radau": 2}
+#: methods of scipy.integrate.solve_ivp (one call from Python per right-hand side)
+SCIPY_METHODS = ("BDF", "LSODA", "scipy:Radau", "scipy:RK45", "scipy:DOP853")
 
 _DONE, _CONTINUE, _EVENT = 0, 1, 2
 _ESINGULAR, _ENAN, _ESTEP, _ECALLBACK, _ENOMEM = -1, -2, -3, -4, -5
@@ -295,7 +298,8 @@ def simulate(system: System, t_span: tuple[float, float], y0: Any, yd0: Any,
     y0, yd0 : initial coordinates and rates (f each, in the order of ``system.coordinates``)
     parameters : overrides of parameter values by name (no recompilation)
     inputs : input name -> number, table ``(times, values)``, expression or callable (see module)
-    method : "DOP853" (default), "RK45" (step loop in C) or "Radau", "BDF", "LSODA" (SciPy)
+    method : "DOP853" (default), "RK45", "Radau" (step loop in C) or "BDF", "LSODA",
+        "scipy:Radau", "scipy:RK45", "scipy:DOP853" (SciPy's solve_ivp)
     rtol, atol : tolerances; the local error of each state component stays below
         ``atol + rtol·|x|``; ``atol`` may be a vector of length 2f (y then ẏ)
     t_eval : output times (continuous extension); default: every accepted step
@@ -339,9 +343,9 @@ def simulate(system: System, t_span: tuple[float, float], y0: Any, yd0: Any,
     if a.size != 2 * f or not np.all(a > 0) or not np.all(np.isfinite(a)):
         raise EvaluationError(f"atol must be a positive number or {2 * f} positive numbers")
     atol_x = np.concatenate([a, [a.min()]])
-    if method not in EXPLICIT and method not in SCIPY_METHODS:
+    if method not in C_METHODS and method not in SCIPY_METHODS:
         raise EvaluationError(f"unknown method {method!r}; methods are "
-                              f"{sorted(EXPLICIT) + list(SCIPY_METHODS)}")
+                              f"{sorted(C_METHODS) + list(SCIPY_METHODS)}")
     te = None
     if t_eval is not None:
         te = np.ascontiguousarray(t_eval, dtype=float).reshape(-1)
@@ -349,11 +353,11 @@ def simulate(system: System, t_span: tuple[float, float], y0: Any, yd0: Any,
             raise EvaluationError("t_eval must be sorted and lie within t_span")
     p = parameter_vector(system, parameters)
     mkq = mkq_function(system)
-    setup = _Setup(system, mkq, p, inputs, events, EXPLICIT.get(method, 1), rtol, atol_x,
+    setup = _Setup(system, mkq, p, inputs, events, C_METHODS.get(method, 1), rtol, atol_x,
                    max_step, first_step or 0.0)
     x0 = np.concatenate([yv, ydv, [0.0]])
     wall = time.perf_counter()
-    if method in EXPLICIT:
+    if method in C_METHODS:
         run = _run_c(setup, t0, t1, x0, te, progress, output)
     else:
         run = _run_scipy(setup, method, t0, t1, x0, te, rtol, atol_x, max_step, first_step)
@@ -501,7 +505,7 @@ def _run_scipy(setup: _Setup, method: str, t0: float, t1: float, x0: np.ndarray,
     if first_step:
         kw["first_step"] = first_step
     try:
-        sol = solve_ivp(fun, (t0, t1), x0, method=method, t_eval=te, rtol=rtol, atol=atol,
+        sol = solve_ivp(fun, (t0, t1), x0, method=method.removeprefix("scipy:"), t_eval=te, rtol=rtol, atol=atol,
                         events=ev_funcs or None, **kw)
     except KeyboardInterrupt as exc:
         raise IntegrationError(f"{method} run interrupted; the SciPy methods keep no partial "

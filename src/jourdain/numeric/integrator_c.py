@@ -1,10 +1,13 @@
 """C source of jourdain's explicit Runge–Kutta integrators for ``M(y,t)·ÿ + k(y,ẏ,t) = q(y,ẏ,t)``.
 
 The step loop runs in C: Dormand–Prince 5(4) ("RK45") and 8(5,3) ("DOP853") with adaptive
-steps (Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.4–II.6), their continuous extensions for
+steps (Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.4–II.6) and the implicit Radau IIA method
+of order 5 for stiff problems (Hairer & Wanner, *Solving ODEs II*, §IV.8: simplified Newton
+iterations in the eigenbasis of the Runge–Kutta matrix, a forward-difference Jacobian, the
+embedded error estimate and Gustafsson's step-size predictor), their continuous extensions for
 output at requested times and for locating events, and a Cholesky factorization of ``M`` in
-every right-hand-side evaluation. The Butcher tables are read from SciPy, which tabulates the
-same published coefficients, and written into the source as constants.
+every right-hand-side evaluation. The coefficient tables are read from SciPy, which tabulates
+the same published coefficients, and written into the source as constants.
 
 The state is ``x = [y, ẏ, W]`` with ``W`` the work of the generalized applied forces
 ``q`` (``Ẇ = ẏᵀq``), integrated to the same tolerance, for the energy balance.
@@ -23,6 +26,7 @@ def _arr(name: str, a: np.ndarray) -> str:
 def tables() -> str:
     """C constants of the two methods' coefficients."""
     from scipy.integrate._ivp import dop853_coefficients as d8
+    from scipy.integrate._ivp import radau as rd
     from scipy.integrate._ivp.rk import RK45
 
     out = ["/* Dormand-Prince 5(4): 6 stages + FSAL stage */\n"]
@@ -40,6 +44,14 @@ def tables() -> str:
     out.append(_arr("RK8_E3", d8.E3))
     out.append(_arr("RK8_E5", d8.E5))
     out.append(_arr("RK8_D", d8.D))  # 4 x 16
+    out.append("/* Radau IIA order 5: nodes, transformation to the eigenbasis, error weights */\n")
+    out.append(_arr("RADAU_C", rd.C))
+    out.append(_arr("RADAU_T", rd.T))
+    out.append(_arr("RADAU_TI", rd.TI))
+    out.append(_arr("RADAU_E", rd.E))
+    out.append(_arr("RADAU_P", rd.P))
+    out.append(f"static const double RADAU_MU_REAL = {float(rd.MU_REAL)!r};\n")
+    out.append(_arr("RADAU_MU_CPLX", np.array([rd.MU_COMPLEX.real, rd.MU_COMPLEX.imag])))
     return "".join(out)
 
 
@@ -203,7 +215,8 @@ typedef struct {
     int method;
     long n;
     double t_old, h;
-    double *x_old, *x_new, *K, *F, *tmp;
+    const double *x_old;
+    double *x_new, *K, *F, *tmp;
     int have_dense;
 } jd_step;
 
@@ -211,6 +224,14 @@ typedef struct {
 static int dense_prepare(jd_step *s) {
     long n = s->n;
     if (s->have_dense) return 0;
+    if (s->method == 2) {  /* Q = Zᵀ P from the collocation values Z (in K) */
+        for (int k = 0; k < 3; ++k)
+            for (long i = 0; i < n; ++i) {
+                double a = 0.0;
+                for (int j = 0; j < 3; ++j) a += s->K[j * n + i] * RADAU_P[j * 3 + k];
+                s->F[k * n + i] = a;
+            }
+    }
     if (s->method == 1) {
         double h = s->h;
         for (int st = 13; st < 16; ++st) {
@@ -243,6 +264,11 @@ static int dense_prepare(jd_step *s) {
 static void dense_eval(const jd_step *s, double t, double *out) {
     long n = s->n;
     double th = (t - s->t_old) / s->h;
+    if (s->method == 2) {  /* collocation polynomial: x_old + Q·(θ, θ², θ³) */
+        for (long i = 0; i < n; ++i)
+            out[i] = s->x_old[i] + th * (s->F[i] + th * (s->F[n + i] + th * s->F[2 * n + i]));
+        return;
+    }
     if (s->method == 1) {
         for (long i = 0; i < n; ++i) {
             double y = 0.0;
@@ -303,6 +329,425 @@ static int crossed(int dir, double g0, double g1) {
 
 int jd_state_size(long f) { return (int)(2 * f + 1); }
 
+/* where the results of a run go */
+typedef struct {
+    const double *t_eval; long n_eval; long *i_eval;
+    double *out_t, *out_x; long cap; long *n_out;
+    double *ev_t, *ev_x; long *ev_i; long ev_cap; long *n_ev;
+    double *g_old, *g_new, *g_tmp, *roots, *xe;
+    double *fail;
+} jd_io;
+
+/*
+ * Events and output for the accepted step s from s->t_old to t_new (end state s->x_new).
+ * Returns 0, JD_EVENT (a terminal event: *t_stop and io->xe hold its time and state) or an
+ * error code.
+ */
+static int post_step(jd_step *s, jd_io *io, double t_new, double *t_stop_out) {
+    const jd_problem *P = s->c->P;
+    long f = P->f, n = s->n, nev = P->nev;
+    double t_stop = t_new;
+    int terminal = -1, r;
+    if (nev) {
+        inputs(s->c, t_new, s->x_new, s->x_new + f);
+        P->events(s->x_new, s->x_new + f, t_new, P->p, s->c->u, io->g_new);
+        long n_found = 0;
+        for (long e = 0; e < nev; ++e) {
+            if (!crossed(P->ev_dir[e], io->g_old[e], io->g_new[e])) continue;
+            r = dense_prepare(s);
+            if (r) { io->fail[0] = s->c->fail_t; return r; }
+            double te = event_root(s, e, io->g_old[e], io->g_new[e], io->xe, io->g_tmp);
+            io->roots[e] = te;
+            n_found++;
+            if (P->ev_term[e] && te <= t_stop) { t_stop = te; terminal = (int)e; }
+        }
+        /* record the events up to the stop, in time order */
+        while (n_found > 0) {
+            long best = -1;
+            for (long e = 0; e < nev; ++e) {
+                if (!crossed(P->ev_dir[e], io->g_old[e], io->g_new[e])) continue;
+                if (best < 0 || io->roots[e] < io->roots[best]) best = e;
+            }
+            if (best < 0) break;
+            if (io->roots[best] <= t_stop && *io->n_ev < io->ev_cap) {
+                io->ev_t[*io->n_ev] = io->roots[best];
+                dense_eval(s, io->roots[best], io->ev_x + *io->n_ev * n);
+                io->ev_i[*io->n_ev] = best;
+                ++*io->n_ev;
+            }
+            io->g_old[best] = io->g_new[best];   /* consumed */
+            n_found--;
+        }
+    }
+    if (io->n_eval > 0) {
+        while (*io->i_eval < io->n_eval && io->t_eval[*io->i_eval] <= t_stop) {
+            double te = io->t_eval[*io->i_eval];
+            io->out_t[*io->n_out] = te;
+            if (te == t_new && terminal < 0) {
+                memcpy(io->out_x + *io->n_out * n, s->x_new, n * sizeof(double));
+            } else {
+                r = dense_prepare(s);
+                if (r) { io->fail[0] = s->c->fail_t; return r; }
+                dense_eval(s, te, io->out_x + *io->n_out * n);
+            }
+            ++*io->n_out; ++*io->i_eval;
+        }
+    }
+    if (terminal >= 0) {
+        r = dense_prepare(s);
+        if (r) { io->fail[0] = s->c->fail_t; return r; }
+        dense_eval(s, t_stop, io->xe);
+        if (io->n_eval == 0) {
+            io->out_t[*io->n_out] = t_stop;
+            memcpy(io->out_x + *io->n_out * n, io->xe, n * sizeof(double));
+            ++*io->n_out;
+        }
+        *t_stop_out = t_stop;
+        return JD_EVENT;
+    }
+    if (io->n_eval == 0) {
+        io->out_t[*io->n_out] = t_new;
+        memcpy(io->out_x + *io->n_out * n, s->x_new, n * sizeof(double));
+        ++*io->n_out;
+    }
+    if (nev) memcpy(io->g_old, io->g_new, nev * sizeof(double));
+    return 0;
+}
+
+/* ---- dense linear algebra for Radau IIA ---- */
+static int lu_real(long n, double *A, long *piv) {
+    for (long k = 0; k < n; ++k) {
+        long p = k;
+        double best = fabs(A[k * n + k]);
+        for (long i = k + 1; i < n; ++i) if (fabs(A[i * n + k]) > best) { best = fabs(A[i * n + k]); p = i; }
+        piv[k] = p;
+        if (best == 0.0 || !isfinite(best)) return 1;
+        if (p != k) for (long j = 0; j < n; ++j) { double tmp = A[k * n + j]; A[k * n + j] = A[p * n + j]; A[p * n + j] = tmp; }
+        for (long i = k + 1; i < n; ++i) {
+            double l = A[i * n + k] / A[k * n + k];
+            A[i * n + k] = l;
+            for (long j = k + 1; j < n; ++j) A[i * n + j] -= l * A[k * n + j];
+        }
+    }
+    return 0;
+}
+
+static void lu_solve_real(long n, const double *A, const long *piv, double *b) {
+    for (long k = 0; k < n; ++k) { long p = piv[k]; if (p != k) { double tmp = b[k]; b[k] = b[p]; b[p] = tmp; } }
+    for (long i = 0; i < n; ++i) { double s = b[i]; for (long j = 0; j < i; ++j) s -= A[i * n + j] * b[j]; b[i] = s; }
+    for (long i = n - 1; i >= 0; --i) { double s = b[i]; for (long j = i + 1; j < n; ++j) s -= A[i * n + j] * b[j]; b[i] = s / A[i * n + i]; }
+}
+
+/* complex matrices as separate real and imaginary parts (no C99 complex needed) */
+static int lu_cplx(long n, double *Ar, double *Ai, long *piv) {
+    for (long k = 0; k < n; ++k) {
+        long p = k;
+        double best = hypot(Ar[k * n + k], Ai[k * n + k]);
+        for (long i = k + 1; i < n; ++i) {
+            double a = hypot(Ar[i * n + k], Ai[i * n + k]);
+            if (a > best) { best = a; p = i; }
+        }
+        piv[k] = p;
+        if (best == 0.0 || !isfinite(best)) return 1;
+        if (p != k) for (long j = 0; j < n; ++j) {
+            double tr = Ar[k * n + j], ti = Ai[k * n + j];
+            Ar[k * n + j] = Ar[p * n + j]; Ai[k * n + j] = Ai[p * n + j];
+            Ar[p * n + j] = tr; Ai[p * n + j] = ti;
+        }
+        double dr = Ar[k * n + k], di = Ai[k * n + k], dd = dr * dr + di * di;
+        for (long i = k + 1; i < n; ++i) {
+            double ar = Ar[i * n + k], ai = Ai[i * n + k];
+            double lr = (ar * dr + ai * di) / dd, li = (ai * dr - ar * di) / dd;
+            Ar[i * n + k] = lr; Ai[i * n + k] = li;
+            for (long j = k + 1; j < n; ++j) {
+                double br = Ar[k * n + j], bi = Ai[k * n + j];
+                Ar[i * n + j] -= lr * br - li * bi;
+                Ai[i * n + j] -= lr * bi + li * br;
+            }
+        }
+    }
+    return 0;
+}
+
+static void lu_solve_cplx(long n, const double *Ar, const double *Ai, const long *piv,
+                          double *br, double *bi) {
+    for (long k = 0; k < n; ++k) {
+        long p = piv[k];
+        if (p != k) { double t = br[k]; br[k] = br[p]; br[p] = t; t = bi[k]; bi[k] = bi[p]; bi[p] = t; }
+    }
+    for (long i = 0; i < n; ++i) {
+        double sr = br[i], si = bi[i];
+        for (long j = 0; j < i; ++j) {
+            sr -= Ar[i * n + j] * br[j] - Ai[i * n + j] * bi[j];
+            si -= Ar[i * n + j] * bi[j] + Ai[i * n + j] * br[j];
+        }
+        br[i] = sr; bi[i] = si;
+    }
+    for (long i = n - 1; i >= 0; --i) {
+        double sr = br[i], si = bi[i];
+        for (long j = i + 1; j < n; ++j) {
+            sr -= Ar[i * n + j] * br[j] - Ai[i * n + j] * bi[j];
+            si -= Ar[i * n + j] * bi[j] + Ai[i * n + j] * br[j];
+        }
+        double dr = Ar[i * n + i], di = Ai[i * n + i], dd = dr * dr + di * di;
+        br[i] = (sr * dr + si * di) / dd;
+        bi[i] = (si * dr - sr * di) / dd;
+    }
+}
+
+/* forward-difference Jacobian J[i*n + j] = d f_i / d x_j; the work W (last component) does not
+   enter the right-hand side, so its column is zero */
+static int jacobian(jd_ctx *c, double t, const double *x, const double *f0, double *J,
+                    double *xs, double *fx) {
+    long n = c->n;
+    memcpy(xs, x, n * sizeof(double));
+    for (long j = 0; j < n; ++j) {
+        if (j == n - 1) { for (long i = 0; i < n; ++i) J[i * n + j] = 0.0; continue; }
+        double d = 1.4901161193847656e-08 * fmax(1.0, fabs(x[j]));
+        xs[j] = x[j] + d;
+        d = xs[j] - x[j];
+        int r = rhs(c, t, xs, fx);
+        xs[j] = x[j];
+        if (r) return r;
+        for (long i = 0; i < n; ++i) J[i * n + j] = (fx[i] - f0[i]) / d;
+    }
+    return 0;
+}
+
+typedef struct {
+    double *J, *LUr, *LCr, *LCi, *Z, *Z0, *W, *F, *dW, *fr, *fi, *xs, *fx, *sc;
+    long *pr, *pc;
+} jd_radau_ws;
+
+/* simplified Newton iteration for the collocation system of one Radau IIA step.
+   Returns 1 converged, 0 not converged, or a negative error code that must stop the run */
+static int collocation(jd_ctx *c, jd_radau_ws *w, double t, const double *x, double h,
+                       double tol, int *n_iter, double *rate_out) {
+    long n = c->n;
+    double mr = RADAU_MU_REAL / h;
+    double mcr = RADAU_MU_CPLX[0] / h, mci = RADAU_MU_CPLX[1] / h;
+    for (int k = 0; k < 3; ++k)
+        for (long i = 0; i < n; ++i) {
+            double a = 0.0;
+            for (int j = 0; j < 3; ++j) a += RADAU_TI[k * 3 + j] * w->Z0[j * n + i];
+            w->W[k * n + i] = a;
+        }
+    memcpy(w->Z, w->Z0, 3 * n * sizeof(double));
+    double dw_old = -1.0, rate = -1.0;
+    int converged = 0, k;
+    for (k = 0; k < 6; ++k) {
+        for (int st = 0; st < 3; ++st) {
+            for (long i = 0; i < n; ++i) w->xs[i] = x[i] + w->Z[st * n + i];
+            int r = rhs(c, t + RADAU_C[st] * h, w->xs, w->F + st * n);
+            if (r == JD_ECALLBACK || r == JD_ENOMEM) return r;
+            if (r) { *n_iter = k + 1; *rate_out = rate; return 0; }
+        }
+        for (long i = 0; i < n; ++i) {
+            double a = 0.0, b = 0.0, e = 0.0;
+            for (int st = 0; st < 3; ++st) {
+                a += w->F[st * n + i] * RADAU_TI[0 * 3 + st];
+                b += w->F[st * n + i] * RADAU_TI[1 * 3 + st];
+                e += w->F[st * n + i] * RADAU_TI[2 * 3 + st];
+            }
+            w->fr[i] = a - mr * w->W[i];
+            /* (b + i e) - (mcr + i mci) (W1 + i W2) */
+            w->dW[n + i] = b - (mcr * w->W[n + i] - mci * w->W[2 * n + i]);
+            w->dW[2 * n + i] = e - (mcr * w->W[2 * n + i] + mci * w->W[n + i]);
+        }
+        lu_solve_real(n, w->LUr, w->pr, w->fr);
+        lu_solve_cplx(n, w->LCr, w->LCi, w->pc, w->dW + n, w->dW + 2 * n);
+        memcpy(w->dW, w->fr, n * sizeof(double));
+        double s = 0.0;
+        for (int q = 0; q < 3; ++q)
+            for (long i = 0; i < n; ++i) { double v = w->dW[q * n + i] / w->sc[i]; s += v * v; }
+        double dw = sqrt(s / (3.0 * (double)n));
+        if (!isfinite(dw)) break;
+        if (dw_old >= 0.0) rate = dw / dw_old;
+        if (rate >= 0.0 && (rate >= 1.0 || pow(rate, 6 - k) / (1.0 - rate) * dw > tol)) break;
+        for (long i = 0; i < 3 * n; ++i) w->W[i] += w->dW[i];
+        for (int q = 0; q < 3; ++q)
+            for (long i = 0; i < n; ++i) {
+                double a = 0.0;
+                for (int j = 0; j < 3; ++j) a += RADAU_T[q * 3 + j] * w->W[j * n + i];
+                w->Z[q * n + i] = a;
+            }
+        if (dw == 0.0 || (rate >= 0.0 && rate / (1.0 - rate) * dw < tol)) { converged = 1; break; }
+        dw_old = dw;
+    }
+    *n_iter = k + 1 > 6 ? 6 : k + 1;
+    *rate_out = rate;
+    return converged;
+}
+
+static int radau_lu(jd_radau_ws *w, long n, double h) {
+    double mr = RADAU_MU_REAL / h, mcr = RADAU_MU_CPLX[0] / h, mci = RADAU_MU_CPLX[1] / h;
+    for (long i = 0; i < n * n; ++i) {
+        w->LUr[i] = -w->J[i];
+        w->LCr[i] = -w->J[i];
+        w->LCi[i] = 0.0;
+    }
+    for (long i = 0; i < n; ++i) {
+        w->LUr[i * n + i] += mr;
+        w->LCr[i * n + i] += mcr;
+        w->LCi[i * n + i] += mci;
+    }
+    return lu_real(n, w->LUr, w->pr) || lu_cplx(n, w->LCr, w->LCi, w->pc);
+}
+
+static double predict_factor(double h, double h_old, double en, double en_old) {
+    double mult = 1.0;
+    if (en_old >= 0.0 && h_old > 0.0 && en > 0.0) mult = h / h_old * pow(en_old / en, 0.25);
+    return fmin(1.0, mult) * (en > 0.0 ? pow(en, -0.25) : INFINITY);
+}
+
+/* the Radau IIA (order 5) step loop of Hairer & Wanner, Solving ODEs II, IV.8 */
+static int radau_loop(jd_ctx *c, jd_step *s, jd_io *io, double t_end, double *t_io,
+                      double *h_io, double *x, double *k0, long *cnt, long max_steps) {
+    const jd_problem *P = c->P;
+    long n = c->n;
+    double *mem = (double *)malloc(sizeof(double) * (4 * n * n + 26 * n) + sizeof(long) * 2 * n);
+    if (!mem) return JD_ENOMEM;
+    jd_radau_ws w;
+    w.J = mem; w.LUr = w.J + n * n; w.LCr = w.LUr + n * n; w.LCi = w.LCr + n * n;
+    w.Z = w.LCi + n * n; w.Z0 = w.Z + 3 * n; w.W = w.Z0 + 3 * n; w.F = w.W + 3 * n;
+    w.dW = w.F + 3 * n; w.fr = w.dW + 3 * n; w.fi = w.fr + n; w.xs = w.fi + n;
+    w.fx = w.xs + n; w.sc = w.fx + n;
+    double *xprev = w.sc + n, *Qprev = xprev + n, *err = Qprev + 3 * n;
+    w.pr = (long *)(err + n); w.pc = w.pr + n;
+    double t = *t_io, h = *h_io, h_old = -1.0, en_old = -1.0, t_prev = 0.0, h_prev = 0.0;
+    double tol = fmax(10.0 * 2.220446049250313e-16 / P->rtol, fmin(0.03, sqrt(P->rtol)));
+    int status = JD_CONTINUE, r, have_sol = 0, lu_ok = 0, current_jac = 1, rejected = 0;
+    long steps = 0;
+    r = jacobian(c, t, x, k0, w.J, w.xs, w.fx);
+    if (r) { io->fail[0] = c->fail_t; status = r; goto out; }
+    while (1) {
+        if (t >= t_end) { status = JD_DONE; break; }
+        if (steps >= max_steps) { status = JD_CONTINUE; break; }
+        if (io->n_eval == 0 && *io->n_out >= io->cap) { status = JD_CONTINUE; break; }
+        double h_min = 10.0 * (nextafter(t, INFINITY) - t);
+        if (h > P->h_max) { h = P->h_max; h_old = -1.0; en_old = -1.0; lu_ok = 0; }
+        if (h < h_min) { h = h_min; h_old = -1.0; en_old = -1.0; lu_ok = 0; }
+        double t_new = t + h;
+        if (t_new >= t_end || t_end - t_new < h_min) t_new = t_end;
+        if (t_new - t != h) lu_ok = 0;
+        h = t_new - t;
+        /* starting values from the previous collocation polynomial */
+        for (int k = 0; k < 3; ++k)
+            for (long i = 0; i < n; ++i) {
+                double v = 0.0;
+                if (have_sol) {
+                    double th = (t + RADAU_C[k] * h - t_prev) / h_prev;
+                    v = xprev[i] + th * (Qprev[i] + th * (Qprev[n + i] + th * Qprev[2 * n + i]))
+                        - x[i];
+                }
+                w.Z0[k * n + i] = v;
+            }
+        for (long i = 0; i < n; ++i) w.sc[i] = P->atol[i] + P->rtol * fabs(x[i]);
+        int converged = 0, n_iter = 0;
+        double rate = -1.0;
+        while (!converged) {
+            if (!lu_ok) {
+                if (radau_lu(&w, n, h)) break;
+                lu_ok = 1;
+            }
+            r = collocation(c, &w, t, x, h, tol, &n_iter, &rate);
+            if (r < 0) { io->fail[0] = c->fail_t; status = r; goto out; }
+            converged = r;
+            if (!converged) {
+                if (current_jac) break;
+                r = jacobian(c, t, x, k0, w.J, w.xs, w.fx);
+                if (r) { io->fail[0] = c->fail_t; status = r; goto out; }
+                current_jac = 1;
+                lu_ok = 0;
+            }
+        }
+        cnt[1]++; steps++;
+        if (!converged) {
+            h *= 0.5; lu_ok = 0; rejected = 1; cnt[3]++;
+            if (h < h_min) {
+                io->fail[0] = t; memcpy(io->fail + 1, x, n * sizeof(double));
+                status = JD_ESTEP; break;
+            }
+            continue;
+        }
+        double *x_new = s->x_new;
+        for (long i = 0; i < n; ++i) x_new[i] = x[i] + w.Z[2 * n + i];
+        /* error estimate */
+        for (long i = 0; i < n; ++i) {
+            double ze = 0.0;
+            for (int k = 0; k < 3; ++k) ze += w.Z[k * n + i] * RADAU_E[k];
+            w.fi[i] = ze / h;  /* ZE */
+            err[i] = k0[i] + w.fi[i];
+            w.sc[i] = P->atol[i] + P->rtol * fmax(fabs(x[i]), fabs(x_new[i]));
+        }
+        lu_solve_real(n, w.LUr, w.pr, err);
+        double en = 0.0;
+        for (long i = 0; i < n; ++i) { double v = err[i] / w.sc[i]; en += v * v; }
+        en = sqrt(en / (double)n);
+        double safety = 0.9 * 13.0 / (12.0 + (double)n_iter);
+        if (rejected && en > 1.0) {
+            for (long i = 0; i < n; ++i) w.xs[i] = x[i] + err[i];
+            r = rhs(c, t, w.xs, w.fx);
+            if (r == JD_ECALLBACK || r == JD_ENOMEM) { io->fail[0] = c->fail_t; status = r; goto out; }
+            if (!r) {
+                for (long i = 0; i < n; ++i) err[i] = w.fx[i] + w.fi[i];
+                lu_solve_real(n, w.LUr, w.pr, err);
+                en = 0.0;
+                for (long i = 0; i < n; ++i) { double v = err[i] / w.sc[i]; en += v * v; }
+                en = sqrt(en / (double)n);
+            }
+        }
+        if (!(en <= 1.0)) {
+            if (!isfinite(en)) en = 1e10;
+            h *= fmax(0.2, safety * predict_factor(h, h_old, en, en_old));
+            lu_ok = 0; rejected = 1; cnt[3]++;
+            if (h < h_min) {
+                io->fail[0] = t; memcpy(io->fail + 1, x, n * sizeof(double));
+                status = JD_ESTEP; break;
+            }
+            continue;
+        }
+        /* accepted */
+        cnt[2]++;
+        int recompute_jac = n_iter > 2 && rate > 1e-3;
+        double factor = fmin(10.0, safety * predict_factor(h, h_old, en, en_old));
+        if (!recompute_jac && factor < 1.2) factor = 1.0; else lu_ok = 0;
+        r = rhs(c, t_new, x_new, w.fx);
+        if (r) { io->fail[0] = c->fail_t; status = r; goto out; }
+        /* collocation polynomial of the step, for output, events and the next start */
+        s->t_old = t; s->h = h; s->x_old = x; s->have_dense = 0;
+        memcpy(s->K, w.Z, 3 * n * sizeof(double));
+        double t_stop;
+        r = post_step(s, io, t_new, &t_stop);
+        if (r == JD_EVENT) {
+            memcpy(x, io->xe, n * sizeof(double));
+            t = t_stop; cnt[4] = 0; status = JD_EVENT; break;
+        }
+        if (r) { status = r; goto out; }
+        dense_prepare(s);
+        memcpy(Qprev, s->F, 3 * n * sizeof(double));
+        memcpy(xprev, x, n * sizeof(double));
+        t_prev = t; h_prev = h; have_sol = 1;
+        memcpy(x, x_new, n * sizeof(double));
+        memcpy(k0, w.fx, n * sizeof(double));
+        t = t_new;
+        if (recompute_jac) {
+            r = jacobian(c, t, x, k0, w.J, w.xs, w.fx);
+            if (r) { io->fail[0] = c->fail_t; status = r; goto out; }
+            current_jac = 1;
+        } else {
+            current_jac = 0;
+        }
+        h_old = h; en_old = en;
+        h *= factor;
+        rejected = 0;
+    }
+out:
+    *t_io = t; *h_io = h;
+    free(mem);
+    return status;
+}
+
 /*
  * Advance from st[0] = t towards t_end. st[1] holds the step size (0: choose one).
  * x (n), k0 (n: derivative at x, valid when cnt[4] != 0), g_old (nev: events at x).
@@ -318,7 +763,8 @@ int jd_integrate(const jd_problem *P, double t_end, double *st, double *x, doubl
     long f = P->f, n = 2 * f + 1, nev = P->nev;
     jd_method m5 = {6, 7, RK5_A, RK5_B, RK5_C, -1.0 / 5.0};
     jd_method m8 = {12, 16, RK8_A, RK8_B, RK8_C, -1.0 / 8.0};
-    const jd_method *m = P->method == 1 ? &m8 : &m5;
+    jd_method mr = {3, 3, RADAU_T, RADAU_E, RADAU_C, -1.0 / 4.0};  /* only err_exp is used */
+    const jd_method *m = P->method == 1 ? &m8 : P->method == 2 ? &mr : &m5;
     int S = m->stages;
     long nu = P->nu > 0 ? P->nu : 1;
     double *mem = (double *)malloc(sizeof(double) *
@@ -329,6 +775,8 @@ int jd_integrate(const jd_problem *P, double t_end, double *st, double *x, doubl
            *sc = xs + n, *err = sc + n, *xe = err + n, *g_new = xe + n, *g_tmp = g_new + nev + 1,
            *roots = g_tmp + nev + 1;
     jd_step s = {&c, m, P->method, n, 0.0, 0.0, x, x_new, K, F, xs, 0};
+    jd_io io = {t_eval, n_eval, i_eval, out_t, out_x, cap, n_out, ev_t, ev_x, ev_i, ev_cap, n_ev,
+                g_old, g_new, g_tmp, roots, xe, fail};
     double t = st[0], h = st[1];
     int status = JD_CONTINUE, r = 0;
     long steps = 0;
@@ -366,6 +814,10 @@ int jd_integrate(const jd_problem *P, double t_end, double *st, double *x, doubl
                         : pow(0.01 / fmax(d1, d2), -m->err_exp);
             h = fmin(100.0 * h0, h1);
         }
+    }
+    if (P->method == 2) {
+        status = radau_loop(&c, &s, &io, t_end, &t, &h, x, k0, cnt, max_steps);
+        goto done;
     }
     int rejected = 0;
     while (1) {
@@ -442,79 +894,15 @@ int jd_integrate(const jd_problem *P, double t_end, double *st, double *x, doubl
         /* accepted */
         cnt[2]++;
         s.t_old = t; s.h = h; s.have_dense = 0;
-        double t_stop = t_new;
-        int terminal = -1;
-        if (nev) {
-            inputs(&c, t_new, x_new, x_new + f);
-            P->events(x_new, x_new + f, t_new, P->p, c.u, g_new);
-            long n_found = 0;
-            for (long e = 0; e < nev; ++e) {
-                if (!crossed(P->ev_dir[e], g_old[e], g_new[e])) continue;
-                r = dense_prepare(&s);
-                if (r) { fail[0] = c.fail_t; status = r; goto done; }
-                double te = event_root(&s, e, g_old[e], g_new[e], xe, g_tmp);
-                roots[e] = te;
-                n_found++;
-                if (P->ev_term[e] && te <= t_stop) { t_stop = te; terminal = (int)e; }
-            }
-            /* record the events up to the stop, in time order */
-            while (n_found > 0) {
-                long best = -1;
-                for (long e = 0; e < nev; ++e) {
-                    if (!crossed(P->ev_dir[e], g_old[e], g_new[e])) continue;
-                    if (best < 0 || roots[e] < roots[best]) best = e;
-                }
-                if (best < 0) break;
-                if (roots[best] <= t_stop && *n_ev < ev_cap) {
-                    ev_t[*n_ev] = roots[best];
-                    dense_eval(&s, roots[best], ev_x + *n_ev * n);
-                    ev_i[*n_ev] = best;
-                    ++*n_ev;
-                }
-                roots[best] = -INFINITY;
-                g_old[best] = g_new[best];   /* mark as consumed */
-                n_found--;
-                (void)n_found;
-            }
-        }
-        /* output */
-        if (n_eval > 0) {
-            while (*i_eval < n_eval && t_eval[*i_eval] <= t_stop) {
-                double te = t_eval[*i_eval];
-                out_t[*n_out] = te;
-                if (te == t_new && terminal < 0) {
-                    memcpy(out_x + *n_out * n, x_new, n * sizeof(double));
-                } else {
-                    r = dense_prepare(&s);
-                    if (r) { fail[0] = c.fail_t; status = r; goto done; }
-                    dense_eval(&s, te, out_x + *n_out * n);
-                }
-                ++*n_out; ++*i_eval;
-            }
-        }
-        if (terminal >= 0) {
-            r = dense_prepare(&s);
-            if (r) { fail[0] = c.fail_t; status = r; goto done; }
-            dense_eval(&s, t_stop, xe);
-            if (n_eval == 0) {
-                out_t[*n_out] = t_stop;
-                memcpy(out_x + *n_out * n, xe, n * sizeof(double));
-                ++*n_out;
-            }
+        double t_stop;
+        r = post_step(&s, &io, t_new, &t_stop);
+        if (r == JD_EVENT) {
             memcpy(x, xe, n * sizeof(double));
-            t = t_stop;
-            cnt[4] = 0;
-            status = JD_EVENT;
-            break;
+            t = t_stop; cnt[4] = 0; status = JD_EVENT; break;
         }
-        if (n_eval == 0) {
-            out_t[*n_out] = t_new;
-            memcpy(out_x + *n_out * n, x_new, n * sizeof(double));
-            ++*n_out;
-        }
+        if (r) { status = r; break; }
         memcpy(x, x_new, n * sizeof(double));
         memcpy(k0, K + S * n, n * sizeof(double));
-        if (nev) memcpy(g_old, g_new, nev * sizeof(double));
         t = t_new;
         double factor = en == 0.0 ? MAX_FACTOR : fmin(MAX_FACTOR, SAFETY * pow(en, m->err_exp));
         if (rejected) factor = fmin(1.0, factor);

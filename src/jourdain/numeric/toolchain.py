@@ -85,19 +85,24 @@ def build(key: str, source: str) -> ctypes.CDLL:
     d.mkdir(parents=True, exist_ok=True)
     so = d / f"{key}.so"
     src = d / f"{key}.c"
-    src.write_text(source)
-    # compile to a private name, then rename: concurrent builds never see a half-written file
+    # write and compile under private names, then rename: a concurrent build of the same key
+    # (another process) never sees a half-written source or library
     fd, tmp = tempfile.mkstemp(suffix=".so", dir=d)
     os.close(fd)
+    fd, tmp_c = tempfile.mkstemp(suffix=".c", dir=d)
+    with os.fdopen(fd, "w") as fh:
+        fh.write(source)
     try:
-        proc = subprocess.run([compiler(), *CFLAGS, "-o", tmp, str(src), "-lm"],
+        proc = subprocess.run([compiler(), *CFLAGS, "-o", tmp, tmp_c, "-lm"],
                               capture_output=True, text=True)
+        os.replace(tmp_c, src)  # kept for reading, also when the compiler fails
         if proc.returncode != 0:
             raise CompilerError(f"compiling {src} failed:\n{proc.stderr[-4000:]}")
         os.replace(tmp, so)
     finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+        for leftover in (tmp, tmp_c):
+            if os.path.exists(leftover):
+                os.unlink(leftover)
     lib = ctypes.CDLL(str(so))
     _loaded[key] = lib
     return lib
