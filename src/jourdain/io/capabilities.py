@@ -90,7 +90,16 @@ def linear_analysis(model: ModelFile, about: str | None,
                            "h_norm": float(np.abs(num["h"]).max(initial=0.0))}
     res["conservative"] = None
     res["modes"] = res["stability"] = None
-    if lin.is_time_invariant:
+    res["numerically_time_invariant"] = False
+    if not lin.is_time_invariant and _constant_in_time(lin, params, num):
+        # t enters only through terms that cancel (cos²(Ωt) + sin²(Ωt), cyclic coordinates):
+        # the system is time-invariant and the split and the eigenvalues apply
+        res["time_invariant"] = True
+        res["numerically_time_invariant"] = True
+        num = dict(num)
+        num.update(split(num["P"], num["Q"]))
+        res["numbers"] = num
+    if res["time_invariant"]:
         D, N = num["D"], num["N"]
         scale = max(1.0, float(np.abs(num["P"]).max()), float(np.abs(num["Q"]).max()),
                     float(np.abs(num["M_tilde"]).max()))
@@ -99,12 +108,27 @@ def linear_analysis(model: ModelFile, about: str | None,
                                    and res["h_norm"] <= 1e-9 * scale)
         try:
             from ..analysis.modes import modes, stability
+            from ..analysis.state_space import state_space
 
-            res["modes"] = modes(lin, t=t, parameters=params)
-            res["stability"] = stability(lin, t=t, parameters=params)
+            ss = state_space(lin, t, params, allow_time_variant=True)
+            res["modes"] = modes(ss)
+            res["stability"] = stability(ss)
         except ImportError:
             pass
     return res
+
+
+def _constant_in_time(lin: Any, params: Mapping[str, float] | None,
+                      at_t: Mapping[str, np.ndarray]) -> bool:
+    """Whether M̃, P, Q and B take the same values at several times."""
+    keys = ("M_tilde", "P", "Q", "B")
+    scale = max(1.0, *(float(np.abs(at_t[k]).max(initial=0.0)) for k in keys))
+    for tt in (0.37, 1.91, 4.6):
+        other = lin.evaluate(t=tt, parameters=params)
+        for k in keys:
+            if np.abs(np.asarray(other[k]) - np.asarray(at_t[k])).max(initial=0.0) > 1e-9 * scale:
+                return False
+    return True
 
 
 def jsonable(res: Mapping[str, Any]) -> dict[str, Any]:

@@ -10,8 +10,10 @@ SymEngine.
 from __future__ import annotations
 
 import re
+import time
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import TYPE_CHECKING, Any
 
 import symengine as se
@@ -26,6 +28,8 @@ if TYPE_CHECKING:
 MAX_DISPLAY_OPS = 600
 #: Entries up to this many operations are simplified for display (trigonometric identities).
 SIMPLIFY_OPS = 500
+#: Time budget (seconds) for simplifying the entries of one matrix for display.
+SIMPLIFY_SECONDS = 3.0
 
 _GREEK = {
     "alpha": "α", "beta": "β", "gamma": "γ", "delta": "δ", "epsilon": "ε", "zeta": "ζ",
@@ -116,23 +120,33 @@ def too_large(m: SymMatrix, max_ops: int = MAX_DISPLAY_OPS) -> bool:
 
 
 def to_sympy_matrix(m: SymMatrix, simplify: bool = True) -> Any:
-    """The matrix as SymPy, each entry lightly simplified (trigonometric identities) when small."""
+    """The matrix as SymPy, each entry lightly simplified (trigonometric identities) when small.
+
+    Simplification is for reading only; it stops after :data:`SIMPLIFY_SECONDS` per matrix
+    (the remaining entries are shown as derived) and its result is memoized per matrix.
+    """
+    return _sympy_matrix(m, simplify)
+
+
+@lru_cache(maxsize=64)
+def _sympy_matrix(m: SymMatrix, simplify: bool) -> Any:
     import sympy
 
     memo: dict = {}
+    deadline = time.perf_counter() + SIMPLIFY_SECONDS
     rows = []
     for r in m.rows:
         row = []
         for e in r:
             s = to_sympy(e, memo)
-            if simplify and e.free_symbols:
+            if simplify and e.free_symbols and time.perf_counter() < deadline:
                 n = sympy.count_ops(s)
                 if n <= SIMPLIFY_OPS:
                     short = sympy.trigsimp(sympy.expand(s))
                     s = short if sympy.count_ops(short) <= n else s
             row.append(s)
         rows.append(row)
-    return sympy.Matrix(rows)
+    return sympy.ImmutableMatrix(rows)
 
 
 # ------------------------------------------------------------------------------------------

@@ -565,6 +565,10 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
             keys = ["M_tilde", "P", "Q", "h"]
             if res["time_invariant"]:
                 keys += ["D", "G", "K", "N"]
+                if res.get("numerically_time_invariant"):
+                    s.append("<p class='meta'>t appears in the expressions but cancels: M̃, P, "
+                             "Q (and B) take the same values at every time checked, so the "
+                             "system is time-invariant.</p>")
             else:
                 s.append(_note("time-variant linearization ("
                                + ", ".join(res["linearization"].time_dependence)
