@@ -198,11 +198,55 @@ def test_ctrl_c_keeps_results(tmp_path):
         s.simulate((0, 2), [0.0, 3.0], [0, 0], inputs={"F": force}, raise_on_interrupt=True)
 
 
-def test_progress_and_chunked_output():
+def test_progress_and_chunked_output(tmp_path):
     s = n_link_pendulum_on_cart(1)
     seen = []
-    # tiny steps: several chunks of the C loop, the same numbers as one run
-    res = s.simulate((0, 20), [0.0, 3.0], [0, 0], inputs={"F": 0.0}, max_step=5e-4,
-                     progress=lambda t, t1: seen.append(t))
+    kw = {"inputs": {"F": 0.0}, "rtol": 1e-9, "atol": 1e-9}
+    # tiny steps: many chunks of the C loop, written to the file as they come
+    res = s.simulate((0, 20), [0.0, 3.0], [0, 0], max_step=5e-4, output=str(tmp_path / "r.h5"),
+                     progress=lambda t, t1: seen.append((t, t1)), **kw)
     assert res.status == "finished" and res.t[-1] == 20.0
     assert len(res.t) > 40000 and np.all(np.diff(res.t) > 0)
+    assert len(seen) > 30 and all(b == 20.0 for _, b in seen)
+    assert np.all(np.diff([a for a, _ in seen]) > 0)
+    # chunking does not change the motion: one long run at the same step limit agrees
+    whole = s.simulate((0, 20), [0.0, 3.0], [0, 0], max_step=5e-4, t_eval=[20.0], **kw)
+    np.testing.assert_allclose(whole.y[-1], res.y[-1], atol=1e-9)
+    back = jd.Results.load(tmp_path / "r.h5")
+    np.testing.assert_array_equal(back.t, res.t)
+
+
+def test_partial_file_of_a_killed_run_is_readable(tmp_path):
+    """What a run killed by the system (no chance to finish the file) leaves behind."""
+    from jourdain.results import append_incremental, open_incremental
+
+    s = n_link_pendulum_on_cart(1)
+    res = s.simulate((0, 1), [0.0, 3.0], [0, 0], inputs={"F": 0.0})
+    h = open_incremental(tmp_path / "killed.h5", s)
+    x = np.c_[res.y, res.yd, res.W]
+    append_incremental(h, res.t[:10], x[:10])
+    append_incremental(h, res.t[10:20], x[10:20])
+    h.close()
+    back = jd.Results.load(tmp_path / "killed.h5")
+    assert back.status == "running" and "killed" in back.message
+    np.testing.assert_array_equal(back.y, res.y[:20])
+    np.testing.assert_array_equal(back.W, res.W[:20])
+
+
+def test_failure_keeps_the_motion_up_to_it():
+    """A point mass in polar coordinates (angle a, radius x) pulled to the centre by an
+    overdamped spring: M = diag(m x², m) loses positive definiteness as x -> 0. The error names
+    the time and state; the motion before it is on the exception."""
+    a, x, m = jd.symbols("a x m")
+    arm = jd.Body("arm", "world", jd.Revolute("pivot", a, "z"), mass=0, inertia=jd.point_mass())
+    bead = jd.Body("bead", "arm", jd.Prismatic("slot", x, "x"), mass=m, inertia=jd.point_mass())
+    s = jd.System([a, x], [arm, bead], [jd.RotationalSpringDamper("pull", x, 100.0, 25.0)],
+                  parameters={"m": 1.0}, name="polar bead")
+    # x'' + 25 x' + 100 x = 0 from x = 1, x' = 5: x(t) = exp(-5 t), which reaches
+    # sqrt(1e-13) (the relative pivot limit of the Cholesky factorization) at t ≈ 3.0
+    with pytest.raises(jd.SingularMassMatrix, match=r"polar bead.*t = 2\.9") as info:
+        s.simulate((0, 10), [0.0, 1.0], [0.0, -5.0], rtol=1e-10, atol=1e-12)
+    res = info.value.results
+    assert res.status == "failed" and "not positive definite" in res.message
+    assert 2.5 < res.t[-1] < 3.0
+    np.testing.assert_allclose(res.y[:, 1], np.exp(-5 * res.t), rtol=1e-6, atol=1e-12)

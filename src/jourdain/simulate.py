@@ -305,7 +305,8 @@ def simulate(system: System, t_span: tuple[float, float], y0: Any, yd0: Any,
     t_eval : output times (continuous extension); default: every accepted step
     events : :class:`Event` objects
     max_step, first_step : step size limits
-    progress : True prints the progress to stderr; a callable gets ``(t, t1)``
+    progress : True prints the progress to stderr (every 0.5 s); a callable gets ``(t, t1)``
+        after every chunk of the C loop (at most 20000 steps or 1024 output points)
     output : path of a results file (``.h5``) written as the run goes
     raise_on_interrupt : re-raise KeyboardInterrupt after keeping the results
 
@@ -320,7 +321,8 @@ def simulate(system: System, t_span: tuple[float, float], y0: Any, yd0: Any,
     SingularMassMatrix
         ``M`` lost positive definiteness (the time and state are in the message).
     IntegrationError
-        a NaN/inf in the state, a step size underflow, a failing input function.
+        a NaN/inf in the state or a step size underflow (time and state in the message).
+        Both carry the motion up to the failure as ``exc.results`` (C methods).
     EvaluationError
         bad arguments (wrong sizes, NaN initial values, unknown names).
     """
@@ -365,6 +367,10 @@ def simulate(system: System, t_span: tuple[float, float], y0: Any, yd0: Any,
     res = _results(setup, run, method, rtol, a, p)
     if output is not None:
         res.save(output)
+    if run.get("error") is not None:
+        # the motion up to the failure is kept on the exception (and in ``output``)
+        run["error"].results = res
+        raise run["error"]
     if res.interrupted and raise_on_interrupt and isinstance(run.get("exception"),
                                                              KeyboardInterrupt):
         raise run["exception"]
@@ -405,6 +411,8 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
     status = "finished"
     message = "reached the end of t_span"
     exception: BaseException | None = None
+    error: JourdainError | None = None
+    written = 0
     max_steps = 20000
     t_last_report = time.perf_counter()
     try:
@@ -424,6 +432,9 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
                 chunks_x.append(out_x[:n_out[0]])
                 if writer:
                     writer.append(chunks_t[-1], chunks_x[-1])
+            elif writer:
+                writer.append(out_t[written:n_out[0]], out_x[written:n_out[0]])
+                written = int(n_out[0])
             if code < 0:
                 if code == _ECALLBACK and isinstance(setup.callback_error, KeyboardInterrupt):
                     raise setup.callback_error
@@ -431,7 +442,8 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
                 if code == _ECALLBACK:
                     status, message, exception = "interrupted", str(err), setup.callback_error
                     break
-                raise err
+                status, message, error = "failed", str(err), err
+                break
             if code == _EVENT:
                 k = int(ev_i[n_ev[0] - 1])
                 status = "event"
@@ -440,13 +452,12 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
             if code == _DONE:
                 break
             now = time.perf_counter()
-            if progress and now - t_last_report > 0.5:
+            if callable(progress):
+                progress(float(st[0]), t1)
+            elif progress and now - t_last_report > 0.5:
                 t_last_report = now
-                if callable(progress):
-                    progress(float(st[0]), t1)
-                else:
-                    print(f"\rsimulating {system.name}: t = {st[0]:.4g} of {t1:.4g} "
-                          f"({100 * (st[0] - t0) / (t1 - t0):.0f} %)", end="", file=sys.stderr)
+                print(f"\rsimulating {system.name}: t = {st[0]:.4g} of {t1:.4g} "
+                      f"({100 * (st[0] - t0) / (t1 - t0):.0f} %)", end="", file=sys.stderr)
     except KeyboardInterrupt as exc:
         status = "interrupted"
         message = f"interrupted by the user (Ctrl-C) at t = {st[0]:.9g}; results up to there kept"
@@ -464,7 +475,7 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
     if nev and m == ev_cap:
         message += f"; only the first {ev_cap} event crossings were recorded"
     return {"t": t_out, "x": x_out, "status": status, "message": message,
-            "exception": exception, "nfev": int(cnt[0]), "nstep": int(cnt[1]),
+            "exception": exception, "error": error, "nfev": int(cnt[0]), "nstep": int(cnt[1]),
             "naccept": int(cnt[2]), "nreject": int(cnt[3]),
             "events": (ev_t[:m].copy(), ev_x[:m].copy(), ev_i[:m].copy())}
 
@@ -567,7 +578,16 @@ def accelerations(mkq: CompiledFunction, y: np.ndarray, yd: np.ndarray, t: np.nd
         return np.zeros((0, f))
     out = mkq.batch(y, yd, t, p, u if u.shape[1] else None)
     M, k, q = out["M"], out["k"][:, :, 0], out["q"][:, :, 0]
-    return np.linalg.solve(M, (q - k)[:, :, None])[:, :, 0]
+    try:
+        return np.linalg.solve(M, (q - k)[:, :, None])[:, :, 0]
+    except np.linalg.LinAlgError:  # a singular state (kept by a failed run): NaN there
+        ydd = np.full((n, f), np.nan)
+        for i in range(n):
+            try:
+                ydd[i] = np.linalg.solve(M[i], q[i] - k[i])
+            except np.linalg.LinAlgError:
+                pass
+        return ydd
 
 
 class _Writer:
