@@ -1,0 +1,115 @@
+"""The HTML report of ``jourdain run``: self-contained, and its equations render in a browser.
+
+The browser test uses headless Chromium (Debian's ``chromium`` package; ``make test`` installs it
+when missing and it runs as root). Without it the test is skipped with the reason.
+"""
+
+import os
+import re
+import shutil
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from jourdain.io import load_model
+from jourdain.io.report import write_report
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope="module")
+def report(tmp_path_factory) -> Path:
+    out = tmp_path_factory.mktemp("report")
+    info = write_report(load_model(ROOT / "examples" / "double_pendulum.toml"), out)
+    assert info.html == out / "report.html"
+    return out
+
+
+def test_report_is_self_contained(report):
+    text = (report / "report.html").read_text()
+    # no scripts, no external resources: opens offline, from a mail attachment, in ten years
+    assert "<script" not in text.lower()
+    urls = set(re.findall(r"(?:src|href)=['\"]([^'\"]+)", text))
+    assert all(not u.startswith(("http:", "https:", "//")) for u in urls), urls
+    assert text.count("<math") >= 10  # headline equations, M̄, J̄, q̄^c, q̄^e, M, k, q, symbols
+    assert text.count("<svg") >= 5  # plots, eigenvalues, snapshot strip, animation
+    assert "<animate " in text
+    for name in ("hinge1.F_x", "marginally stable", "unstable", "conservative"):
+        assert name in text
+
+
+def test_report_data_files_agree_with_the_model(report):
+    import json
+
+    values = json.loads((report / "values.json").read_text())
+    model = load_model(ROOT / "examples" / "double_pendulum.toml")
+    ref = model.system.evaluate(values["y"], values["yd"])
+    np.testing.assert_allclose(values["values"]["M"], ref["M"], rtol=1e-12)
+    lin = json.loads((report / "linearization-hanging.json").read_text())
+    assert lin["stability"]["verdict"] == "marginally stable"
+    header = [ln for ln in (report / "simulation.csv").read_text().splitlines()
+              if not ln.startswith("#")][0]
+    assert header.split(",")[:3] == ["t", "phi1", "phi2"]
+
+
+def _chromium() -> str | None:
+    for name in ("chromium", "chromium-browser", "google-chrome"):
+        exe = shutil.which(name)
+        if exe:
+            return exe
+    return None
+
+
+def _screenshot(exe: str, page: Path, png: Path, size: str, tmp: Path) -> None:
+    cmd = [exe, "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
+           "--no-first-run", "--disable-background-networking", "--disable-component-update",
+           "--disable-sync", "--hide-scrollbars", f"--user-data-dir={tmp / 'profile'}",
+           f"--window-size={size}", f"--screenshot={png}", page.as_uri()]
+    subprocess.run(cmd, capture_output=True, timeout=120, env={**os.environ, "HOME": str(tmp)})
+
+
+def _ink_box(png: Path) -> tuple[int, int]:
+    """Width and height of the non-white part of a screenshot."""
+    from PIL import Image
+
+    a = np.asarray(Image.open(png).convert("L"))
+    rows = np.flatnonzero((a < 200).any(axis=1))
+    cols = np.flatnonzero((a < 200).any(axis=0))
+    if rows.size == 0:
+        return 0, 0
+    return int(cols[-1] - cols[0] + 1), int(rows[-1] - rows[0] + 1)
+
+
+def test_equations_render_in_headless_chromium(report, tmp_path):
+    exe = _chromium()
+    if exe is None:
+        pytest.skip("headless Chromium not found (Debian: apt-get install chromium; `make test` "
+                    "installs it when run as root); the browser rendering check is skipped")
+    text = (report / "report.html").read_text()
+    # the full report, for a person to look at
+    full = tmp_path / "report.png"
+    _screenshot(exe, report / "report.html", full, "1200,3000", tmp_path)
+    assert full.is_file() and full.stat().st_size > 20_000, "Chromium wrote no screenshot"
+    # one equation alone: rendered MathML lays the 2×2 mass matrix with its fractions out in
+    # two dimensions; without MathML support the same markup is a single line of text
+    style = re.search(r"<style>(.*?)</style>", text, re.S).group(1)
+    eq = [m for m in re.findall(r'<div class="eq">(.*?)</div>', text, re.S)
+          if "<mrow><mi>M</mi><mo>=</mo>" in m and "<mtable" in m][0]
+    page = tmp_path / "eq.html"
+    page.write_text(f"<!DOCTYPE html><html><head><meta charset='utf-8'><style>{style}"
+                    f"body{{margin:10px;max-width:none}}</style></head><body>{eq}</body></html>")
+    plain = tmp_path / "plain.html"
+    plain.write_text(page.read_text().replace("<math", "<span").replace("</math>", "</span>"))
+    png, png_plain = tmp_path / "eq.png", tmp_path / "plain.png"
+    _screenshot(exe, page, png, "1400,600", tmp_path)
+    _screenshot(exe, plain, png_plain, "1400,600", tmp_path)
+    w, h = _ink_box(png)
+    w0, h0 = _ink_box(png_plain)
+    assert h > 0 and h0 > 0, "nothing rendered"
+    # two matrix rows of stacked fractions: several text lines tall, and narrower than the
+    # same symbols strung out on a line
+    print("ink boxes (MathML, plain):", (w, h), (w0, h0))
+    assert h >= 2.5 * h0, (w, h, w0, h0)
+    assert w < w0, (w, h, w0, h0)
