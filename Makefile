@@ -5,7 +5,7 @@ PYTHON ?= python3
 VENV   ?= .venv
 BIN    := $(VENV)/bin
 
-.PHONY: run test lint clean
+.PHONY: run test lint clean browser
 
 $(BIN)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -14,12 +14,22 @@ $(BIN)/.installed: pyproject.toml
 	touch $@
 
 run: $(BIN)/.installed
-	$(BIN)/python -m jourdain.demo
+	$(BIN)/jourdain run examples/double_pendulum.toml --out report/
 
 lint: $(BIN)/.installed
 	$(BIN)/ruff check src tests benchmarks
 
-test: lint
+# headless Chromium for the report's browser test: installed when missing and running as root
+# with apt-get; otherwise that one test is skipped with the reason
+browser:
+	@command -v chromium >/dev/null 2>&1 || command -v chromium-browser >/dev/null 2>&1 || \
+	{ if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
+	    echo "installing chromium (Debian package) for the report's browser test"; \
+	    (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium) \
+	      >/dev/null 2>&1 || echo "chromium could not be installed: the browser test will be skipped"; \
+	  else echo "chromium not found and not root: the report's browser test will be skipped"; fi; }
+
+test: lint browser
 	$(BIN)/python -m pytest -q
 
 clean:
