@@ -101,10 +101,13 @@ class _Frame:
     omega: Vec3 = Z3
     omega_bar: Vec3 = Z3
     alpha_bar: Vec3 = Z3
+    # a_bar as the sum of its pieces S_k·v_k: ((orientation of frame k, v_k), ...)
+    a_pieces: tuple = ()
 
     def copy(self) -> _Frame:
         return _Frame(self.S, self.identity, self.axis, self.r, dict(self.JT), self.v_bar,
-                      self.a_bar, dict(self.JR), self.omega, self.omega_bar, self.alpha_bar)
+                      self.a_bar, dict(self.JR), self.omega, self.omega_bar, self.alpha_bar,
+                      self.a_pieces)
 
 
 class _Rates:
@@ -146,6 +149,18 @@ class _Context:
     index: dict[se.Symbol, int]
     yd: tuple[se.Symbol, ...]
     t: se.Symbol
+    # columns of J_T that are one rotated local vector S·v: id(col) -> (col, orientation, v)
+    pure: dict[int, tuple] = field(default_factory=dict)
+
+
+def orientation(F: _Frame) -> tuple:
+    """How a frame's S is known: ("I",), ("axis", u, θ) for rotations about one fixed axis
+    u from the inertial frame, or ("S", S)."""
+    if F.identity:
+        return ("I",)
+    if F.axis is not None:
+        return ("axis", F.axis[0], F.axis[1])
+    return ("S", F.S)
 
 
 def _rotate(F: _Frame, u: Vec3, angle: se.Basic, ctx: _Context) -> None:
@@ -203,8 +218,16 @@ def _translate(F: _Frame, d: Vec3, ctx: _Context) -> None:
         dj = tuple(rt.dy.get(j, ZERO) for rt in rates)
         if not _is_zero(dj):  # type: ignore[arg-type]
             local = _add(local, dj)  # type: ignore[arg-type]
-        col = F.JT.get(j, Z3)
-        newJT[j] = _add(col, toI(local)) if not _is_zero(local) else col
+        if _is_zero(local):
+            newJT[j] = F.JT.get(j, Z3)
+        elif j in F.JT:
+            newJT[j] = _add(F.JT[j], toI(local))
+        else:
+            # remember S and v of a column S·v: dot products of such columns are formed from the
+            # local vectors (no sin² + cos² of components, see jourdain.projection)
+            col = toI(local)
+            newJT[j] = col
+            ctx.pure[id(col)] = (col, orientation(F), local)
     F.JT = newJT
     d_t: Vec3 = tuple(rt.dt for rt in rates)  # type: ignore[assignment]
     d_1: Vec3 = tuple(rt.d1 for rt in rates)  # type: ignore[assignment]
@@ -214,6 +237,8 @@ def _translate(F: _Frame, d: Vec3, ctx: _Context) -> None:
     if not _is_zero(d_1):
         acc = _add(acc, _add(_scale(_cross(F.omega, d_1), se.Integer(2)), d_2))
     F.a_bar = _add(F.a_bar, toI(acc))
+    if not _is_zero(acc):
+        F.a_pieces = (*F.a_pieces, (orientation(F), acc))
 
 
 @dataclass(frozen=True)
@@ -245,6 +270,8 @@ class BodyKinematics:
     cols_T: MappingProxyType = field(repr=False, compare=False)
     cols_R: MappingProxyType = field(repr=False, compare=False)
     cols_T_O: MappingProxyType = field(repr=False, compare=False)
+    #: a_bar as pieces S_k·v_k, ((orientation, v_k), ...), see :func:`orientation`
+    a_bar_pieces: tuple = field(default=(), repr=False, compare=False)
 
     def point(self, p: Vec3) -> tuple[Vec3, dict[int, Vec3], Vec3, Vec3]:
         """Position, J_T columns, v̄ and ā (inertial) of the point ``p`` (body-frame, from the
@@ -285,6 +312,9 @@ class Kinematics:
     yd: tuple[se.Symbol, ...]
     ydd: tuple[se.Symbol, ...]
     t: se.Symbol
+    #: columns of J_T known as one rotated local vector: id(col) -> (col, orientation, v)
+    pure_columns: MappingProxyType = field(default_factory=lambda: MappingProxyType({}),
+                                           repr=False, compare=False)
 
     def __getitem__(self, name: str) -> BodyKinematics:
         for b in self.bodies:
@@ -300,12 +330,19 @@ def kinematics(system: System) -> Kinematics:
     ctx = _Context({c: i for i, c in enumerate(y)}, tuple(rate(c) for c in y), system.t)
     f = len(y)
     frames: dict[str, _Frame] = {"world": _Frame()}
+    coms: dict[str, tuple[Vec3, _Frame]] = {}
     out = []
     for body in system.bodies:
-        F = frames[body.parent].copy()
         j = body.joint
-        # joint frame on the parent, then the joint's elementary transformations
-        _translate(F, j.position, ctx)
+        # joint frame on the parent, then the joint's elementary transformations; a joint point at
+        # the parent's centre of mass (a chain of point masses) reuses that state, so that equal
+        # Jacobian columns are the same objects and the projection collects their masses
+        com = coms.get(body.parent)
+        if com is not None and com[0] == j.position:
+            F = com[1].copy()
+        else:
+            F = frames[body.parent].copy()
+            _translate(F, j.position, ctx)
         _reorient(F, j.orientation)
         for step in j.steps:
             if isinstance(step, Rot):
@@ -316,6 +353,7 @@ def kinematics(system: System) -> Kinematics:
         # centre of mass
         C = F.copy()
         _translate(C, body.com, ctx)
+        coms[body.name] = (body.com, C)
         col = SymMatrix.column
         out.append(BodyKinematics(
             name=body.name, r=col(C.r), S=SymMatrix.from_rows(F.S), omega=col(F.omega),
@@ -323,6 +361,7 @@ def kinematics(system: System) -> Kinematics:
             omega_bar=col(F.omega_bar), a_bar=col(C.a_bar), alpha_bar=col(F.alpha_bar),
             r_O=col(F.r), J_T_O=_dense(F.JT, f), v_bar_O=col(F.v_bar), a_bar_O=col(F.a_bar),
             cols_T=MappingProxyType(C.JT), cols_R=MappingProxyType(F.JR),
-            cols_T_O=MappingProxyType(F.JT),
+            cols_T_O=MappingProxyType(F.JT), a_bar_pieces=C.a_pieces,
         ))
-    return Kinematics(system, tuple(out), y, ctx.yd, tuple(acceleration(c) for c in y), system.t)
+    return Kinematics(system, tuple(out), y, ctx.yd, tuple(acceleration(c) for c in y), system.t,
+                      MappingProxyType(ctx.pure))
