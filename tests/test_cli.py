@@ -272,3 +272,15 @@ def test_reactions_command(capsys):
     # the rod (body y axis, from the bob towards the hinge)
     assert g["hinge.F_y"] == pytest.approx(1.0 * (9.81 + 1.0 * 2.0**2), rel=1e-12)
     assert g["hinge.F_x"] == pytest.approx(0.0, abs=1e-12)
+
+
+def test_linearize_slider_on_rotating_rod_relative_equilibrium(capsys):
+    """In the rod turning at Omega the spring balances the centrifugal force at
+    s = c·L0/(c − m·Ω²); the stiffness about it is c − m·Ω², the damping d."""
+    data = _lin(capsys, "slider_on_rotating_rod")
+    m, c, d, Om = 0.5, 50.0, 0.2, 6.0
+    assert data["h_norm"] == pytest.approx(0.0, abs=1e-12)
+    assert data["matrices"]["K"][0][0] == pytest.approx(c - m * Om**2, rel=1e-12)
+    assert data["matrices"]["D"][0][0] == pytest.approx(d, rel=1e-12)
+    assert data["matrices"]["M_tilde"][0][0] == pytest.approx(m, rel=1e-12)
+    assert data["stability"]["verdict"] == "asymptotically stable"

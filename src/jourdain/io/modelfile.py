@@ -136,7 +136,7 @@ class ModelFile:
 # ------------------------------------------------------------------------------------------
 
 _TOP = {"model", "coordinates", "parameters", "inputs", "bodies", "forces", "nominal",
-        "simulation", "report"}
+        "simulation"}
 _JOINT_KEYS: dict[str, set[str]] = {
     "revolute": {"coordinate", "axis"},
     "prismatic": {"coordinate", "axis"},

@@ -371,6 +371,18 @@ def _note(text: str) -> str:
     return f'<p class="note">{_e(text)}</p>'
 
 
+def _prescribed_joints(system: Any) -> list[str]:
+    """Joints whose steps depend on t explicitly (rheonomic drives)."""
+    out = []
+    for b in system.bodies:
+        for st in b.joint.steps:
+            exprs = [st.angle] if hasattr(st, "angle") else list(st.vector)
+            if any("t" in {str(x) for x in e.free_symbols} for e in exprs):
+                out.append(b.joint.name)
+                break
+    return out
+
+
 def _display_matrix(name: str, m: Any, system: Any, max_ops: int) -> str:
     rows, cols = m.shape
     if rows > MAX_DISPLAY_ROWS:
@@ -641,11 +653,15 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
                 s.append(_time_plot(res.t, {"T (kinetic)": Tk, "V (potential)": V,
                                             "T + V − W_nc": Tk + V - W},
                                     "energy", "energy balance"))
+                driven = _prescribed_joints(system)
+                why = (f" — not expected to close: the prescribed motion of "
+                       f"{', '.join(driven)} does work on the system" if driven else "")
                 s.append(f"<p class='meta'>energy balance error (relative): "
-                         f"{res.energy_balance_error:.2e}</p>")
+                         f"{res.energy_balance_error:.2e}{_e(why)}</p>")
                 info.summary_lines.append(
                     f"  simulated t = 0 … {res.t[-1]:g} s, energy balance error "
-                    f"{res.energy_balance_error:.1e}")
+                    f"{res.energy_balance_error:.1e}"
+                    + (" (prescribed motion does work)" if driven else ""))
             except (JourdainError, KeyError, AttributeError, ValueError) as exc:
                 s.append(_note(f"energies not available: {exc}"))
                 info.summary_lines.append(f"  simulated t = 0 … {res.t[-1]:g} s")
