@@ -317,13 +317,31 @@ _NUMPY = {"sin": np.sin, "cos": np.cos, "tan": np.tan, "exp": np.exp, "log": np.
           "sinh": np.sinh, "cosh": np.cosh, "tanh": np.tanh, "sign": np.sign}
 
 
+def _key1(e: se.Basic) -> tuple:
+    args = e.args
+    if not args:
+        return (type(e).__name__, hash(e), str(e))
+    return (type(e).__name__, hash(e), tuple(sorted(hash(a) for a in args)))
+
+
+def _node_key(e: se.Basic) -> tuple:
+    """Structural fingerprint of a node over three levels. SymEngine's hash of a sum ignores
+    the coefficients of its terms (x + y and 2x + 2y share it), its children's hashes do not;
+    ``==`` cannot be used, it walks whole trees on distinct but equal nodes of a DAG."""
+    args = e.args
+    if not args:
+        return (type(e).__name__, hash(e), str(e))
+    return (type(e).__name__, hash(e), tuple(sorted(_key1(a) for a in args)))
+
+
 def graph_values(exprs: Sequence[se.Basic], values: Mapping[se.Basic, Any]) -> list[Any]:
     """Numeric values of ``exprs`` for the symbol values ``values`` (NumPy arrays broadcast), each
-    distinct node of the shared expression graph evaluated once."""
-    from . import cse as _cse
+    distinct node of the shared expression graph evaluated once.
 
-    exprs = list(exprs)
-    g = _cse.Graph(exprs)
+    Nodes are looked up by :func:`_node_key` and confirmed with ``==``, which SymEngine answers
+    at once for the same shared node; a fingerprint alone is not exact (two different nodes of
+    a large graph can share it, which gave wrong numbers here).
+    """
     given = {k: np.asarray(v, dtype=float) for k, v in values.items()}
 
     def atom(a: se.Basic) -> Any:
@@ -333,30 +351,60 @@ def graph_values(exprs: Sequence[se.Basic], values: Mapping[se.Basic, Any]) -> l
             raise EvaluationError(f"no value for symbol {a}")
         return float(a)
 
-    val: dict[Any, Any] = {}
-    for h in g.order:
-        node = g.node[h]
-        args = [atom(a) if ka is None else val[ka]
-                for a, ka in zip(g.args[h], g.arg_ids[h], strict=True)]
-        name = type(node).__name__
-        if name == "Add":
-            r = args[0]
-            for x in args[1:]:
-                r = r + x
-        elif name == "Mul":
-            r = args[0]
-            for x in args[1:]:
-                r = r * x
-        elif name == "Pow":
-            r = np.power(args[0], args[1])
-        elif name in _NUMPY:
-            r = _NUMPY[name](*args)
-        elif name == "atan2":
-            r = np.arctan2(*args)
-        else:
-            r = np.vectorize(lambda *xs, f=node.func: float(f(*(se.Float(x) for x in xs))))(*args)
-        val[h] = r
-    return [atom(e) if r is None else val[r] for e, r in zip(exprs, g.root_ids, strict=True)]
+    memo: dict[tuple, list[tuple[se.Basic, Any]]] = {}
+
+    def lookup(e: se.Basic, k: tuple) -> tuple[bool, Any]:
+        for node, v in memo.get(k, ()):
+            if node == e:
+                return True, v
+        return False, None
+
+    out: list[Any] = []
+    for root in exprs:
+        if not root.args:
+            out.append(atom(root))
+            continue
+        rk = _node_key(root)
+        stack: list[tuple[se.Basic, tuple, list | None]] = [(root, rk, None)]
+        while stack:
+            node, k, kids = stack.pop()
+            if kids is None:
+                if lookup(node, k)[0]:
+                    continue
+                args = node.args
+                kids = [_node_key(a) if a.args else None for a in args]
+                stack.append((node, k, kids))
+                stack.extend((a, ka, None) for a, ka in zip(args, kids, strict=True)
+                             if ka is not None)
+                continue
+            if lookup(node, k)[0]:
+                continue
+            a_vals = [lookup(a, ka)[1] if ka is not None else atom(a)
+                      for a, ka in zip(node.args, kids, strict=True)]
+            memo.setdefault(k, []).append((node, _apply(node, a_vals)))
+        out.append(lookup(root, rk)[1])
+    return out
+
+
+def _apply(node: se.Basic, args: list[Any]) -> Any:
+    name = type(node).__name__
+    if name == "Add":
+        r = args[0]
+        for x in args[1:]:
+            r = r + x
+        return r
+    if name == "Mul":
+        r = args[0]
+        for x in args[1:]:
+            r = r * x
+        return r
+    if name == "Pow":
+        return np.power(args[0], args[1])
+    if name in _NUMPY:
+        return _NUMPY[name](*args)
+    if name == "atan2":
+        return np.arctan2(*args)
+    return np.vectorize(lambda *xs: float(node.func(*(se.Float(x) for x in xs))))(*args)
 
 
 def _sample_values(exprs: list[se.Basic], coordinates: Sequence[se.Symbol],
@@ -661,8 +709,6 @@ def check_orthogonality(ne: NewtonEuler, Q_bar: SymMatrix, joints: Sequence[Join
     J = ne.J_bar
     n6, f = J.shape
     q = Q_bar.shape[1]
-    if q == 0:
-        return 0.0
     rng = np.random.default_rng(seed)
     exprs = J.entries() + Q_bar.entries()
     vals = _sample_values(exprs, system.coordinates, system.parameter_values, rng, samples)
@@ -674,7 +720,7 @@ def check_orthogonality(ne: NewtonEuler, Q_bar: SymMatrix, joints: Sequence[Join
         scale = np.abs(Jn[:, :, s]).T @ np.abs(Qn[:, :, s])
         scale_col = scale.max(axis=0) + 1e-300
         rel = np.abs(JQ).max(axis=0) / scale_col
-        worst = max(worst, float(rel.max()))
+        worst = max(worst, float(rel.max())) if rel.size else worst
         bad = np.nonzero(rel > 1e-9)[0]
         if bad.size:
             c = int(bad[0])
@@ -686,6 +732,23 @@ def check_orthogonality(ne: NewtonEuler, Q_bar: SymMatrix, joints: Sequence[Join
                 f"(J̄ᵀQ̄ ≠ 0 in the row of coordinate {system.coordinates[k]}, relative residual "
                 f"{rel[c]:.2e}); the orthogonality relation J̄ᵀ·Q̄ = 0 fails"
             )
+    # completeness: [J̄, Q̄] must span all 6p directions, else some reaction is missing from Q̄
+    A = np.concatenate([Jn[:, :, 0], Qn[:, :, 0]], axis=1)
+    sv = np.linalg.svd(A, compute_uv=False)
+    rank = int((sv > 1e-9 * sv[0]).sum())
+    if rank < n6:
+        # a joint that moves with coordinates it does not drive (gears, a screw turned by
+        # another joint's angle) couples two joints: that coupling force is no joint's reaction
+        odd = [f'"{jr.joint.name}" (moves in {6 - len(jr.names)} directions, drives '
+               f"{len(jr.joint.coordinates)} coordinate(s))" for jr in joints
+               if jr.joint.kind == "general" and 6 - len(jr.names) != len(jr.joint.coordinates)]
+        raise ModelError(
+            f"the joints' constrained directions and the motions span only {rank} of the 6p = "
+            f"{n6} directions: the reactions need every joint to move only with the coordinates "
+            "it drives; "
+            + (f"check joint(s) {', '.join(odd)}" if odd else
+               "check the constrained directions given for general joints")
+        )
     return worst
 
 
