@@ -7,7 +7,21 @@ equations of motion M·ÿ + k = q.
 
 from symengine import atan2, cos, exp, log, pi, sin, sqrt, tan
 
+from .analysis import (
+    FrequencyResponse,
+    Modes,
+    Stability,
+    StateSpace,
+    Sweep,
+    frequency_response,
+    modes,
+    stability,
+    stability_boundary,
+    state_space,
+    sweep,
+)
 from .energy import Energy, energy
+from .equilibrium import Equilibrium, NoEquilibrium, find_equilibria, find_equilibrium
 from .errors import EvaluationError, JourdainError, ModelError, SingularMassMatrix
 from .kinematics import BodyKinematics, Kinematics, kinematics
 from .linearization import (
@@ -65,6 +79,9 @@ __all__ = [
     "BodyKinematics", "Kinematics", "kinematics", "NewtonEuler", "newton_euler",
     "EquationsOfMotion", "projection", "SymMatrix",
     "CompiledLinearization", "Linearization", "TimeVariantError", "linearization",
+    "FrequencyResponse", "Modes", "Stability", "StateSpace", "Sweep", "frequency_response",
+    "modes", "stability", "stability_boundary", "state_space", "sweep",
+    "Equilibrium", "NoEquilibrium", "find_equilibria", "find_equilibrium",
     "JointReactions", "Reactions", "evaluate_reactions", "joint_reactions", "reactions",
     "Results", "Event", "IntegrationError", "simulate", "Energy", "energy",
     "WORLD", "Body", "Cylindrical", "Fixed", "Force", "Free", "General", "GeneralizedForce",

@@ -1,0 +1,21 @@
+"""Analysis of linearized systems: state space, eigenvalues and modes, stability, frequency
+response, parameter sweeps (METHOD.md §6)."""
+
+from .frequency import FrequencyResponse, frequency_response
+from .modes import (
+    ASYMPTOTICALLY_STABLE,
+    MARGINALLY_STABLE,
+    UNSTABLE,
+    Modes,
+    Stability,
+    modes,
+    stability,
+)
+from .state_space import StateSpace, state_space
+from .sweep import Sweep, stability_boundary, sweep
+
+__all__ = [
+    "ASYMPTOTICALLY_STABLE", "MARGINALLY_STABLE", "UNSTABLE", "FrequencyResponse", "Modes",
+    "Stability", "StateSpace", "Sweep", "frequency_response", "modes", "stability",
+    "stability_boundary", "state_space", "sweep",
+]

@@ -1,0 +1,199 @@
+"""Eigenvalues, modes and the stability verdict of a linear time-invariant system.
+
+For ``ẋ = A·x`` with eigenvalues ``λ = δ ± iω_d``: the natural (undamped) angular frequency is
+``ω_n = |λ|``, the damping ratio ``ζ = −δ/|λ|``, the damped frequency ``ω_d = |Im λ|``; the mode
+shape is the position part (first f rows) of the eigenvector.
+
+Stability (Lyapunov, of the linear system): *asymptotically stable* when every eigenvalue has a
+negative real part; *marginally stable* when none has a positive real part and those on the
+imaginary axis are semisimple (as many independent eigenvectors as their multiplicity);
+*unstable* otherwise — an eigenvalue with a positive real part (real: divergence, complex:
+flutter) or a repeated eigenvalue on the imaginary axis with too few eigenvectors (secular,
+linearly growing motion, e.g. a free rigid-body coordinate).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..linearization import CompiledLinearization, Linearization
+from .state_space import StateSpace, state_space
+
+ASYMPTOTICALLY_STABLE = "asymptotically stable"
+MARGINALLY_STABLE = "marginally stable"
+UNSTABLE = "unstable"
+
+
+@dataclass(frozen=True)
+class Modes:
+    """Eigen-analysis of a state-space system, sorted by natural frequency (conjugate pairs
+    adjacent, the one with positive imaginary part first).
+
+    Attributes
+    ----------
+    eigenvalues : (2f,) complex array
+    vectors : (2f, 2f) complex array
+        Eigenvectors of A (columns), for the state ``[η; η̇]``.
+    shapes : (f, 2f) complex array
+        Mode shapes: the position part of each eigenvector, scaled so that its largest component
+        is 1.
+    natural_frequencies : (2f,) array
+        ``ω_n = |λ|`` in rad/s.
+    damping_ratios : (2f,) array
+        ``ζ = −Re λ / |λ|`` (1 for λ = 0 by convention is avoided: NaN there).
+    damped_frequencies : (2f,) array
+        ``|Im λ|`` in rad/s.
+    coordinate_names : tuple of str
+    """
+
+    eigenvalues: np.ndarray
+    vectors: np.ndarray
+    shapes: np.ndarray
+    natural_frequencies: np.ndarray
+    damping_ratios: np.ndarray
+    damped_frequencies: np.ndarray
+    coordinate_names: tuple[str, ...]
+
+    @property
+    def frequencies_hz(self) -> np.ndarray:
+        """Natural frequencies in Hz."""
+        return self.natural_frequencies / (2 * np.pi)
+
+    def oscillating(self) -> np.ndarray:
+        """Indices of one eigenvalue per oscillating mode (positive imaginary part)."""
+        scale = max(1.0, float(np.abs(self.eigenvalues).max(initial=0.0)))
+        return np.flatnonzero(self.eigenvalues.imag > 1e-9 * scale)
+
+    def __str__(self) -> str:
+        lines = [f"{'eigenvalue':>28}  {'f_n [Hz]':>10}  {'zeta':>8}"]
+        for lam, fn, z in zip(self.eigenvalues, self.frequencies_hz, self.damping_ratios,
+                              strict=True):
+            lines.append(f"{lam.real:>13.6g} {lam.imag:+13.6g}j  {fn:>10.5g}  {z:>8.4f}")
+        return "\n".join(lines)
+
+
+@dataclass(frozen=True)
+class Stability:
+    """Stability verdict of a linear time-invariant system.
+
+    ``verdict`` is one of ``"asymptotically stable"``, ``"marginally stable"``, ``"unstable"``;
+    ``reason`` says why in words; ``max_real_part`` is the largest real part of the eigenvalues;
+    ``critical`` the eigenvalues that decide the verdict.
+    """
+
+    verdict: str
+    reason: str
+    max_real_part: float
+    critical: np.ndarray
+
+    @property
+    def is_stable(self) -> bool:
+        """True for asymptotically or marginally stable."""
+        return self.verdict != UNSTABLE
+
+    def __str__(self) -> str:
+        return f"{self.verdict}: {self.reason}"
+
+
+def _as_state_space(system: StateSpace | Linearization | CompiledLinearization, t: float,
+                    parameters: Mapping[str, float] | None) -> StateSpace:
+    if isinstance(system, StateSpace):
+        return system
+    return state_space(system, t, parameters)
+
+
+def modes(system: StateSpace | Linearization | CompiledLinearization, t: float = 0.0,
+          parameters: Mapping[str, float] | None = None) -> Modes:
+    """Eigenvalues, natural frequencies, damping ratios and mode shapes.
+
+    ``system`` is a :class:`StateSpace` or a linearization (evaluated at ``t`` with
+    ``parameters``).
+    """
+    ss = _as_state_space(system, t, parameters)
+    lam, V = np.linalg.eig(ss.A)
+    order = np.lexsort((-lam.imag, np.round(np.abs(lam), 12)))
+    lam, V = lam[order], V[:, order]
+    f = ss.f
+    shapes = V[:f].copy()
+    for j in range(shapes.shape[1]):
+        col = shapes[:, j]
+        k = int(np.argmax(np.abs(col)))
+        if abs(col[k]) > 0:
+            shapes[:, j] = col / col[k]
+    wn = np.abs(lam)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        zeta = np.where(wn > 0, -lam.real / np.where(wn > 0, wn, 1.0), np.nan)
+    return Modes(eigenvalues=lam, vectors=V, shapes=shapes, natural_frequencies=wn,
+                 damping_ratios=zeta, damped_frequencies=np.abs(lam.imag),
+                 coordinate_names=ss.coordinate_names)
+
+
+def stability(system: StateSpace | Linearization | CompiledLinearization, t: float = 0.0,
+              parameters: Mapping[str, float] | None = None, rtol: float = 1e-8) -> Stability:
+    """Stability verdict with its reason (see the module docstring for the definitions).
+
+    ``rtol`` is the relative tolerance (to the largest |λ|, at least 1) below which a real part
+    counts as zero.
+    """
+    ss = _as_state_space(system, t, parameters)
+    A = ss.A
+    lam = np.linalg.eigvals(A)
+    n = lam.size
+    scale = max(1.0, float(np.abs(lam).max(initial=0.0)))
+    tol = rtol * scale
+    # eigenvalues that split from a defective (Jordan) eigenvalue sit about sqrt(eps)·scale
+    # apart; group them first and judge each group by its centre
+    cluster_tol = 1e3 * np.sqrt(np.finfo(float).eps) * scale
+    groups: list[list[int]] = []
+    for i in np.argsort(lam.real):
+        for grp in groups:
+            if abs(lam[i] - lam[grp[0]]) <= cluster_tol:
+                grp.append(int(i))
+                break
+        else:
+            groups.append([int(i)])
+    max_re = float(lam.real.max(initial=-np.inf))
+    unstable, on_axis, defective = [], [], []
+    for grp in groups:
+        centre = lam[grp].mean()
+        if centre.real > tol:
+            unstable.extend(grp)
+        elif centre.real >= -tol:
+            on_axis.extend(grp)
+            if len(grp) > 1:
+                # geometric multiplicity from the rank of A − λI
+                sv = np.linalg.svd(A - centre * np.eye(n), compute_uv=False)
+                geometric = int(np.sum(sv <= 1e3 * np.sqrt(np.finfo(float).eps) * scale))
+                if geometric < len(grp):
+                    defective.append((centre, len(grp), geometric))
+    if unstable:
+        lu = lam[unstable]
+        worst = lu[np.argmax(lu.real)]
+        kind = ("flutter: an oscillating mode grows" if abs(worst.imag) > tol
+                else "divergence: a real eigenvalue is positive")
+        reason = (f"{len(lu)} eigenvalue(s) with positive real part, largest "
+                  f"λ = {_fmt(worst)} ({kind})")
+        return Stability(UNSTABLE, reason, max_re, lu)
+    if defective:
+        centre, alg, geo = defective[0]
+        reason = (f"eigenvalue λ = {_fmt(centre)} on the imaginary axis is repeated {alg} times "
+                  f"with only {geo} eigenvector(s): the motion grows linearly in time "
+                  "(e.g. a free rigid-body coordinate without stiffness)")
+        return Stability(UNSTABLE, reason, max_re, lam[on_axis])
+    if on_axis:
+        la = lam[on_axis]
+        reason = (f"no eigenvalue has a positive real part; {len(la)} lie on the imaginary axis "
+                  f"(undamped or rigid-body motion, e.g. λ = {_fmt(la[np.argmax(la.imag)])}) "
+                  "and are semisimple")
+        return Stability(MARGINALLY_STABLE, reason, max_re, la)
+    worst = lam[np.argmax(lam.real)]
+    reason = (f"all {n} eigenvalues have negative real parts (largest real part {max_re:.6g} "
+              f"at λ = {_fmt(worst)})")
+    return Stability(ASYMPTOTICALLY_STABLE, reason, max_re, np.array([worst]))
+
+
+def _fmt(z: complex) -> str:
+    return f"{z.real:.6g}{z.imag:+.6g}j"

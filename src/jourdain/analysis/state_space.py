@@ -1,0 +1,148 @@
+"""State-space form of a linearized system (METHOD.md §6, "the natural next steps").
+
+With the state ``x = [η; η̇]`` (2f) the linear equations ``M̃·η̈ + P·η̇ + Q·η = h + B·Δu`` read
+
+    ẋ = A·x + B_x·Δu + E·h,   A = [[0, I], [−M̃⁻¹Q, −M̃⁻¹P]],  B_x = [[0], [M̃⁻¹B]],  E = [[0], [M̃⁻¹]]
+
+M̃ is factored numerically (Cholesky), never inverted symbolically.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..errors import EvaluationError, SingularMassMatrix
+from ..linearization import CompiledLinearization, Linearization, TimeVariantError
+
+
+@dataclass(frozen=True)
+class StateSpace:
+    """Numeric state-space form ``ẋ = A·x + B·Δu + E·h`` of a linearization at one time.
+
+    Attributes
+    ----------
+    A : (2f, 2f) array
+        System matrix for the state ``x = [η; η̇]``.
+    B : (2f, m) array
+        Input matrix for the input deviations ``Δu``.
+    E : (2f, f) array
+        Input matrix of the generalized excitation h.
+    M_tilde, P, Q : (f, f) arrays
+        The second-order matrices they came from; ``B_u`` (f, m) and ``h`` (f,) likewise.
+    coordinate_names, input_names : tuple of str
+    state_names : tuple of str
+        ``η`` names then ``η̇`` names (``<coordinate>_d``).
+    t : float
+        The time at which the matrices were evaluated.
+    parameters : dict
+        All parameter values used.
+    """
+
+    A: np.ndarray
+    B: np.ndarray
+    E: np.ndarray
+    M_tilde: np.ndarray
+    P: np.ndarray
+    Q: np.ndarray
+    B_u: np.ndarray
+    h: np.ndarray
+    coordinate_names: tuple[str, ...]
+    input_names: tuple[str, ...]
+    t: float
+    parameters: dict[str, float]
+
+    @property
+    def state_names(self) -> tuple[str, ...]:
+        return (*self.coordinate_names, *(f"{n}_d" for n in self.coordinate_names))
+
+    @property
+    def f(self) -> int:
+        return len(self.coordinate_names)
+
+
+def numbers(lin: Linearization | CompiledLinearization, t: float = 0.0,
+            parameters: Mapping[str, float] | None = None) -> dict[str, np.ndarray]:
+    """``M_tilde, P, Q, h, B`` (and D, G, K, N) as arrays, from a symbolic or compiled result."""
+    if isinstance(lin, CompiledLinearization):
+        return lin(t, parameters)
+    if isinstance(lin, Linearization):
+        return lin.evaluate(t, parameters)
+    raise EvaluationError(f"expected a Linearization or a CompiledLinearization, got "
+                          f"{type(lin).__name__}")
+
+
+def _linearization_of(lin: Any) -> Linearization:
+    return lin.linearization if isinstance(lin, CompiledLinearization) else lin
+
+
+def state_space(lin: Linearization | CompiledLinearization, t: float = 0.0,
+                parameters: Mapping[str, float] | None = None,
+                allow_time_variant: bool = False) -> StateSpace:
+    """State-space matrices of a linearization for numeric parameter values.
+
+    Parameters
+    ----------
+    lin : Linearization or CompiledLinearization
+    t : float
+        Time at which to evaluate (matters for time-variant results only).
+    parameters : mapping name -> value, optional
+        Overrides of the default parameter values.
+    allow_time_variant : bool
+        A time-variant result is refused (its eigenvalues at a frozen time say nothing about
+        stability) unless this is True.
+
+    Raises
+    ------
+    TimeVariantError
+        For a time-variant result without ``allow_time_variant``.
+    SingularMassMatrix
+        When M̃ is not positive definite at these values.
+    """
+    base = _linearization_of(lin)
+    if not base.is_time_invariant and not allow_time_variant:
+        raise TimeVariantError(
+            f"state_space: the linearization of {base.system.name!r} is time-variant "
+            f"({', '.join(base.time_dependence)} depend on t); frozen-time eigenvalues do not "
+            "decide stability. Pass allow_time_variant=True to get A(t) at one t anyway."
+        )
+    num = numbers(lin, t, parameters)
+    return _from_numbers(base, num, float(t), parameters)
+
+
+def _from_numbers(base: Linearization, num: Mapping[str, np.ndarray], t: float,
+                  parameters: Mapping[str, float] | None) -> StateSpace:
+    from ..numeric import parameter_vector
+
+    M, P, Q, Bu, h = num["M_tilde"], num["P"], num["Q"], num["B"], num["h"]
+    f = M.shape[0]
+    try:
+        L = np.linalg.cholesky(0.5 * (M + M.T))
+    except np.linalg.LinAlgError:
+        ev = np.linalg.eigvalsh(0.5 * (M + M.T))
+        raise SingularMassMatrix(
+            f"M_tilde of {base.system.name!r} is not positive definite at t = {t} "
+            f"(eigenvalues {np.array2string(ev, precision=4)})"
+        ) from None
+
+    def solve(X: np.ndarray) -> np.ndarray:
+        return np.linalg.solve(L.T, np.linalg.solve(L, X))
+
+    m = Bu.shape[1]
+    A = np.zeros((2 * f, 2 * f))
+    A[:f, f:] = np.eye(f)
+    A[f:, :f] = -solve(Q)
+    A[f:, f:] = -solve(P)
+    B = np.zeros((2 * f, m))
+    if m:
+        B[f:] = solve(Bu)
+    E = np.zeros((2 * f, f))
+    E[f:] = solve(np.eye(f))
+    pv = parameter_vector(base.system, parameters)
+    pars = {str(s): float(v) for s, v in zip(base.system.parameter_symbols, pv, strict=True)}
+    return StateSpace(A=A, B=B, E=E, M_tilde=M, P=P, Q=Q, B_u=Bu, h=np.asarray(h),
+                      coordinate_names=tuple(base.system.coordinate_names),
+                      input_names=tuple(base.system.input_names), t=t, parameters=pars)

@@ -1,0 +1,106 @@
+"""Eigenvalues over a swept parameter, and the value at which stability is lost.
+
+Rotor speed, follower load, a damping coefficient: the linearization is symbolic in every
+parameter (and the nominal motion may depend on it, e.g. ``phi = Omega*t``), so a sweep only
+evaluates numbers; a :class:`~jourdain.CompiledLinearization` makes long sweeps faster.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import EvaluationError
+from ..linearization import CompiledLinearization, Linearization
+from .modes import UNSTABLE, stability
+from .state_space import _from_numbers, _linearization_of, numbers, state_space
+
+
+@dataclass(frozen=True)
+class Sweep:
+    """Eigenvalues of the linearization for each value of one parameter.
+
+    Attributes
+    ----------
+    parameter : str
+    values : (n,) array
+    eigenvalues : (n, 2f) complex array
+        Sorted by imaginary part, then real part, at every value.
+    max_real_part : (n,) array
+    verdicts : tuple of str
+        Stability verdict at every value.
+    """
+
+    parameter: str
+    values: np.ndarray
+    eigenvalues: np.ndarray
+    max_real_part: np.ndarray
+    verdicts: tuple[str, ...]
+
+    def first_unstable(self) -> float | None:
+        """The first swept value at which the system is unstable (None if it never is)."""
+        for v, verdict in zip(self.values, self.verdicts, strict=True):
+            if verdict == UNSTABLE:
+                return float(v)
+        return None
+
+
+def _check_parameter(lin: Linearization, parameter: str) -> None:
+    names = [k for k, _ in lin.system.parameters]
+    if parameter not in names:
+        raise EvaluationError(f'unknown parameter "{parameter}"; parameters are {names}')
+
+
+def sweep(lin: Linearization | CompiledLinearization, parameter: str,
+          values: Sequence[float] | np.ndarray, t: float = 0.0,
+          parameters: Mapping[str, float] | None = None) -> Sweep:
+    """Eigenvalues and stability verdicts over ``values`` of ``parameter`` (other parameters at
+    their defaults, overridden by ``parameters``)."""
+    base = _linearization_of(lin)
+    _check_parameter(base, parameter)
+    vals = np.asarray(values, dtype=float).reshape(-1)
+    state_space(lin, t, parameters)  # refuses time-variant results with a clear message
+    eigs, maxre, verdicts = [], [], []
+    for v in vals:
+        pars = {**(parameters or {}), parameter: float(v)}
+        ss = _from_numbers(base, numbers(lin, t, pars), float(t), pars)
+        lam = np.linalg.eigvals(ss.A)
+        eigs.append(lam[np.lexsort((lam.real, lam.imag))])
+        maxre.append(float(lam.real.max()))
+        verdicts.append(stability(ss).verdict)
+    return Sweep(parameter, vals, np.array(eigs), np.array(maxre), tuple(verdicts))
+
+
+def stability_boundary(lin: Linearization | CompiledLinearization, parameter: str,
+                       lower: float, upper: float, t: float = 0.0,
+                       parameters: Mapping[str, float] | None = None,
+                       rtol: float = 1e-10) -> float:
+    """The value of ``parameter`` in ``[lower, upper]`` at which the verdict changes between
+    stable (asymptotically or marginally) and unstable, by bisection.
+
+    Raises :class:`EvaluationError` when both ends have the same verdict.
+    """
+    base = _linearization_of(lin)
+    _check_parameter(base, parameter)
+
+    def unstable(v: float) -> bool:
+        pars = {**(parameters or {}), parameter: float(v)}
+        ss = _from_numbers(base, numbers(lin, t, pars), float(t), pars)
+        return stability(ss).verdict == UNSTABLE
+
+    state_space(lin, t, parameters)
+    a, b = float(lower), float(upper)
+    ua, ub = unstable(a), unstable(b)
+    if ua == ub:
+        word = "unstable" if ua else "stable"
+        raise EvaluationError(f'stability_boundary: the system is {word} at both {parameter} = '
+                              f"{a} and {parameter} = {b}; give a bracket where it changes")
+    while abs(b - a) > rtol * max(1.0, abs(a), abs(b)):
+        mid = 0.5 * (a + b)
+        if unstable(mid) == ua:
+            a = mid
+        else:
+            b = mid
+    return 0.5 * (a + b)
