@@ -284,3 +284,23 @@ def test_linearize_slider_on_rotating_rod_relative_equilibrium(capsys):
     assert data["matrices"]["D"][0][0] == pytest.approx(d, rel=1e-12)
     assert data["matrices"]["M_tilde"][0][0] == pytest.approx(m, rel=1e-12)
     assert data["stability"]["verdict"] == "asymptotically stable"
+
+
+def test_constrained_direction_that_does_work(tmp_path, capsys):
+    """A general joint whose declared constrained direction does work violates J̄ᵀQ̄ = 0:
+    `check` reports it at the key, `eval` still gives the equations of motion and says why the
+    reactions are missing."""
+    path = tmp_path / "slider.toml"
+    path.write_text(
+        '[coordinates]\ns = "m"\n[parameters]\nm = 1.0\n[bodies.slider]\nparent = "world"\n'
+        'mass = "m"\ninertia = "point"\njoint = { type = "general", steps = [{ trans = "x", '
+        'distance = "s" }], constrained = ["F_x", "F_y", "F_z", "T_x", "T_y", "T_z"] }\n')
+    code, _, err = run(capsys, "check", path)
+    assert code == 1 and "Traceback" not in err
+    assert f"{path}:9: body \"slider\" → joint → constrained:" in err
+    assert "does work in an admissible motion" in err
+    code, out, err = run(capsys, "eval", path, "--at", "s=0.5", "--json")
+    assert code == 0, err
+    data = json.loads(out)
+    assert data["values"]["M"] == [[1.0]]
+    assert "could not be formed" in data["not_available"]["Q_bar"]

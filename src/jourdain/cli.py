@@ -172,6 +172,12 @@ def _step_exprs(step: Any) -> set[Any]:
 
 def cmd_check(args: argparse.Namespace) -> int:
     model = _load(args.model)
+    if has_capability("reactions"):
+        # the joints' constrained directions must satisfy the orthogonality J̄ᵀQ̄ = 0
+        try:
+            model.system.reactions()
+        except JourdainError as exc:
+            raise model.error(str(exc)) from None
     s = summary(model)
     if args.json:
         print(json.dumps(s, indent=2))
@@ -247,20 +253,32 @@ def evaluate_all(model: Any, y: np.ndarray, yd: np.ndarray, t: float,
     Returns the arrays by the seed's names, extra information (``g_names``,
     ``g_undetermined``) and, for what is missing, the reason.
     """
+    from .numeric import evaluate
+
     system = model.system
-    out = dict(system.evaluate(y, yd, t=t, parameters=parameters or None,
-                               inputs=inputs or None))
+    missing: dict[str, str] = {}
+    reaction_names = ("Q_bar", "N_hat", "k_hat", "q_hat", "g")
+    try:
+        out = dict(system.evaluate(y, yd, t=t, parameters=parameters or None,
+                                   inputs=inputs or None))
+    except JourdainError as exc:
+        # the equations of motion alone, when a later stage (the reactions) cannot be formed
+        out = dict(evaluate(system, y, yd, t=t, parameters=parameters or None,
+                            inputs=inputs or None))
+        missing.update({k: f"the reaction forces could not be formed: {exc}"
+                        for k in reaction_names})
     values = {k: np.asarray(v, float) for k, v in out.items() if isinstance(v, np.ndarray)}
     extra = {k: v for k, v in out.items() if not isinstance(v, np.ndarray)}
-    missing: dict[str, str] = {}
-    for k in ("Q_bar", "N_hat", "k_hat", "q_hat", "g"):
-        if k not in values:
+    for k in reaction_names:
+        if k not in values and k not in missing:
             missing[k] = "the reaction forces are not available yet in this version of jourdain"
     lin_names = ("M_tilde", "P", "Q", "h", "D", "G", "K", "N")
     try:
         values.update(_linearization_at(model, y, yd, t, parameters, inputs))
     except NotAvailable as exc:
         missing.update({k: str(exc) for k in lin_names})
+    except JourdainError as exc:
+        missing.update({k: f"the linearization could not be formed: {exc}" for k in lin_names})
     return values, extra, missing
 
 

@@ -118,6 +118,23 @@ class ModelFile:
     descriptions: tuple[tuple[str, str], ...] = ()
     view: str | None = None
 
+    def error(self, message: str) -> ModelFileError:
+        """A :class:`ModelFileError` for a problem a later stage found in this model (e.g. a
+        joint whose constrained directions violate J̄ᵀQ̄ = 0), located in the file by the body,
+        joint or force that the message names."""
+        try:
+            text = FsPath(self.path).read_text(encoding="utf-8")
+        except OSError:
+            text = ""
+        loader = _Loader(text, self.path)
+        loader.lines = key_lines(text)
+        loader.body_names = self.system.body_names
+        loader.joint_of_body = {b.name: b.joint.name for b in self.system.bodies}
+        path = loader.locate(message)
+        if path[:1] == ("bodies",) and len(path) == 3 and (*path, "constrained") in loader.lines:
+            path = (*path, "constrained")
+        return loader.fail(path, message)
+
     def nominal_motion(self, name: str | None = None) -> NominalMotion:
         """The nominal motion called ``name`` (the first one when ``None``)."""
         if not self.nominal:
@@ -393,18 +410,20 @@ class _Loader:
                          tuple(self.descriptions.items()), view)
 
     def locate(self, message: str) -> Path:
-        """Best key path for an error the core raised about the assembled system."""
-        m = re.search(r'body "(\w+)"', message)
-        if m and m.group(1) in self.body_names:
-            return ("bodies", m.group(1))
-        m = re.search(r'joint "(\w+)"', message)
-        if m:
+        """Best key path for an error the core raised about the assembled system: the element
+        named first in the message."""
+        found: list[tuple[int, Path]] = []
+        for m in re.finditer(r'body "(\w+)"', message):
+            if m.group(1) in self.body_names:
+                found.append((m.start(), ("bodies", m.group(1))))
+        for m in re.finditer(r'joint "(\w+)"', message):
             for b, j in self.joint_of_body.items():
                 if j == m.group(1):
-                    return ("bodies", b, "joint")
-        m = re.search(r'(?:force|spring-damper|torque) "(\w+)"', message)
-        if m:
-            return ("forces", m.group(1))
+                    found.append((m.start(), ("bodies", b, "joint")))
+        for m in re.finditer(r'(?:force|spring-damper|torque) "(\w+)"', message):
+            found.append((m.start(), ("forces", m.group(1))))
+        if found:
+            return min(found)[1]
         if "coordinate" in message:
             return ("coordinates",)
         return ()

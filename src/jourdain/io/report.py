@@ -520,7 +520,10 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
         if "g" in values:
             g = np.asarray(values["g"], float).reshape(-1)
             labels = list(extra.get("g_names", [str(i) for i in range(g.size)]))
-            s.append("<h3>Reaction forces g (N̂·g = k̂ − q̂)</h3>"
+            s.append("<h3>Reaction forces g</h3>"
+                     f'<div class="eq">{_headline_reactions()}</div>'
+                     f"<p class='meta'>Q̄ is {6 * p}×{g.size}: one column per constrained "
+                     "direction of every joint.</p>"
                      "<p class='meta'>Components in the child body frame at the joint point; "
                      "forces in N, torques in N·m (in the model's units).</p>")
             s.append(_matrix_table(g[None, :], None, labels))
