@@ -404,7 +404,7 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
     the initial state, the format of ``jourdain eval --json``), ``linearization-<name>.json``
     per nominal motion, ``simulation.csv``.
     """
-    from ..cli import EVAL_FORMAT, evaluate_all, has_capability, summary
+    from ..cli import EVAL_FORMAT, _json_array, evaluate_all, has_capability, summary
 
     t_start = time.perf_counter()
     out = Path(out)
@@ -538,11 +538,9 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
         vj = {"format": EVAL_FORMAT, "model": system.name, "file": model.path,
               "coordinates": coords, "t": 0.0, "y": y0.tolist(), "yd": yd0.tolist(),
               "parameters": pv, "inputs": u0,
-              "values": {k: np.where(np.isfinite(v), v, np.nan).tolist()
-                         for k, v in values.items()},
+              "values": {k: _json_array(v) for k, v in values.items()},
               "g_names": list(extra.get("g_names", [])), "not_available": missing}
-        (out / "values.json").write_text(json.dumps(vj, indent=1).replace("NaN", "null"),
-                                         encoding="utf-8")
+        (out / "values.json").write_text(json.dumps(vj, indent=1), encoding="utf-8")
         info.files.append(out / "values.json")
     except JourdainError as exc:
         s.append(_note(f"could not evaluate at the initial state: {exc}"))
