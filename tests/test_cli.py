@@ -44,6 +44,7 @@ def test_example_check_and_eom(path, capsys):
     assert code == 0, err
     system = load_model(path).system
     assert f"degrees of freedom f = {system.f}" in out
+    assert f"constrained directions q = {len(system.reactions().g_names)}:" in out
     code, out, err = run(capsys, "eom", path)
     assert code == 0, err
     assert "M (mass matrix, f×f) =" in out and "q (generalized applied forces, f) =" in out

@@ -137,21 +137,34 @@ def _load(path: str) -> Any:
 # ------------------------------------------------------------------------------------------
 
 def summary(model: Any) -> dict[str, Any]:
-    """Bodies, joints, degrees of freedom and constrained directions of a loaded model."""
+    """Bodies, joints, degrees of freedom and constrained directions of a loaded model.
+
+    The constrained directions of each joint come from the reactions stage (the columns of Q̄)
+    when it is available, else from the joint's own freedoms (6 minus them).
+    """
     system = model.system
+    directions: dict[str, list[str]] = {}
+    if has_capability("reactions"):
+        try:
+            for jr in system.reactions().joints:
+                directions[jr.joint.name] = [n.split(".", 1)[-1] for n in jr.names]
+        except JourdainError:
+            directions = {}
     joints = []
     constraints = 0
     for b in system.bodies:
         j = b.joint
-        n_free = len(j.coordinates) if j.kind != "general" else None
-        # a joint between two rigid bodies removes 6 minus its own freedoms; general joints
-        # (prescribed motions included) count their coordinate steps
-        steps_free = sum(1 for s in j.steps
-                         if {str(x) for x in _step_exprs(s)} & set(system.coordinate_names))
-        freedoms = n_free if n_free is not None else steps_free
-        constraints += 6 - freedoms
+        if j.name in directions:
+            names = directions[j.name]
+        else:
+            freedoms = sum(1 for s in j.steps
+                           if {str(x) for x in _step_exprs(s)} & set(system.coordinate_names))
+            names = [f"{6 - freedoms} directions"]
+        count = len(directions[j.name]) if j.name in directions else 6 - freedoms
+        constraints += count
         joints.append({"name": j.name, "type": j.kind, "body": b.name, "parent": b.parent,
-                       "coordinates": [str(c) for c in j.coordinates], "constrained": 6 - freedoms})
+                       "coordinates": [str(c) for c in j.coordinates], "constrained": count,
+                       "constrained_directions": names if j.name in directions else []})
     return {
         "name": system.name, "file": model.path, "degrees_of_freedom": system.f,
         "coordinates": system.coordinate_names, "bodies": system.body_names,
@@ -188,8 +201,10 @@ def cmd_check(args: argparse.Namespace) -> int:
     print(f"  joints ({len(s['joints'])}), constrained directions q = {s['constraints']}:")
     for j in s["joints"]:
         coords = ", ".join(j["coordinates"]) or "—"
+        dirs = ", ".join(j["constrained_directions"])
         print(f"    {j['name']:<14} {j['type']:<12} {j['parent']} → {j['body']}   "
-              f"coordinates: {coords}; constrained: {j['constrained']}")
+              f"coordinates: {coords}; constrained: {j['constrained']}"
+              + (f" ({dirs})" if dirs else ""))
     if s["forces"]:
         print("  force elements: " + ", ".join(f"{f['name']} ({f['type']})" for f in s["forces"]))
     if s["inputs"]:
