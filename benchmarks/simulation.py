@@ -93,10 +93,10 @@ def bench_jourdain(n: int) -> dict:
     y0, yd0 = initial_state(n)
     kw = {"inputs": {"F": 0.0}, "rtol": TOL, "atol": TOL}
     res = s.simulate((0, T_END), y0, yd0, **kw)
-    t_sim = best_of(lambda: s.simulate((0, T_END), y0, yd0, **kw))
     ref = s.simulate((0, T_END), y0, yd0, inputs={"F": 0.0}, rtol=1e-12, atol=1e-12)
     return {"system": s, "derive": t_derive, "codegen": t_codegen, "codegen_cached": t_cached,
-            "integrate": t_sim, "nfev": res.nfev, "steps": res.n_accepted,
+            "run": lambda: s.simulate((0, T_END), y0, yd0, **kw),
+            "nfev": res.nfev, "steps": res.n_accepted,
             "x_final": np.concatenate([res.y[-1], res.yd[-1]]),
             "x_ref": np.concatenate([ref.y[-1], ref.yd[-1]])}
 
@@ -136,9 +136,9 @@ def bench_pydy(n: int, solver: str, generator: str, params: dict) -> dict:
         # one output interval: mxstep must allow all the steps of 10 s
         kw_ode = {"rtol": TOL, "atol": TOL, "mxstep": 10**6}
         x, info = odeint(rhs, x0, tt, args=args, full_output=True, **kw_ode)
-        t_int = best_of(lambda: odeint(rhs, x0, tt, args=args, **kw_ode), repeat=5)
         x_ref = odeint(rhs, x0, tt, args=args, rtol=1e-12, atol=1e-12, mxstep=10**6)[-1]
-    return {"derive": t_derive, "codegen": t_codegen, "integrate": t_int,
+    return {"derive": t_derive, "codegen": t_codegen,
+            "run": lambda: odeint(rhs, x0, tt, args=args, **kw_ode),
             "nfev": int(info["nfe"][-1]), "x_final": x[-1], "x_ref_odeint": x_ref}
 
 
@@ -254,6 +254,7 @@ def main(argv: list[str] | None = None) -> dict:
                     help="n = 2 and PyDy's lambdify backend only (smoke test)")
     ap.add_argument("--sympy-max-n", type=int, default=10)
     ap.add_argument("--no-pinocchio", action="store_true")
+    ap.add_argument("--rounds", type=int, default=15, help="interleaved timing rounds")
     ap.add_argument("--json", type=str, default=None)
     args = ap.parse_args(argv)
     ns = [2] if args.quick else args.n
@@ -286,6 +287,12 @@ def main(argv: list[str] | None = None) -> dict:
                 skipped.append(f"PyDy {gen}/{solver}: {type(exc).__name__}: {exc}")
                 continue
             rows.append((f"PyDy {gen}/{solver} + odeint", P))
+        # interleaved rounds, best of each: a busy machine slows all tools alike
+        for r in rows:
+            r[1]["integrate"] = math.inf
+        for _ in range(args.rounds):
+            for _, r in rows:
+                r["integrate"] = min(r["integrate"], best_of(r["run"], repeat=1, min_time=0.05))
         pydy_times = [r[1]["integrate"] for r in rows[1:]]
         fastest = min(pydy_times) if pydy_times else math.nan
         entry = {"n": n, "tools": {}}

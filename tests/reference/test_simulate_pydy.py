@@ -55,3 +55,16 @@ def test_four_link_pendulum_on_cart_against_pydy():
     for i in (10, 50):
         xd = rhs(np.concatenate([res.y[i], res.yd[i]]), t[i], np.array([0.5]), p)
         np.testing.assert_allclose(res.ydd[i], xd[n + 1:], rtol=1e-9, atol=1e-9)
+
+
+def test_benchmark_script_runs_on_a_tiny_case():
+    """benchmarks/simulation.py --quick: n = 2 against PyDy's lambdify backend."""
+    from benchmarks.simulation import main
+
+    report = main(["--quick", "--no-pinocchio", "--rounds", "1"])
+    (entry,) = report["pendulum"]
+    tools = entry["tools"]
+    assert set(tools) == {"jourdain DOP853 (C loop)", "PyDy lambdify/numpy + odeint"}
+    for t in tools.values():
+        assert t["final_state_error"] < 1e-5 and t["integrate"] > 0 and t["nfev"] > 100
+    assert entry["reference_check"] < 1e-8  # the reference agrees with odeint at 1e-12
