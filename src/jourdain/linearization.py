@@ -71,8 +71,9 @@ class Linearization:
     B : SymMatrix (f×m)
         Input matrix ``∂q/∂u|_s`` for the input deviations ``Δu`` (m = number of inputs).
     time_dependence : tuple of str
-        Names of the matrices among M̃, P, Q, B that depend on t explicitly (empty for a
-        time-invariant result).
+        Names of the matrices among M̃, P, Q, B that depend on t (empty for a time-invariant
+        result). Where t appears but cancels (a symmetric rotor turning at Ω t), numeric tests
+        at several times and parameter values decide, and the matrices are stored at t = 0.
     """
 
     equations_of_motion: EquationsOfMotion
@@ -149,8 +150,9 @@ class Linearization:
 
         Entries that are not zero as written are tested numerically (an identity test): at the
         default parameter values and at two random perturbations of them (each value scaled by a
-        factor in [0.7, 1.3]), and for h at several times; zero means below 1e-9 relative to the
-        size of P, Q. Time-invariant results only.
+        factor in [0.7, 1.3], zeros replaced by values in [0.2, 1]), and for h at several times.
+        It is a property of the symbolic system, for all parameter values; "zero" means below
+        1e-9 relative to the size of M̃, P, Q. Time-invariant results only.
         """
         self._require_time_invariant("is_conservative")
         names = ("D", "N", "h")
@@ -159,8 +161,7 @@ class Linearization:
             return True
         rng = np.random.default_rng(20240601)
         base = self.system.parameter_values
-        trials = [base] + [{k: v * rng.uniform(0.7, 1.3) for k, v in base.items()}
-                           for _ in range(2)]
+        trials = [base] + [_perturbed(base, rng) for _ in range(2)]
         for values in trials:
             for t in (0.0, 0.37, 1.91):
                 num = self.evaluate(t=t, parameters=values)
@@ -339,8 +340,16 @@ def linearization(eom: EquationsOfMotion, nominal: Mapping[Any, Any] | Any) -> L
         Mt[i][j] = v
         Mt[j][i] = v
     matrices = {"M_tilde": Mt, "P": P, "Q": Q, "B": B}
-    dependence = tuple(n for n, rows in matrices.items()
-                       if "t" in free_symbol_names([e for row in rows for e in row]))
+    dependence = _time_dependence(system, matrices)
+    if not dependence:
+        # t may still appear where it cancels (sin²Ωt + cos²Ωt of a symmetric rotor): the
+        # matrices equal their values at t = 0, which read shorter
+        for name, rows in matrices.items():
+            flat = [e for row in rows for e in row]
+            if "t" in free_symbol_names(flat):
+                vals = iter(jet(flat, [], {t: ZERO}).values)
+                matrices[name] = [[next(vals) for _ in row] for row in rows]
+        Mt, P, Q, B = (matrices[n] for n in ("M_tilde", "P", "Q", "B"))
     return Linearization(
         equations_of_motion=eom, time_dependence=dependence,
         y_s=SymMatrix.column(y_s), yd_s=SymMatrix.column(yd_s), ydd_s=SymMatrix.column(ydd_s),
@@ -348,6 +357,36 @@ def linearization(eom: EquationsOfMotion, nominal: Mapping[Any, Any] | Any) -> L
         M_tilde=SymMatrix.from_rows(Mt), P=SymMatrix.from_rows(P), Q=SymMatrix.from_rows(Q),
         h=SymMatrix.column(h), B=SymMatrix(tuple(tuple(row) for row in B)),
     )
+
+
+def _time_dependence(system: System, matrices: dict[str, list[list[se.Basic]]]
+                     ) -> tuple[str, ...]:
+    """Names of the matrices that depend on t. Where t appears in an expression it is tested
+    numerically whether it cancels: the matrix at four times, for the default parameter values
+    and two random perturbations of them, must agree to 1e-10 relative to its size."""
+    rng = np.random.default_rng(7)
+    base = system.parameter_values
+    trials = [base] + [_perturbed(base, rng) for _ in range(2)]
+    out = []
+    for name, rows in matrices.items():
+        flat = [e for row in rows for e in row]
+        if "t" not in free_symbol_names(flat):
+            continue
+        for values in trials:
+            nums = np.array([evaluate_float(flat, {**values, "t": tv})
+                             for tv in (0.0, 0.37, 1.91, 4.3)])
+            scale = max(1.0, float(np.abs(nums).max()))
+            if not np.all(np.isfinite(nums)) or np.ptp(nums, axis=0).max() > 1e-10 * scale:
+                out.append(name)
+                break
+    return tuple(out)
+
+
+def _perturbed(values: dict[str, float], rng: np.random.Generator) -> dict[str, float]:
+    """Random parameter values near the defaults for identity tests; a default of zero (a load
+    switched off) is replaced by a random value, so that terms it multiplies are seen."""
+    return {k: v * rng.uniform(0.7, 1.3) if v != 0 else rng.uniform(0.2, 1.0)
+            for k, v in values.items()}
 
 
 def _sym_part(A: SymMatrix, sign: int) -> SymMatrix:

@@ -1,0 +1,42 @@
+"""n_link_pendulum_on_cart(n) linearized at the upright equilibrium against
+sympy.physics.mechanics' KanesMethod.linearize on sympy's own model (A and B of x = [q, u],
+u = q̇, input F)."""
+
+import numpy as np
+import pytest
+import sympy as sp
+from sympy.physics.mechanics import dynamicsymbols
+from sympy.physics.mechanics.models import n_link_pendulum_on_cart as sympy_model
+
+import jourdain as jd
+from jourdain.models import n_link_pendulum_on_cart
+
+
+@pytest.mark.parametrize("n", [1, 2, 3])
+def test_upright_A_B_match_kanes_linearize(n, rng):
+    kane = sympy_model(n, cart_force=True)
+    op = {**{q: 0 for q in kane.q}, **{u: 0 for u in kane.u}}
+    A_sym, B_sym, r = kane.linearize(A_and_B=True, op_point=op, new_method=True)
+    assert list(r) == [dynamicsymbols("F")]
+    m = sp.symbols(f"m:{n + 1}")
+    l = sp.symbols(f"l:{n}")
+    g = sp.Symbol("g")
+    f_A = sp.lambdify([*m, *l, g], A_sym)
+    f_B = sp.lambdify([*m, *l, g], B_sym)
+    system = n_link_pendulum_on_cart(n)
+    lin = system.linearize({c: 0 for c in system.coordinate_names})
+    for _ in range(3):
+        vals = rng.uniform(0.5, 2.0, 2 * n + 2)
+        pars = {str(s): float(v) for s, v in zip([*m, *l, g], vals, strict=True)}
+        A_ref = np.array(f_A(*vals), dtype=float)
+        B_ref = np.array(f_B(*vals), dtype=float)
+        ss = jd.state_space(lin, parameters=pars)
+        scale = np.abs(A_ref).max()
+        assert np.abs(ss.A - A_ref).max() <= 1e-12 * scale
+        np.testing.assert_allclose(ss.B, B_ref, rtol=1e-12, atol=1e-12 * np.abs(B_ref).max())
+        # upright: divergence (one real eigenvalue > 0 per link), as both agree
+        st = jd.stability(ss)
+        assert st.verdict == "unstable" and "divergence" in st.reason
+        lam_ref = np.sort_complex(np.linalg.eigvals(A_ref))
+        lam = np.sort_complex(np.linalg.eigvals(ss.A))
+        np.testing.assert_allclose(lam, lam_ref, atol=1e-8 * max(1.0, np.abs(lam_ref).max()))
