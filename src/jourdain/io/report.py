@@ -308,10 +308,13 @@ def _animation(m: _Motion, view: str | None, frames: int = 120, size: int = 360)
     idx = np.linspace(0, n - 1, min(frames, n)).round().astype(int)
     scale = size / float(max(hi - lo))
     dur = max(float(m.t[-1] - m.t[0]), 0.5)
+    # centre the drawing in the square
+    off = (size - (hi - lo) * scale) / 2
 
     def xy(p: np.ndarray) -> tuple[float, float]:
         q = proj(p)
-        return (float((q[0] - lo[0]) * scale), float(size - (q[1] - lo[1]) * scale))
+        return (float((q[0] - lo[0]) * scale + off[0]),
+                float(size - (q[1] - lo[1]) * scale - off[1]))
 
     def anim(attr: str, vals: list[float]) -> str:
         v = ";".join(f"{x:.2f}" for x in vals)
