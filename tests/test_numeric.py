@@ -66,6 +66,26 @@ def test_sign_flipped_subexpressions_stay_distinct():
                                rtol=1e-15)
 
 
+def test_large_functions_are_split_into_parts(monkeypatch, rng):
+    """Above SPLIT_ABOVE temporaries the body is split into parts sharing an array; the
+    numbers are the same."""
+    s = spatial_chain(3)
+    eom = s.equations_of_motion()
+    mats = {"M": eom.M, "k": eom.k}
+    whole = numeric.lambdify(s, mats)
+    monkeypatch.setattr(ccode, "SPLIT_ABOVE", 5)
+    monkeypatch.setattr(ccode, "PART", 7)
+    monkeypatch.setattr(numeric, "_GENERATOR_VERSION", "split-test")  # a new cache key
+    parts = numeric.lambdify(s, mats)
+    assert parts.key != whole.key
+    assert "_part3(" in (numeric.cache_dir() / f"{parts.key}.c").read_text()
+    p = numeric.parameter_vector(s, None)
+    Y, YD = rng.uniform(-2, 2, (5, s.f)), rng.uniform(-2, 2, (5, s.f))
+    a, b = whole.batch(Y, YD, 0.0, p), parts.batch(Y, YD, 0.0, p)
+    np.testing.assert_allclose(b["M"], a["M"], rtol=1e-13, atol=1e-14)
+    np.testing.assert_allclose(b["k"], a["k"], rtol=1e-13, atol=1e-14)
+
+
 def test_batch_equals_single_state(rng):
     s = n_link_pendulum_on_cart(4)
     fn = numeric.mkq_function(s)

@@ -123,10 +123,11 @@ def test_inputs_constant_expression_table_callable_agree():
     np.testing.assert_allclose(fb.u[:, 0], -c * fb.yd[:, 0], rtol=1e-12)
 
 
-def test_terminal_event_stops_the_run():
+@pytest.mark.parametrize("method", ["DOP853", "RK45", "Radau"])
+def test_terminal_event_stops_the_run(method):
     s = pendulum()
     phi = s.y[0]
-    res = s.simulate((0, 10), [1.0], [0.0], rtol=1e-10, atol=1e-10,
+    res = s.simulate((0, 10), [1.0], [0.0], rtol=1e-10, atol=1e-10, method=method,
                      events=[Event(phi, direction=-1, terminal=True, name="bottom")])
     assert res.status == "event" and "bottom" in res.message
     t_hit = res.events["bottom"]["t"][0]
