@@ -113,3 +113,5 @@ def test_conservative_run_reports_drift(run):
                                              res.kinetic_energy.max()))
     assert res.energy_drift < 1e-9
     assert math.isfinite(res.wall_time) and res.nfev > 0
+    text = res.summary()
+    assert "finished" in text and f"relative energy drift {res.energy_drift:.3e}" in text

@@ -130,6 +130,24 @@ class Results:
                 f"{self.t[-1]:.4g}, status={self.status!r}, method={self.method}, "
                 f"nfev={self.nfev})")
 
+    def summary(self) -> str:
+        """What happened, in a few lines: status, cost and, when the system is at hand, the
+        relative energy drift (conservative model) or the energy balance error."""
+        lines = [f"{self.name}: {self.status} - {self.message}",
+                 f"  t = {self.t[0]:.6g} .. {self.t[-1]:.6g} s, {len(self.t)} points, method "
+                 f"{self.method}, rtol {self.rtol:g}",
+                 f"  {self.n_accepted} steps accepted, {self.n_rejected} rejected, "
+                 f"{self.nfev} right-hand sides, {1e3 * self.wall_time:.3f} ms"]
+        try:
+            if self.conservative:
+                lines.append(f"  relative energy drift {self.energy_drift:.3e} (conservative model)")
+            else:
+                lines.append(f"  energy balance error {self.energy_balance_error:.3e} "
+                             f"(non-conservative: {', '.join(self._energies['nonconservative'])})")
+        except JourdainError:
+            pass
+        return "\n".join(lines)
+
     def coordinate(self, name: str) -> np.ndarray:
         """Time history of one coordinate (or ``<name>_d`` / ``<name>_dd`` for its rates)."""
         for suffix, arr in (("_dd", self.ydd), ("_d", self.yd), ("", self.y)):
