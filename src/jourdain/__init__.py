@@ -27,8 +27,10 @@ from .kinematics import BodyKinematics, Kinematics, kinematics
 from .linearization import (
     CompiledLinearization,
     Linearization,
+    NumericLinearization,
     TimeVariantError,
     linearization,
+    linearize_numeric,
 )
 from .model import (
     WORLD,
@@ -78,7 +80,8 @@ __all__ = [
     "EvaluationError", "JourdainError", "ModelError", "SingularMassMatrix",
     "BodyKinematics", "Kinematics", "kinematics", "NewtonEuler", "newton_euler",
     "EquationsOfMotion", "projection", "SymMatrix",
-    "CompiledLinearization", "Linearization", "TimeVariantError", "linearization",
+    "CompiledLinearization", "Linearization", "NumericLinearization", "TimeVariantError",
+    "linearization", "linearize_numeric",
     "FrequencyResponse", "Modes", "Stability", "StateSpace", "Sweep", "frequency_response",
     "modes", "stability", "stability_boundary", "state_space", "sweep",
     "Equilibrium", "NoEquilibrium", "find_equilibria", "find_equilibrium",

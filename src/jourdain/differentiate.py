@@ -15,7 +15,7 @@ Substituting while differentiating keeps the results short: at an equilibrium ``
 the point needs no gradient of its other factors at all (the *needed* pass below finds them
 before any derivative is formed).
 
-Nodes are identified by the address of the SymEngine object a wrapper holds (:func:`node_id`),
+Nodes are identified by the address of the SymEngine object a wrapper holds ,
 not by SymEngine's hash: that hash combines the terms of a sum by exclusive-or, so different sums
 collide often (``cx5 + dx4`` and ``cx5 + dx0 + dx1 + dx2 + dx3 + dx4`` have the same hash), and a
 collision confirmed only by the children's hashes would silently merge different expressions.
@@ -32,6 +32,7 @@ from collections.abc import Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 
+import numpy as np
 import symengine as se
 
 from .errors import JourdainError
@@ -98,14 +99,12 @@ _POINTERS = _pointers_work()
 
 
 class _Identity:
-    """Keys for nodes: the C++ address, or (fallback) the hash with ``==`` confirmation."""
+    """Fallback keys where addresses cannot be read: the hash confirmed by ``==``."""
 
     def __init__(self) -> None:
         self._by_hash: dict[int, list[tuple[Expr, int]]] = {}
 
     def __call__(self, e: Expr) -> int:
-        if _POINTERS:
-            return _pointer(e)
         h = hash(e)
         bucket = self._by_hash.setdefault(h, [])
         for known, key in bucket:
@@ -116,34 +115,73 @@ class _Identity:
         return key
 
 
-class _Graph:
-    """Distinct non-atomic nodes of some expressions, children before parents."""
+class Graph:
+    """The distinct nodes of some expressions, identified by address (see the module docstring).
+
+    ``order``: keys of the non-atomic nodes, children before parents; ``node``: key -> node;
+    ``children``: key -> tuple of the children's keys (atoms included); ``atoms``: key -> atom
+    (symbols and numbers). ``roots``: the keys of the expressions, in order. A graph is built
+    once and may be walked many times (an equilibrium search evaluates the same equations at
+    many points); it keeps every node alive, so the addresses stay valid.
+    """
 
     def __init__(self, exprs: Sequence[Expr]) -> None:
-        key = _Identity()
-        self.key = key
-        self.node: dict[int, Expr] = {}
-        self.children: dict[int, tuple[tuple[Expr, int | None], ...]] = {}
-        self.order: list[int] = []
+        with _no_gc():
+            self._build(list(exprs))
+
+    def _build(self, exprs: list[Expr]) -> None:
+        node: dict[int, Expr] = {}
+        atoms: dict[int, Expr] = {}
+        children: dict[int, tuple[int, ...]] = {}
+        order: list[int] = []
+        if _POINTERS:
+            rd, off = _read_pointer, _POINTER_OFFSET
+
+            def key(e: Expr) -> int:
+                return rd(id(e) + off).value  # type: ignore[return-value]
+        else:
+            key = _Identity()
+        roots = []
         for root in exprs:
-            if root.is_Atom or key(root) in self.node:
+            rk = key(root)
+            roots.append(rk)
+            if root.is_Atom:
+                atoms[rk] = root
                 continue
-            stack: list[tuple[Expr, bool]] = [(root, False)]
+            if rk in node:
+                continue
+            stack: list[tuple[Expr, int, tuple[int, ...] | None]] = [(root, rk, None)]
             while stack:
-                e, done = stack.pop()
-                k = key(e)
-                if k in self.node:
+                e, k, kids = stack.pop()
+                if kids is not None:
+                    if k not in node:
+                        node[k] = e
+                        children[k] = kids
+                        order.append(k)
                     continue
-                if done:
-                    self.node[k] = e
-                    self.order.append(k)
+                if k in node:
                     continue
-                kids = tuple((a, None if a.is_Atom else key(a)) for a in e.args)
-                self.children[k] = kids
-                stack.append((e, True))
-                for a, ka in kids:
-                    if ka is not None and ka not in self.node:
-                        stack.append((a, False))
+                keys = []
+                push = []
+                for a in e.args:
+                    ka = key(a)
+                    keys.append(ka)
+                    if a.is_Atom:
+                        atoms[ka] = a
+                    elif ka not in node:
+                        push.append((a, ka, None))
+                stack.append((e, k, tuple(keys)))
+                stack.extend(push)
+        self.node = node
+        self.atoms = atoms
+        self.children = children
+        self.order = order
+        self.roots = tuple(roots)
+        self._exprs = exprs  # keeps the roots (and so every node) alive
+
+    def symbol_names(self) -> set[str]:
+        """Names of the symbols among the atoms."""
+        return {str(a) for a in self.atoms.values() if a.is_Symbol}
 
 
 @contextmanager
@@ -160,7 +198,7 @@ def _no_gc() -> Iterator[None]:
 
 
 def jet(exprs: Sequence[Expr], variables: Sequence[se.Symbol],
-        point: Mapping[se.Symbol, Expr], n_gradients: int | None = None) -> Jet:
+        point: Mapping[se.Symbol, Expr], differentiate: Sequence[bool] | None = None) -> Jet:
     """Values and first derivatives of ``exprs`` with respect to ``variables`` at ``point``.
 
     Parameters
@@ -172,95 +210,83 @@ def jet(exprs: Sequence[Expr], variables: Sequence[se.Symbol],
     point : mapping symbol -> expression
         Substitutions that define the point; symbols not in it stay as they are (parameters,
         ``t``). It may substitute symbols that are not variables (e.g. accelerations).
-    n_gradients : int, optional
-        Differentiate only the first ``n_gradients`` expressions; of the others only the values
-        are wanted (their gradients come back empty).
+    differentiate : sequence of bool, optional
+        Which expressions to differentiate (all when None); of the others only the values are
+        wanted (their gradients come back empty).
 
     Returns
     -------
     Jet
         ``values`` (one per expression) and sparse ``gradients``.
     """
+    exprs = list(exprs)
+    mask = [True] * len(exprs) if differentiate is None else [bool(d) for d in differentiate]
     with _no_gc():
-        return _jet(list(exprs), variables, point,
-                    len(exprs) if n_gradients is None else n_gradients)
+        return _jet(exprs, variables, point, mask)
 
 
 def _jet(exprs: list[Expr], variables: Sequence[se.Symbol], point: Mapping[se.Symbol, Expr],
-         n_gradients: int) -> Jet:
+         mask: list[bool]) -> Jet:
+    g = Graph(exprs)
     # symbols are told apart by name (their hashes may collide too)
     var_index = {str(v): i for i, v in enumerate(variables)}
     sub = {str(k): as_basic(v) for k, v in point.items()}
-    g = _Graph(exprs)
-
-    def atom_value(a: Expr) -> Expr:
-        return sub.get(str(a), a) if a.is_Symbol else a
-
-    def atom_grad(a: Expr) -> dict[int, Expr]:
-        i = var_index.get(str(a)) if a.is_Symbol else None
-        return {} if i is None else {i: ONE}
-
     value: dict[int, Expr] = {}
     grad: dict[int, dict[int, Expr]] = {}
-
-    def val(a: Expr, ka: int | None) -> Expr:
-        return atom_value(a) if ka is None else value[ka]
+    changed: set[int] = set()
+    for ka, a in g.atoms.items():
+        value[ka] = a
+        grad[ka] = {}
+        if a.is_Symbol:
+            name = str(a)
+            if name in sub:
+                value[ka] = sub[name]
+                changed.add(ka)
+            i = var_index.get(name)
+            if i is not None:
+                grad[ka] = {i: ONE}
+    atom_keys = set(g.atoms)
 
     # 1. values at the point, bottom-up; a node whose children keep their values is kept as is
     for k in g.order:
-        node = g.node[k]
-        changed = False
-        vals = []
-        for a, ka in g.children[k]:
-            v = val(a, ka)
-            if v is not a:
-                changed = True
-            vals.append(v)
-        value[k] = _rebuild(node, vals) if changed else node
+        kids = g.children[k]
+        if any(c in changed for c in kids):
+            value[k] = _rebuild(g.node[k], [value[c] for c in kids])
+            changed.add(k)
+        else:
+            value[k] = g.node[k]
 
     # 2. which nodes need a gradient, top-down (reverse post-order): a factor of a product
     #    whose other factors vanish at the point contributes nothing
-    need: set[int] = {g.key(e) for e in exprs[:n_gradients] if not e.is_Atom}
+    need: set[int] = {k for k, m in zip(g.roots, mask, strict=True) if m} - atom_keys
     for k in reversed(g.order):
         if k not in need:
             continue
         kids = g.children[k]
         if type(g.node[k]).__name__ == "Mul":
-            zeros = [i for i, (a, ka) in enumerate(kids) if _is_zero(val(a, ka))]
+            zeros = [c for c in kids if _is_zero(value[c])]
             if len(zeros) >= 2:
                 continue
             if len(zeros) == 1:
-                ka = kids[zeros[0]][1]
-                if ka is not None:
-                    need.add(ka)
+                need.add(zeros[0])
                 continue
-        for _, ka in kids:
-            if ka is not None:
-                need.add(ka)
+        need.update(kids)
 
     # 3. gradients of the needed nodes, bottom-up
     for k in g.order:
         if k not in need:
             continue
         kids = g.children[k]
-        grads = [atom_grad(a) if ka is None else grad.get(ka, {}) for a, ka in kids]
+        grads = [grad.get(c, {}) for c in kids]
         if not any(grads):
             grad[k] = {}
             continue
-        vals = [val(a, ka) for a, ka in kids]
-        grad[k] = _chain(g.node[k], vals, grads, value[k])
+        grad[k] = _chain(g.node[k], [value[c] for c in kids], grads, value[k])
 
-    values = []
-    gradients = []
-    for i, e in enumerate(exprs):
-        if not e.is_Atom:
-            k = g.key(e)
-            values.append(value[k])
-            gradients.append(dict(grad[k]) if i < n_gradients else {})
-        else:
-            values.append(atom_value(e))
-            gradients.append(atom_grad(e) if i < n_gradients else {})
-    return Jet(tuple(values), tuple(gradients))
+    values = tuple(value[k] for k in g.roots)
+    gradients = tuple(dict(grad.get(k, {})) if m else {}
+                      for k, m in zip(g.roots, mask, strict=True))
+    return Jet(values, gradients)
 
 
 def as_basic(v: object) -> Expr:
@@ -392,48 +418,176 @@ def evaluate_float(exprs: Sequence[Expr], values: Mapping[str, float]) -> list[f
     evaluations compile with :func:`jourdain.numeric.lambdify`. ``values`` maps symbol names to
     numbers; a symbol without a value raises :class:`JourdainError`.
     """
+    g = Graph(exprs)
     with _no_gc():
-        exprs = list(exprs)
-        g = _Graph(exprs)
-        num: dict[int, float] = {}
+        num = _float_values(g, values)
+    return [num[k] for k in g.roots]
 
-        def atom(a: Expr) -> float:
-            if a.is_Symbol:
-                name = str(a)
-                if name not in values:
-                    raise JourdainError(f'no value for the symbol "{name}"')
-                return float(values[name])
-            return float(a)
 
-        for k in g.order:
-            node = g.node[k]
-            args = [atom(a) if ka is None else num[ka] for a, ka in g.children[k]]
-            name = type(node).__name__
-            if name == "Add":
-                num[k] = math.fsum(args) if len(args) > 8 else sum(args)
-            elif name == "Mul":
-                num[k] = math.prod(args)
-            elif name == "Pow":
-                num[k] = math.exp(args[1]) if node.args[0] == se.E else args[0] ** args[1]
-            elif name in _FLOAT_FUNCS:
-                num[k] = _FLOAT_FUNCS[name](*args)
-            else:
-                num[k] = float(node.func(*(se.RealDouble(x) for x in args)))
-        return [atom(e) if e.is_Atom else num[g.key(e)] for e in exprs]
+def _float_values(g: Graph, values: Mapping[str, float]) -> dict[int, float]:
+    num: dict[int, float] = {}
+    for ka, a in g.atoms.items():
+        if a.is_Symbol:
+            name = str(a)
+            if name not in values:
+                raise JourdainError(f'no value for the symbol "{name}"')
+            num[ka] = float(values[name])
+        else:
+            num[ka] = float(a)
+    funcs = _FLOAT_FUNCS
+    fsum, prod = math.fsum, math.prod
+    for k in g.order:
+        node = g.node[k]
+        args = [num[c] for c in g.children[k]]
+        name = type(node).__name__
+        if name == "Add":
+            v = fsum(args)
+        elif name == "Mul":
+            v = prod(args)
+        elif name == "Pow":
+            v = math.exp(args[1]) if node.args[0] == se.E else args[0] ** args[1]
+        elif name in funcs:
+            v = funcs[name](*args)
+        else:
+            v = float(node.func(*(se.RealDouble(x) for x in args)))
+        if isinstance(v, complex):
+            raise JourdainError(f"{name} has no real value here (argument {args})")
+        num[k] = v
+    return num
 
 
 def free_symbol_names(exprs: Sequence[Expr]) -> set[str]:
     """Names of the symbols in some expressions, visiting each shared node once (SymEngine's
     ``free_symbols`` walks a shared graph as a tree)."""
+    return Graph(exprs).symbol_names()
+
+
+# --- numeric forward mode --------------------------------------------------------------------
+_DFLOAT = {
+    "sin": lambda v, val: math.cos(v[0]),
+    "cos": lambda v, val: -math.sin(v[0]),
+    "tan": lambda v, val: 1.0 + val * val,
+    "log": lambda v, val: 1.0 / v[0],
+    "atan": lambda v, val: 1.0 / (1.0 + v[0] ** 2),
+    "asin": lambda v, val: 1.0 / math.sqrt(1.0 - v[0] ** 2),
+    "acos": lambda v, val: -1.0 / math.sqrt(1.0 - v[0] ** 2),
+    "sinh": lambda v, val: math.cosh(v[0]),
+    "cosh": lambda v, val: math.sinh(v[0]),
+    "tanh": lambda v, val: 1.0 - val * val,
+    "Abs": lambda v, val: float((v[0] > 0) - (v[0] < 0)),
+    "sign": lambda v, val: 0.0,
+}
+
+
+@dataclass(frozen=True)
+class FloatJet:
+    """Result of :func:`jet_float`: ``values`` (n,), ``jacobian`` (n, number of variables), and
+    ``symbols``: the names of all symbols met in the expressions."""
+
+    values: np.ndarray
+    jacobian: np.ndarray
+    symbols: frozenset[str]
+
+
+def jet_float(exprs: Sequence[Expr] | Graph, variables: Sequence[se.Symbol],
+              values: Mapping[str, float], differentiate: Sequence[bool] | None = None
+              ) -> FloatJet:
+    """Numbers and first derivatives of ``exprs`` with respect to ``variables`` at a numeric
+    point: forward mode in floating point with dense NumPy gradients, each shared node once.
+
+    ``exprs`` may be a prebuilt :class:`Graph` (to evaluate the same expressions at many
+    points). ``values`` maps every symbol name of the expressions (variables included) to a
+    number. Only the expressions marked in ``differentiate`` are differentiated (all when
+    None); the rows of the others in the Jacobian are zero.
+    """
+    g = exprs if isinstance(exprs, Graph) else Graph(exprs)
+    mask = ([True] * len(g.roots) if differentiate is None
+            else [bool(d) for d in differentiate])
     with _no_gc():
-        exprs = list(exprs)
-        g = _Graph(exprs)
-        out: set[str] = set()
-        for e in exprs:
-            if e.is_Symbol:
-                out.add(str(e))
-        for kids in g.children.values():
-            for a, ka in kids:
-                if ka is None and a.is_Symbol:
-                    out.add(str(a))
-        return out
+        return _jet_float(g, variables, values, mask)
+
+
+def _jet_float(g: Graph, variables: Sequence[se.Symbol], values: Mapping[str, float],
+               mask: list[bool]) -> FloatJet:
+    nv = len(variables)
+    unit = np.eye(nv)
+    var_index = {str(v): i for i, v in enumerate(variables)}
+    value = _float_values(g, values)
+    grad: dict[int, np.ndarray | None] = {}
+    for ka, a in g.atoms.items():
+        i = var_index.get(str(a)) if a.is_Symbol else None
+        grad[ka] = None if i is None else unit[i]
+    atom_keys = set(g.atoms)
+
+    # nodes that need a gradient (a product with two vanishing factors needs none)
+    need: set[int] = {k for k, m in zip(g.roots, mask, strict=True) if m} - atom_keys
+    for k in reversed(g.order):
+        if k not in need:
+            continue
+        kids = g.children[k]
+        if type(g.node[k]).__name__ == "Mul":
+            zeros = [c for c in kids if value[c] == 0.0]
+            if len(zeros) >= 2:
+                continue
+            if len(zeros) == 1:
+                need.add(zeros[0])
+                continue
+        need.update(kids)
+
+    # gradients (None: does not depend on the variables)
+    prod = math.prod
+    for k in g.order:
+        if k not in need:
+            continue
+        kids = g.children[k]
+        grads = [grad.get(c) for c in kids]
+        if all(x is None for x in grads):
+            grad[k] = None
+            continue
+        vals = [value[c] for c in kids]
+        node = g.node[k]
+        name = type(node).__name__
+        acc = None
+        if name == "Add":
+            for x in grads:
+                if x is not None:
+                    acc = x if acc is None else acc + x
+        elif name == "Mul":
+            n = len(vals)
+            for i, x in enumerate(grads):
+                if x is None:
+                    continue
+                c = prod(vals[j] for j in range(n) if j != i) if n > 2 else vals[1 - i]
+                if c != 0.0:
+                    acc = c * x if acc is None else acc + c * x
+        elif name == "Pow":
+            b, e = vals
+            gb, ge = grads
+            if gb is not None:
+                acc = (e * b ** (e - 1.0)) * gb
+            if ge is not None:
+                term = (value[k] * math.log(b)) * ge
+                acc = term if acc is None else acc + term
+        else:
+            if name in _DFLOAT:
+                partials = [_DFLOAT[name](vals, value[k])]
+            elif name == "atan2":
+                yy, xx = vals
+                r2 = xx * xx + yy * yy
+                partials = [xx / r2, -yy / r2]
+            else:
+                partials = [float(p) for p in _partials(node, name,
+                                                        [se.RealDouble(x) for x in vals],
+                                                        se.RealDouble(value[k]))]
+            for c, x in zip(partials, grads, strict=True):
+                if x is not None and c != 0.0:
+                    acc = c * x if acc is None else acc + c * x
+        grad[k] = acc
+
+    out_v = np.array([value[k] for k in g.roots], dtype=float)
+    out_j = np.zeros((len(g.roots), nv))
+    for i, k in enumerate(g.roots):
+        gi = grad.get(k) if mask[i] else None
+        if gi is not None:
+            out_j[i] = gi
+    return FloatJet(out_v, out_j, frozenset(g.symbol_names()))

@@ -2,7 +2,7 @@
 
 Solved by Newton's method with the exact Jacobian ``∂(k − q)/∂y`` at ``ẏ = 0`` (the stiffness
 part of the linearization), obtained together with the residual in one pass over the expression
-graph (:func:`jourdain.differentiate.jet` with numbers for the parameters). A system usually has
+graph (:func:`jourdain.differentiate.jet_float`, in floating point). A system usually has
 several equilibria (a pendulum hangs or stands); the starting guess says which one is meant,
 :func:`find_equilibria` collects the distinct ones reached from several guesses.
 """
@@ -14,9 +14,8 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import symengine as se
 
-from .differentiate import jet
+from .differentiate import Graph, jet_float
 from .errors import EvaluationError, JourdainError
 
 if TYPE_CHECKING:
@@ -120,19 +119,16 @@ def find_equilibrium(system: System, guess: Mapping[str, float] | Sequence[float
             raise EvaluationError(f"unknown input {k!r}; inputs are {u_names}")
         uvals[k] = float(v)
     eom = eom if eom is not None else system.equations_of_motion()
-    residual_exprs = [eom.k[i] - eom.q[i] for i in range(f)]
-    fixed_point: dict[Any, Any] = {s: se.Integer(0) for s in system.yd}
-    fixed_point.update({se.Symbol(k): se.Float(v) for k, v in pars.items()})
-    fixed_point.update({se.Symbol(k): se.Float(v) for k, v in uvals.items()})
-    fixed_point[system.t] = se.Float(float(t))
+    # the graph of k − q is built once and evaluated (values and exact Jacobian, in floating
+    # point) at every iterate
+    graph = Graph([*eom.k.entries(), *eom.q.entries()])
+    fixed_values = {**pars, **uvals, "t": float(t), **{str(s): 0.0 for s in system.yd}}
 
     def evaluate(y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        point = dict(fixed_point)
-        point.update({s: se.Float(float(v)) for s, v in zip(system.y, y, strict=True)})
-        J = jet(residual_exprs, system.y, point)
-        r = np.array([_number(v, names, "residual") for v in J.values])
-        Jm = np.array([[_number(d, names, "Jacobian") for d in row] for row in J.jacobian(f)])
-        return r, Jm
+        values = dict(fixed_values)
+        values.update({str(s): float(v) for s, v in zip(system.y, y, strict=True)})
+        J = jet_float(graph, system.y, values)
+        return J.values[:f] - J.values[f:], J.jacobian[:f] - J.jacobian[f:]
 
     # Levenberg–Marquardt on ||q - k||²: a trust region keeps the steps short where the
     # Jacobian is nearly singular (nearly cyclic coordinates), so the iteration stays with the
@@ -229,10 +225,3 @@ def _start(guess: Any, names: list[str]) -> np.ndarray:
     if not np.all(np.isfinite(y)):
         raise EvaluationError("guess contains NaN or inf")
     return y
-
-
-def _number(e: se.Basic, names: list[str], what: str) -> float:
-    try:
-        return float(e)
-    except (RuntimeError, TypeError, ValueError):
-        raise JourdainError(f"the equilibrium {what} did not evaluate to a number: {e}") from None

@@ -18,8 +18,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import EvaluationError
-from ..linearization import CompiledLinearization, Linearization
-from .state_space import StateSpace, state_space
+from .state_space import AnyLinearization, StateSpace, state_space
 
 
 @dataclass(frozen=True)
@@ -66,9 +65,9 @@ class FrequencyResponse:
         return self.response[:, i, j]
 
 
-def frequency_response(system: StateSpace | Linearization | CompiledLinearization,
+def frequency_response(system: StateSpace | AnyLinearization,
                        omega: Sequence[float] | np.ndarray, excitation: Any = "inputs",
-                       t: float = 0.0,
+                       t: float | None = None,
                        parameters: Mapping[str, float] | None = None) -> FrequencyResponse:
     """Magnitude and phase of ``η`` for harmonic excitation over the frequencies ``omega``.
 

@@ -19,8 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..linearization import CompiledLinearization, Linearization
-from .state_space import StateSpace, state_space
+from .state_space import AnyLinearization, StateSpace, state_space
 
 ASYMPTOTICALLY_STABLE = "asymptotically stable"
 MARGINALLY_STABLE = "marginally stable"
@@ -98,14 +97,14 @@ class Stability:
         return f"{self.verdict}: {self.reason}"
 
 
-def _as_state_space(system: StateSpace | Linearization | CompiledLinearization, t: float,
+def _as_state_space(system: StateSpace | AnyLinearization, t: float | None,
                     parameters: Mapping[str, float] | None) -> StateSpace:
     if isinstance(system, StateSpace):
         return system
     return state_space(system, t, parameters)
 
 
-def modes(system: StateSpace | Linearization | CompiledLinearization, t: float = 0.0,
+def modes(system: StateSpace | AnyLinearization, t: float | None = None,
           parameters: Mapping[str, float] | None = None) -> Modes:
     """Eigenvalues, natural frequencies, damping ratios and mode shapes.
 
@@ -131,7 +130,7 @@ def modes(system: StateSpace | Linearization | CompiledLinearization, t: float =
                  coordinate_names=ss.coordinate_names)
 
 
-def stability(system: StateSpace | Linearization | CompiledLinearization, t: float = 0.0,
+def stability(system: StateSpace | AnyLinearization, t: float | None = None,
               parameters: Mapping[str, float] | None = None, rtol: float = 1e-8) -> Stability:
     """Stability verdict with its reason (see the module docstring for the definitions).
 

@@ -16,7 +16,14 @@ from typing import Any
 import numpy as np
 
 from ..errors import EvaluationError, SingularMassMatrix
-from ..linearization import CompiledLinearization, Linearization, TimeVariantError
+from ..linearization import (
+    CompiledLinearization,
+    Linearization,
+    NumericLinearization,
+    TimeVariantError,
+)
+
+AnyLinearization = Linearization | CompiledLinearization | NumericLinearization
 
 
 @dataclass(frozen=True)
@@ -64,31 +71,35 @@ class StateSpace:
         return len(self.coordinate_names)
 
 
-def numbers(lin: Linearization | CompiledLinearization, t: float = 0.0,
+def numbers(lin: AnyLinearization, t: float | None = None,
             parameters: Mapping[str, float] | None = None) -> dict[str, np.ndarray]:
-    """``M_tilde, P, Q, h, B`` (and D, G, K, N) as arrays, from a symbolic or compiled result."""
+    """``M_tilde, P, Q, h, B`` (and D, G, K, N) as arrays, from a symbolic, compiled or numeric
+    result (``t`` defaults to 0, or to the time of a numeric result)."""
     if isinstance(lin, CompiledLinearization):
-        return lin(t, parameters)
+        return lin(0.0 if t is None else t, parameters)
     if isinstance(lin, Linearization):
+        return lin.evaluate(0.0 if t is None else t, parameters)
+    if isinstance(lin, NumericLinearization):
         return lin.evaluate(t, parameters)
-    raise EvaluationError(f"expected a Linearization or a CompiledLinearization, got "
-                          f"{type(lin).__name__}")
+    raise EvaluationError(f"expected a Linearization, CompiledLinearization or "
+                          f"NumericLinearization, got {type(lin).__name__}")
 
 
-def _linearization_of(lin: Any) -> Linearization:
+def _linearization_of(lin: Any) -> Linearization | NumericLinearization:
     return lin.linearization if isinstance(lin, CompiledLinearization) else lin
 
 
-def state_space(lin: Linearization | CompiledLinearization, t: float = 0.0,
+def state_space(lin: AnyLinearization, t: float | None = None,
                 parameters: Mapping[str, float] | None = None,
                 allow_time_variant: bool = False) -> StateSpace:
     """State-space matrices of a linearization for numeric parameter values.
 
     Parameters
     ----------
-    lin : Linearization or CompiledLinearization
-    t : float
-        Time at which to evaluate (matters for time-variant results only).
+    lin : Linearization, CompiledLinearization or NumericLinearization
+    t : float, optional
+        Time at which to evaluate (matters for time-variant results only); 0 by default (a
+        numeric result has its own time).
     parameters : mapping name -> value, optional
         Overrides of the default parameter values.
     allow_time_variant : bool
@@ -110,11 +121,13 @@ def state_space(lin: Linearization | CompiledLinearization, t: float = 0.0,
             "decide stability. Pass allow_time_variant=True to get A(t) at one t anyway."
         )
     num = numbers(lin, t, parameters)
-    return _from_numbers(base, num, float(t), parameters)
+    if isinstance(base, NumericLinearization):
+        return _from_numbers(base, num, base.t, base.parameters)
+    return _from_numbers(base, num, 0.0 if t is None else float(t), parameters)
 
 
-def _from_numbers(base: Linearization, num: Mapping[str, np.ndarray], t: float,
-                  parameters: Mapping[str, float] | None) -> StateSpace:
+def _from_numbers(base: Linearization | NumericLinearization, num: Mapping[str, np.ndarray],
+                  t: float, parameters: Mapping[str, float] | None) -> StateSpace:
     from ..numeric import parameter_vector
 
     M, P, Q, Bu, h = num["M_tilde"], num["P"], num["Q"], num["B"], num["h"]

@@ -47,7 +47,10 @@ class Sweep:
         return None
 
 
-def _check_parameter(lin: Linearization, parameter: str) -> None:
+def _check_parameter(lin: object, parameter: str) -> None:
+    if not isinstance(lin, Linearization):
+        raise EvaluationError("sweeps need the symbolic Linearization (or its compiled form); a "
+                              "NumericLinearization holds one set of parameter values")
     names = [k for k, _ in lin.system.parameters]
     if parameter not in names:
         raise EvaluationError(f'unknown parameter "{parameter}"; parameters are {names}')
