@@ -162,6 +162,16 @@ def test_nan_and_bad_arguments_give_clear_errors():
         s.simulate((1, 0), y0, [0, 0], inputs={"F": 0.0})
     with pytest.raises(IntegrationError, match=r"NaN.*t = 0\.5"):
         s.simulate((0, 1), y0, [0, 0], inputs={"F": lambda t: np.nan if t >= 0.5 else 0.0})
+    with pytest.raises(jd.EvaluationError, match="max_step must be positive"):
+        s.simulate((0, 1), y0, [0, 0], inputs={"F": 0.0}, max_step=0)
+    with pytest.raises(jd.EvaluationError, match=r"expected 1 values for \['F'\]"):
+        s.simulate((0, 1), y0, [0, 0], inputs=[0.0, 1.0])
+    with pytest.raises(jd.EvaluationError, match='unknown input'):
+        s.simulate((0, 1), y0, [0, 0], inputs={"F": 0.0, "G": 1.0})
+    with pytest.raises(jd.EvaluationError, match="table times must increase"):
+        s.simulate((0, 1), y0, [0, 0], inputs={"F": ([0.0, 0.0, 1.0], [1.0, 2.0, 3.0])})
+    with pytest.raises(jd.EvaluationError, match=r"input expressions may use"):
+        s.simulate((0, 1), y0, [0, 0], inputs={"F": se.Symbol("w") * 2})
     with pytest.raises(jd.EvaluationError, match="unknown symbol"):
         s.simulate((0, 1), y0, [0, 0], inputs={"F": 0.0}, events=[Event(se.Symbol("zz"))])
 

@@ -139,6 +139,11 @@ class _Setup:
         self.callback_error: BaseException | None = None
         exprs: list[se.Basic] = [se.Integer(0)] * nu
         names = system.input_names
+        if inputs is not None and not isinstance(inputs, Mapping):
+            seq = list(inputs)  # values in the order of system.input_names
+            if len(seq) != nu:
+                raise EvaluationError(f"inputs: expected {nu} values for {names}, got {len(seq)}")
+            inputs = dict(zip(names, seq, strict=True))
         inputs = dict(inputs or {})
         unknown = set(inputs) - set(names)
         if unknown:
@@ -345,6 +350,10 @@ def simulate(system: System, t_span: tuple[float, float], y0: Any, yd0: Any,
     if a.size != 2 * f or not np.all(a > 0) or not np.all(np.isfinite(a)):
         raise EvaluationError(f"atol must be a positive number or {2 * f} positive numbers")
     atol_x = np.concatenate([a, [a.min()]])
+    if not max_step > 0:
+        raise EvaluationError(f"max_step must be positive, got {max_step!r}")
+    if first_step is not None and not (first_step > 0 and math.isfinite(first_step)):
+        raise EvaluationError(f"first_step must be a positive number, got {first_step!r}")
     if method not in C_METHODS and method not in SCIPY_METHODS:
         raise EvaluationError(f"unknown method {method!r}; methods are "
                               f"{sorted(C_METHODS) + list(SCIPY_METHODS)}")

@@ -161,31 +161,34 @@ static int rhs(jd_ctx *c, double t, const double *x, double *dx) {
             if (fabs(M[i * f + i]) > dmax) dmax = fabs(M[i * f + i]);
         }
         dx[2 * f] = w;
+        /* L L^T = M; the diagonal of L holds 1/l_jj (one division per column) */
         for (long j = 0; j < f; ++j) {
+            const double *Lj = L + j * f;
             double d = M[j * f + j];
-            for (long m = 0; m < j; ++m) d -= L[j * f + m] * L[j * f + m];
+            for (long m = 0; m < j; ++m) d -= Lj[m] * Lj[m];
             if (!(d > 1e-13 * dmax)) {
                 if (!isfinite(d)) goto nan;
                 c->fail_t = t; memcpy(c->fail_x, x, c->n * sizeof(double));
                 return JD_ESINGULAR;
             }
-            double ljj = sqrt(d);
-            L[j * f + j] = ljj;
+            double inv = 1.0 / sqrt(d);
+            L[j * f + j] = inv;
             for (long i = j + 1; i < f; ++i) {
+                const double *Li = L + i * f;
                 double s = M[i * f + j];
-                for (long m = 0; m < j; ++m) s -= L[i * f + m] * L[j * f + m];
-                L[i * f + j] = s / ljj;
+                for (long m = 0; m < j; ++m) s -= Li[m] * Lj[m];
+                L[i * f + j] = s * inv;
             }
         }
         for (long i = 0; i < f; ++i) {      /* L z = b */
             double s = b[i];
             for (long m = 0; m < i; ++m) s -= L[i * f + m] * b[m];
-            b[i] = s / L[i * f + i];
+            b[i] = s * L[i * f + i];
         }
         for (long i = f - 1; i >= 0; --i) { /* L^T a = z */
             double s = b[i];
             for (long m = i + 1; m < f; ++m) s -= L[m * f + i] * b[m];
-            b[i] = s / L[i * f + i];
+            b[i] = s * L[i * f + i];
         }
         for (long i = 0; i < c->n; ++i) if (!isfinite(dx[i])) goto nan;
     }
