@@ -251,6 +251,8 @@ def test_joint_moved_by_another_joints_coordinate_is_rejected():
     s = jd.System([phi], bodies, [jd.Gravity((0, 0, -g))], parameters={"g": 9.81})
     with pytest.raises(jd.ModelError, match=r'"screw" \(moves in 1 directions, drives 0'):
         s.reactions()
+    out = s.evaluate([0.3], [1.0])  # the equations of motion are still there, g is not
+    assert "M" in out and "g" not in out and '"screw"' in out["reactions_error"]
 
 
 def test_general_joint_derives_the_revolute_directions(rng):

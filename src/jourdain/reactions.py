@@ -976,7 +976,17 @@ def joint_reactions(system: System, joints: str | Sequence[str], y: Any, yd: Any
 def evaluate_keys(system: System, y: Any, yd: Any, t: float, parameters: Any, inputs: Any,
                   eom: Mapping[str, np.ndarray]) -> dict[str, Any]:
     """The reaction entries of :meth:`System.evaluate`: ``Q_bar, N_hat, k_hat, q_hat, g,
-    g_names, g_undetermined``."""
+    g_names, g_undetermined``.
+
+    A model whose reactions cannot be formed (a joint moved by another joint's coordinate, a
+    symbolic joint axis, constrained directions that do work) still has equations of motion:
+    then the only entry is ``reactions_error``, the message that :func:`reactions` raises, so
+    that no reaction numbers appear for it.
+    """
+    try:
+        _reactions_function(system)
+    except JourdainError as exc:
+        return {"reactions_error": str(exc)}
     return evaluate_reactions(system, y, yd, t, parameters, inputs, eom=eom)
 
 

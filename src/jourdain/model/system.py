@@ -205,7 +205,8 @@ class System:
         """Numbers at one state: a dict from the seed's names to NumPy arrays.
 
         Keys: ``M_bar, J_bar, q_c, q_e, M, k, q``, and the reactions ``Q_bar, N_hat, k_hat,
-        q_hat, g, g_names, g_undetermined`` (:func:`jourdain.reactions.evaluate_reactions`).
+        q_hat, g, g_names, g_undetermined`` (:func:`jourdain.reactions.evaluate_reactions`;
+        only ``reactions_error`` where the model's reactions cannot be formed).
         ``parameters`` overrides default values by name; ``inputs`` gives the inputs by name (or
         in the order of :attr:`input_names`).
         """
