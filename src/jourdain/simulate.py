@@ -110,8 +110,8 @@ def integrator_library() -> ctypes.CDLL:
     lib = build(content_key("integrator", src), src)
     vp, lg, db = ctypes.c_void_p, ctypes.c_long, ctypes.c_double
     lib.jd_integrate.restype = ctypes.c_int
-    lib.jd_integrate.argtypes = [vp, db, vp, vp, vp, vp, vp, vp, lg, vp, vp, vp, lg, vp, vp, vp,
-                                 vp, lg, vp, lg, vp]
+    lib.jd_integrate.argtypes = [vp, db, vp, vp, vp, vp, vp, vp, lg, vp, vp, vp, vp, lg, vp, vp,
+                                 vp, vp, lg, vp, lg, vp]
     lib.jd_rhs.restype = ctypes.c_int
     lib.jd_rhs.argtypes = [vp, db, vp, vp, vp]
     return lib
@@ -410,12 +410,12 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
         cap = te.size
         out_t = np.empty(cap)
         out_x = np.empty((cap, n))
-        chunks_t: list[np.ndarray] = []
-        chunks_x: list[np.ndarray] = []
-    else:
+        out_dx = np.empty((cap, n))
+    chunks_t: list[np.ndarray] = []
+    chunks_x: list[np.ndarray] = []
+    chunks_dx: list[np.ndarray] = []
+    if te is None:
         cap = 1024
-        chunks_t = [np.array([t0])]
-        chunks_x = [x0[None, :].copy()]
     writer = (_Writer(output, system)
               if output and str(output).lower().endswith((".h5", ".hdf5")) else None)
     status = "finished"
@@ -430,16 +430,18 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
             if te is None:
                 out_t = np.empty(cap)
                 out_x = np.empty((cap, n))
+                out_dx = np.empty((cap, n))
                 n_out[0] = 0
             code = lib.jd_integrate(
                 ctypes.byref(setup.problem), t1, st.ctypes.data, x.ctypes.data, k0.ctypes.data,
                 g_old.ctypes.data, cnt.ctypes.data, _ptr(te), 0 if te is None else te.size,
-                i_eval.ctypes.data, out_t.ctypes.data, out_x.ctypes.data, cap,
+                i_eval.ctypes.data, out_t.ctypes.data, out_x.ctypes.data, out_dx.ctypes.data, cap,
                 n_out.ctypes.data, ev_t.ctypes.data, ev_x.ctypes.data, ev_i.ctypes.data, ev_cap,
                 n_ev.ctypes.data, max_steps, fail.ctypes.data)
             if te is None:
                 chunks_t.append(out_t[:n_out[0]])
                 chunks_x.append(out_x[:n_out[0]])
+                chunks_dx.append(out_dx[:n_out[0]])
                 if writer:
                     writer.append(chunks_t[-1], chunks_x[-1])
             elif writer:
@@ -478,13 +480,16 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
     if progress is True:
         print(file=sys.stderr)
     if te is not None:
-        t_out, x_out = out_t[:n_out[0]], out_x[:n_out[0]]
-    else:
+        t_out, x_out, dx_out = out_t[:n_out[0]], out_x[:n_out[0]], out_dx[:n_out[0]]
+    elif chunks_t and sum(len(c) for c in chunks_t):
         t_out, x_out = np.concatenate(chunks_t), np.concatenate(chunks_x)
+        dx_out = np.concatenate(chunks_dx)
+    else:  # failed or interrupted at the start: the initial state only
+        t_out, x_out, dx_out = np.array([t0]), x0[None, :].copy(), None
     m = int(n_ev[0])
     if nev and m == ev_cap:
         message += f"; only the first {ev_cap} event crossings were recorded"
-    return {"t": t_out, "x": x_out, "status": status, "message": message,
+    return {"t": t_out, "x": x_out, "dx": dx_out, "status": status, "message": message,
             "exception": exception, "error": error, "nfev": int(cnt[0]), "nstep": int(cnt[1]),
             "naccept": int(cnt[2]), "nreject": int(cnt[3]),
             "events": (ev_t[:m].copy(), ev_x[:m].copy(), ev_i[:m].copy())}
@@ -558,7 +563,11 @@ def _results(setup: _Setup, run: dict, method: str, rtol: float, atol: np.ndarra
     f = system.f
     t, x = run["t"], run["x"]
     U = setup.inputs_at(t, x) if len(t) else np.zeros((0, len(system.inputs)))
-    ydd = accelerations(setup.mkq, x[:, :f], x[:, f:2 * f], t, p, U)
+    dx = run.get("dx")
+    if dx is not None and len(dx) == len(t):  # from the C loop (NaN where M was singular)
+        ydd = dx[:, f:2 * f].copy()
+    else:
+        ydd = accelerations(setup.mkq, x[:, :f], x[:, f:2 * f], t, p, U)
     ev_t, ev_x, ev_i = run["events"]
     events = {ev.label: [] for ev in setup.events}
     for tt, xx, k in zip(ev_t, ev_x, ev_i, strict=True):

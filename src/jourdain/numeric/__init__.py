@@ -30,7 +30,7 @@ if TYPE_CHECKING:
     from ..model.system import System
 
 
-_GENERATOR_VERSION = "c1"
+_GENERATOR_VERSION = "c2"
 
 
 @dataclass(frozen=True, eq=False)

@@ -190,19 +190,73 @@ def function_source(name: str, exprs: Sequence[se.Basic], names: Mapping[str, st
     code: list[str] = []
     lines: list[str] = []
     n_tmp = 0
+
+    def temporary(c: str) -> str:
+        nonlocal n_tmp
+        if split:
+            lines.append(f"    x[{n_tmp}] = {c};")
+            ref = f"x[{n_tmp}]"
+        else:
+            lines.append(f"    const double x{n_tmp} = {c};")
+            ref = f"x{n_tmp}"
+        n_tmp += 1
+        return ref
+
+    # sin and cos of sums of coordinates (absolute angles of a chain give sin(q1 - q2), ...)
+    # come from one sin/cos pair per symbol and the addition theorems: a few multiplications
+    # instead of a call to sin or cos each
+    base: dict[str, tuple[str, str]] = {}
+    sums: dict[int, tuple[str, str]] = {}
+
+    def base_pair(sym: se.Basic) -> tuple[str, str]:
+        key = str(sym)
+        if key not in base:
+            v = _atom(sym, names)
+            base[key] = (temporary(f"sin({v})"), temporary(f"cos({v})"))
+        return base[key]
+
+    def sin_cos(arg_id: int, arg: se.Basic) -> tuple[str, str] | None:
+        if arg_id in sums:
+            return sums[arg_id]
+        terms = []
+        for term in arg.args:
+            if type(term).__name__ == "Symbol":
+                terms.append((1, term))
+            elif (type(term).__name__ == "Mul" and len(term.args) == 2
+                  and term.args[0].is_Integer and abs(int(term.args[0])) == 1
+                  and type(term.args[1]).__name__ == "Symbol"):
+                terms.append((int(term.args[0]), term.args[1]))
+            else:
+                return None
+        S = C = ""
+        for sign, sym in terms:
+            s1, c1 = base_pair(sym)
+            if not S:
+                S, C = (s1, c1) if sign > 0 else (f"(-{s1})", c1)
+                continue
+            op1, op2 = ("+", "-") if sign > 0 else ("-", "+")
+            S, C = (temporary(f"{S}*{c1} {op1} {C}*{s1}"), temporary(f"{C}*{c1} {op2} {S}*{s1}"))
+        sums[arg_id] = (S, C)
+        return S, C
+
     for i, node in enumerate(g.nodes):
+        tn = type(node).__name__
+        if tn in ("sin", "cos"):
+            arg = node.args[0]
+            sc = None
+            if type(arg).__name__ == "Symbol":
+                sc = base_pair(arg)
+            elif g.children[i][0] >= 0 and type(arg).__name__ == "Add":
+                sc = sin_cos(g.children[i][0], arg)
+            if sc is not None:
+                code.append(sc[0] if tn == "sin" else sc[1])
+                continue
         a = [code[c] if c >= 0 else _atom(x, names)
              for c, x in zip(g.children[i], node.args, strict=True)]
         c = _node(node, a)
         # a node used more than once becomes a temporary; -x of an atom is not worth one
         if g.uses[i] > 1 and not (len(c) < 24 and c.startswith("(-")):
-            if split:
-                lines.append(f"    x[{n_tmp}] = {c};")
-                c = f"x[{n_tmp}]"
-            else:
-                lines.append(f"    const double x{n_tmp} = {c};")
-                c = f"x{n_tmp}"
-            n_tmp += 1
+            c = temporary(c)
         code.append(c)
     first: dict[int, int] = {}
     for k, (e, r) in enumerate(zip(exprs, g.roots, strict=True)):

@@ -220,6 +220,7 @@ typedef struct {
     double t_old, h;
     const double *x_old;
     double *x_new, *K, *F, *tmp;
+    const double *dx_new;  /* derivative at x_new */
     int have_dense;
 } jd_step;
 
@@ -335,11 +336,24 @@ int jd_state_size(long f) { return (int)(2 * f + 1); }
 /* where the results of a run go */
 typedef struct {
     const double *t_eval; long n_eval; long *i_eval;
-    double *out_t, *out_x; long cap; long *n_out;
+    double *out_t, *out_x, *out_dx; long cap; long *n_out;
     double *ev_t, *ev_x; long *ev_i; long ev_cap; long *n_ev;
     double *g_old, *g_new, *g_tmp, *roots, *xe;
     double *fail;
 } jd_io;
+
+/* one output row: time, state and its derivative (evaluated when not at hand) */
+static void emit(jd_step *s, jd_io *io, double t, const double *x, const double *dx) {
+    long n = s->n, k = *io->n_out;
+    io->out_t[k] = t;
+    memcpy(io->out_x + k * n, x, n * sizeof(double));
+    if (dx) {
+        memcpy(io->out_dx + k * n, dx, n * sizeof(double));
+    } else if (rhs(s->c, t, io->out_x + k * n, io->out_dx + k * n)) {
+        for (long i = 0; i < n; ++i) io->out_dx[k * n + i] = NAN;
+    }
+    ++*io->n_out;
+}
 
 /*
  * Events and output for the accepted step s from s->t_old to t_new (end state s->x_new).
@@ -385,34 +399,29 @@ static int post_step(jd_step *s, jd_io *io, double t_new, double *t_stop_out) {
     if (io->n_eval > 0) {
         while (*io->i_eval < io->n_eval && io->t_eval[*io->i_eval] <= t_stop) {
             double te = io->t_eval[*io->i_eval];
-            io->out_t[*io->n_out] = te;
             if (te == t_new && terminal < 0) {
-                memcpy(io->out_x + *io->n_out * n, s->x_new, n * sizeof(double));
+                emit(s, io, te, s->x_new, s->dx_new);
             } else {
                 r = dense_prepare(s);
                 if (r) { io->fail[0] = s->c->fail_t; return r; }
-                dense_eval(s, te, io->out_x + *io->n_out * n);
+                dense_eval(s, te, io->xe);
+                emit(s, io, te, io->xe, NULL);
             }
-            ++*io->n_out; ++*io->i_eval;
+            ++*io->i_eval;
         }
     }
     if (terminal >= 0) {
         r = dense_prepare(s);
         if (r) { io->fail[0] = s->c->fail_t; return r; }
-        dense_eval(s, t_stop, io->xe);
         if (io->n_eval == 0) {
-            io->out_t[*io->n_out] = t_stop;
-            memcpy(io->out_x + *io->n_out * n, io->xe, n * sizeof(double));
-            ++*io->n_out;
+            dense_eval(s, t_stop, io->xe);
+            emit(s, io, t_stop, io->xe, NULL);
         }
+        dense_eval(s, t_stop, io->xe);
         *t_stop_out = t_stop;
         return JD_EVENT;
     }
-    if (io->n_eval == 0) {
-        io->out_t[*io->n_out] = t_new;
-        memcpy(io->out_x + *io->n_out * n, s->x_new, n * sizeof(double));
-        ++*io->n_out;
-    }
+    if (io->n_eval == 0) emit(s, io, t_new, s->x_new, s->dx_new);
     if (nev) memcpy(io->g_old, io->g_new, nev * sizeof(double));
     return 0;
 }
@@ -718,7 +727,7 @@ static int radau_loop(jd_ctx *c, jd_step *s, jd_io *io, double t_end, double *t_
         r = rhs(c, t_new, x_new, w.fx);
         if (r) { io->fail[0] = c->fail_t; status = r; goto out; }
         /* collocation polynomial of the step, for output, events and the next start */
-        s->t_old = t; s->h = h; s->x_old = x; s->have_dense = 0;
+        s->t_old = t; s->h = h; s->x_old = x; s->have_dense = 0; s->dx_new = w.fx;
         memcpy(s->K, w.Z, 3 * n * sizeof(double));
         double t_stop;
         r = post_step(s, io, t_new, &t_stop);
@@ -761,8 +770,9 @@ out:
  */
 int jd_integrate(const jd_problem *P, double t_end, double *st, double *x, double *k0,
                  double *g_old, long *cnt, const double *t_eval, long n_eval, long *i_eval,
-                 double *out_t, double *out_x, long cap, long *n_out, double *ev_t, double *ev_x,
-                 long *ev_i, long ev_cap, long *n_ev, long max_steps, double *fail) {
+                 double *out_t, double *out_x, double *out_dx, long cap, long *n_out,
+                 double *ev_t, double *ev_x, long *ev_i, long ev_cap, long *n_ev, long max_steps,
+                 double *fail) {
     long f = P->f, n = 2 * f + 1, nev = P->nev;
     jd_method m5 = {6, 7, RK5_A, RK5_B, RK5_C, -1.0 / 5.0};
     jd_method m8 = {12, 16, RK8_A, RK8_B, RK8_C, -1.0 / 8.0};
@@ -777,21 +787,15 @@ int jd_integrate(const jd_problem *P, double t_end, double *st, double *x, doubl
     double *K = c.L + f * f, *F = K + 16 * n, *x_new = F + 7 * n, *xs = x_new + n,
            *sc = xs + n, *err = sc + n, *xe = err + n, *g_new = xe + n, *g_tmp = g_new + nev + 1,
            *roots = g_tmp + nev + 1;
-    jd_step s = {&c, m, P->method, n, 0.0, 0.0, x, x_new, K, F, xs, 0};
-    jd_io io = {t_eval, n_eval, i_eval, out_t, out_x, cap, n_out, ev_t, ev_x, ev_i, ev_cap, n_ev,
-                g_old, g_new, g_tmp, roots, xe, fail};
+    jd_step s = {&c, m, P->method, n, 0.0, 0.0, x, x_new, K, F, xs, NULL, 0};
+    jd_io io = {t_eval, n_eval, i_eval, out_t, out_x, out_dx, cap, n_out, ev_t, ev_x, ev_i, ev_cap,
+                n_ev, g_old, g_new, g_tmp, roots, xe, fail};
     double t = st[0], h = st[1];
     int status = JD_CONTINUE, r = 0;
     long steps = 0;
     const double SAFETY = 0.9, MIN_FACTOR = 0.2, MAX_FACTOR = 10.0;
 
-    /* requested output at the start */
-    while (n_eval > 0 && *i_eval < n_eval && t_eval[*i_eval] <= t) {
-        out_t[*n_out] = t_eval[*i_eval];
-        memcpy(out_x + *n_out * n, x, n * sizeof(double));
-        ++*n_out; ++*i_eval;
-    }
-    if (!cnt[4]) {
+    if (!cnt[4]) {  /* the start of a run */
         r = rhs(&c, t, x, k0);
         if (r) { fail[0] = c.fail_t; status = r; goto done; }
         cnt[4] = 1;
@@ -799,6 +803,12 @@ int jd_integrate(const jd_problem *P, double t_end, double *st, double *x, doubl
             inputs(&c, t, x, x + f);
             P->events(x, x + f, t, P->p, c.u, g_old);
         }
+        if (n_eval == 0) emit(&s, &io, t, x, k0);
+    }
+    /* requested output at the start */
+    while (n_eval > 0 && *i_eval < n_eval && t_eval[*i_eval] <= t) {
+        emit(&s, &io, t_eval[*i_eval], x, k0);
+        ++*i_eval;
     }
     if (h <= 0.0) {
         if (P->h_first > 0.0) {
@@ -896,7 +906,7 @@ int jd_integrate(const jd_problem *P, double t_end, double *st, double *x, doubl
         }
         /* accepted */
         cnt[2]++;
-        s.t_old = t; s.h = h; s.have_dense = 0;
+        s.t_old = t; s.h = h; s.have_dense = 0; s.dx_new = K + S * n;
         double t_stop;
         r = post_step(&s, &io, t_new, &t_stop);
         if (r == JD_EVENT) {
