@@ -846,19 +846,24 @@ int jd_integrate(const jd_problem *P, double t_end, double *st, double *x, doubl
         /* stages */
         memcpy(K, k0, n * sizeof(double));
         r = 0;
+        /* stage sums column by column: contiguous, and the zeros of the tables skipped */
         for (int si = 1; si < S && !r; ++si) {
-            for (long i = 0; i < n; ++i) {
-                double acc = 0.0;
-                for (int j = 0; j < si; ++j) acc += m->A[si * m->lda + j] * K[j * n + i];
-                xs[i] = x[i] + h * acc;
+            memcpy(xs, x, n * sizeof(double));
+            for (int j = 0; j < si; ++j) {
+                double a = h * m->A[si * m->lda + j];
+                if (a == 0.0) continue;
+                const double *Kj = K + j * n;
+                for (long i = 0; i < n; ++i) xs[i] += a * Kj[i];
             }
             r = rhs(&c, t + m->C[si] * h, xs, K + si * n);
         }
         if (!r) {
-            for (long i = 0; i < n; ++i) {
-                double acc = 0.0;
-                for (int j = 0; j < S; ++j) acc += m->B[j] * K[j * n + i];
-                x_new[i] = x[i] + h * acc;
+            memcpy(x_new, x, n * sizeof(double));
+            for (int j = 0; j < S; ++j) {
+                double b = h * m->B[j];
+                if (b == 0.0) continue;
+                const double *Kj = K + j * n;
+                for (long i = 0; i < n; ++i) x_new[i] += b * Kj[i];
             }
             r = rhs(&c, t_new, x_new, K + S * n);
         }
@@ -875,14 +880,17 @@ int jd_integrate(const jd_problem *P, double t_end, double *st, double *x, doubl
             sc[i] = P->atol[i] + P->rtol * fmax(fabs(x[i]), fabs(x_new[i]));
         double en;
         if (P->method == 1) {
-            double e5 = 0.0, e3 = 0.0;
+            double e5 = 0.0, e3 = 0.0, *a3v = xe;
+            memset(err, 0, n * sizeof(double));
+            memset(a3v, 0, n * sizeof(double));
+            for (int j = 0; j <= S; ++j) {
+                const double *Kj = K + j * n;
+                double c5 = RK8_E5[j], c3 = RK8_E3[j];
+                if (c5 != 0.0) for (long i = 0; i < n; ++i) err[i] += c5 * Kj[i];
+                if (c3 != 0.0) for (long i = 0; i < n; ++i) a3v[i] += c3 * Kj[i];
+            }
             for (long i = 0; i < n; ++i) {
-                double a5 = 0.0, a3 = 0.0;
-                for (int j = 0; j <= S; ++j) {
-                    a5 += RK8_E5[j] * K[j * n + i];
-                    a3 += RK8_E3[j] * K[j * n + i];
-                }
-                a5 /= sc[i]; a3 /= sc[i];
+                double a5 = err[i] / sc[i], a3 = a3v[i] / sc[i];
                 e5 += a5 * a5; e3 += a3 * a3;
             }
             en = (e5 == 0.0 && e3 == 0.0) ? 0.0 : h * e5 / sqrt((e5 + 0.01 * e3) * (double)n);
