@@ -133,12 +133,13 @@ class Graph:
                 if done:
                     args, pids = pending.pop(p)
                     cids = tuple(None if q is None else canon[q] for q in pids)
-                    parts = [(1, type(a).__name__, str(a)) if c is None else (0, c, "")
+                    parts = [(1, *_atom_key(a)) if c is None else (0, c, "")
                              for a, c in zip(args, cids, strict=True)]
                     name = type(e).__name__
                     if name in ("Add", "Mul"):
                         parts.sort()
-                    key = (name, tuple(parts))
+                    # undefined functions q(t), f(x, y) are told apart by their names
+                    key = (name, e.get_name() if hasattr(e, "get_name") else "", tuple(parts))
                     c = by_structure.get(key)
                     if c is None:
                         c = len(self.order)
@@ -164,6 +165,14 @@ class Graph:
             self.uses[c] = self.uses.get(c, 0) + 1
             roots.append(c)
         self.root_ids: tuple[int | None, ...] = tuple(roots)
+
+
+def _atom_key(a: Expr) -> tuple[str, str]:
+    """Exact identity of an atom: floats by their exact binary value (str keeps 15 digits)."""
+    name = type(a).__name__
+    if name == "RealDouble":
+        return name, float(a).hex()
+    return name, str(a)
 
 
 def _worth_a_temporary(e: Expr) -> bool:

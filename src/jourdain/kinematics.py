@@ -86,6 +86,71 @@ def _is_zero(v: Vec3) -> bool:
     return v[0] == 0 and v[1] == 0 and v[2] == 0
 
 
+class FrameTag:
+    """Identity of a frame orientation, linked to its parent orientation.
+
+    ``A`` gives this frame's axes in the parent's (v_parent = A·v_this), ``S`` the inertial
+    orientation, ``axis`` = (u, θ) when all rotations from the inertial frame are about one fixed
+    axis u (then S = R_u(θ)). Relative rotations between two frames are products of the shallow
+    ``A`` matrices between them (:func:`relative_rotation`), not products of the deep ``S``.
+    """
+
+    __slots__ = ("parent", "A", "S", "axis", "depth")
+
+    def __init__(self, parent: FrameTag | None, A: Mat3, S: Mat3,
+                 axis: tuple[Vec3, se.Basic] | None) -> None:
+        self.parent, self.A, self.S, self.axis = parent, A, S, axis
+        self.depth = 0 if parent is None else parent.depth + 1
+
+
+ROOT = FrameTag(None, IDENTITY, IDENTITY, None)
+
+
+def relative_rotation(a: FrameTag, b: FrameTag) -> Mat3 | None:
+    """S_aᵀ·S_b (b's axes in a's frame); None when a is b (the identity)."""
+    if a is b:
+        return None
+    if a is ROOT and b.axis is not None:
+        return rotation_matrix(b.axis[0], b.axis[1])
+    if b is ROOT and a.axis is not None:
+        return rotation_matrix(a.axis[0], -a.axis[1])
+    if a.axis is not None and b.axis is not None and a.axis[0] == b.axis[0]:
+        return rotation_matrix(a.axis[0], b.axis[1] - a.axis[1])
+    # down from the common ancestor c: S_a = S_c·A_(c→a), S_b = S_c·A_(c→b)
+    pa: list[Mat3] = []
+    pb: list[Mat3] = []
+    x, y = a, b
+    while x is not y:
+        if x.depth >= y.depth:
+            pa.append(x.A)
+            x = x.parent  # type: ignore[assignment]
+        else:
+            pb.append(y.A)
+            y = y.parent  # type: ignore[assignment]
+    Ra = _chain(pa[::-1])
+    Rb = _chain(pb[::-1])
+    if Ra is None:
+        return Rb
+    if Rb is None:
+        return tuple(tuple(Ra[j][i] for j in range(3)) for i in range(3))  # type: ignore[return-value]
+    return _mtm(Ra, Rb)
+
+
+def _chain(ms: list[Mat3]) -> Mat3 | None:
+    out = None
+    for m in ms:
+        out = m if out is None else _mm(out, m)
+    return out
+
+
+def _mtm(A: Mat3, B: Mat3) -> Mat3:
+    """Aᵀ·B"""
+    return tuple(
+        tuple(A[0][i] * B[0][j] + A[1][i] * B[1][j] + A[2][i] * B[2][j] for j in range(3))
+        for i in range(3)
+    )  # type: ignore[return-value]
+
+
 @dataclass
 class _Frame:
     """State of a moving frame during the recursion (mutable scratch, never returned)."""
@@ -101,13 +166,14 @@ class _Frame:
     omega: Vec3 = Z3
     omega_bar: Vec3 = Z3
     alpha_bar: Vec3 = Z3
-    # a_bar as the sum of its pieces S_k·v_k: ((orientation of frame k, v_k), ...)
+    # a_bar as the sum of its pieces S_k·v_k: ((tag of frame k, v_k), ...)
     a_pieces: tuple = ()
+    tag: FrameTag = ROOT
 
     def copy(self) -> _Frame:
         return _Frame(self.S, self.identity, self.axis, self.r, dict(self.JT), self.v_bar,
                       self.a_bar, dict(self.JR), self.omega, self.omega_bar, self.alpha_bar,
-                      self.a_pieces)
+                      self.a_pieces, self.tag)
 
 
 class _Rates:
@@ -149,18 +215,8 @@ class _Context:
     index: dict[se.Symbol, int]
     yd: tuple[se.Symbol, ...]
     t: se.Symbol
-    # columns of J_T that are one rotated local vector S·v: id(col) -> (col, orientation, v)
-    pure: dict[int, tuple] = field(default_factory=dict)
-
-
-def orientation(F: _Frame) -> tuple:
-    """How a frame's S is known: ("I",), ("axis", u, θ) for rotations about one fixed axis
-    u from the inertial frame, or ("S", S)."""
-    if F.identity:
-        return ("I",)
-    if F.axis is not None:
-        return ("axis", F.axis[0], F.axis[1])
-    return ("S", F.S)
+    # columns of J_T as sums of rotated local vectors S_k·v_k: id(col) -> (col, ((tag, v), ...))
+    pieces: dict[int, tuple] = field(default_factory=dict)
 
 
 def _rotate(F: _Frame, u: Vec3, angle: se.Basic, ctx: _Context) -> None:
@@ -178,6 +234,7 @@ def _rotate(F: _Frame, u: Vec3, angle: se.Basic, ctx: _Context) -> None:
     else:
         F.S, F.axis = _mm(F.S, A), None
     F.identity = False
+    F.tag = FrameTag(F.tag, A, F.S, F.axis)
     # angular velocity and acceleration in the new frame: ω' = Aᵀ(ω + u·θ̇)
     keys = set(F.JR) | set(rt.dy)
     F.JR = {
@@ -196,9 +253,17 @@ def _reorient(F: _Frame, R0: Mat3) -> None:
         return
     F.S = R0 if F.identity else _mm(F.S, R0)
     F.identity, F.axis = False, None
+    F.tag = FrameTag(F.tag, R0, F.S, None)
     F.JR = {j: _mtv(R0, c) for j, c in F.JR.items()}
     F.omega, F.omega_bar, F.alpha_bar = (_mtv(R0, F.omega), _mtv(R0, F.omega_bar),
                                          _mtv(R0, F.alpha_bar))
+
+
+def _append(pieces: tuple, tag: FrameTag, v: Vec3) -> tuple:
+    """pieces + S_tag·v, added to the last piece when that is in the same frame."""
+    if pieces and pieces[-1][0] is tag:
+        return (*pieces[:-1], (tag, _add(pieces[-1][1], v)))
+    return (*pieces, (tag, v))
 
 
 def _translate(F: _Frame, d: Vec3, ctx: _Context) -> None:
@@ -220,14 +285,19 @@ def _translate(F: _Frame, d: Vec3, ctx: _Context) -> None:
             local = _add(local, dj)  # type: ignore[arg-type]
         if _is_zero(local):
             newJT[j] = F.JT.get(j, Z3)
-        elif j in F.JT:
-            newJT[j] = _add(F.JT[j], toI(local))
+            continue
+        # remember the column as pieces S_k·v_k: dot products of columns are then formed from
+        # the local vectors (no sin² + cos² of components, see jourdain.projection)
+        old = F.JT.get(j)
+        if old is None:
+            col, pieces = toI(local), ((F.tag, local),)
         else:
-            # remember S and v of a column S·v: dot products of such columns are formed from the
-            # local vectors (no sin² + cos² of components, see jourdain.projection)
-            col = toI(local)
-            newJT[j] = col
-            ctx.pure[id(col)] = (col, orientation(F), local)
+            col = _add(old, toI(local))
+            rec = ctx.pieces.get(id(old))
+            pieces = None if rec is None or rec[0] is not old else _append(rec[1], F.tag, local)
+        newJT[j] = col
+        if pieces is not None:
+            ctx.pieces[id(col)] = (col, pieces)
     F.JT = newJT
     d_t: Vec3 = tuple(rt.dt for rt in rates)  # type: ignore[assignment]
     d_1: Vec3 = tuple(rt.d1 for rt in rates)  # type: ignore[assignment]
@@ -238,7 +308,7 @@ def _translate(F: _Frame, d: Vec3, ctx: _Context) -> None:
         acc = _add(acc, _add(_scale(_cross(F.omega, d_1), se.Integer(2)), d_2))
     F.a_bar = _add(F.a_bar, toI(acc))
     if not _is_zero(acc):
-        F.a_pieces = (*F.a_pieces, (orientation(F), acc))
+        F.a_pieces = _append(F.a_pieces, F.tag, acc)
 
 
 @dataclass(frozen=True)
@@ -270,7 +340,7 @@ class BodyKinematics:
     cols_T: MappingProxyType = field(repr=False, compare=False)
     cols_R: MappingProxyType = field(repr=False, compare=False)
     cols_T_O: MappingProxyType = field(repr=False, compare=False)
-    #: a_bar as pieces S_k·v_k, ((orientation, v_k), ...), see :func:`orientation`
+    #: a_bar as pieces S_k·v_k, ((FrameTag, v_k), ...)
     a_bar_pieces: tuple = field(default=(), repr=False, compare=False)
 
     def point(self, p: Vec3) -> tuple[Vec3, dict[int, Vec3], Vec3, Vec3]:
@@ -312,8 +382,8 @@ class Kinematics:
     yd: tuple[se.Symbol, ...]
     ydd: tuple[se.Symbol, ...]
     t: se.Symbol
-    #: columns of J_T known as one rotated local vector: id(col) -> (col, orientation, v)
-    pure_columns: MappingProxyType = field(default_factory=lambda: MappingProxyType({}),
+    #: columns of J_T as sums of rotated local vectors: id(col) -> (col, ((FrameTag, v), ...))
+    column_pieces: MappingProxyType = field(default_factory=lambda: MappingProxyType({}),
                                            repr=False, compare=False)
 
     def __getitem__(self, name: str) -> BodyKinematics:
@@ -364,4 +434,4 @@ def kinematics(system: System) -> Kinematics:
             cols_T_O=MappingProxyType(F.JT), a_bar_pieces=C.a_pieces,
         ))
     return Kinematics(system, tuple(out), y, ctx.yd, tuple(acceleration(c) for c in y), system.t,
-                      MappingProxyType(ctx.pure))
+                      MappingProxyType(ctx.pieces))

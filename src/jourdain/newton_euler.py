@@ -29,11 +29,17 @@ ZERO = se.Integer(0)
 @dataclass(frozen=True)
 class BodyForces:
     """Resultant applied force ``f`` (inertial, at the centre of mass) and torque ``l`` (body
-    frame, about the centre of mass) on one body: its rows of q̄^e."""
+    frame, about the centre of mass) on one body: its rows of q̄^e.
+
+    ``f = f_other + m·gravity``: ``gravity`` is the field strength of the model's Gravity elements
+    (inertial) and ``f_other`` the rest, kept apart so that the projection can collect masses.
+    """
 
     name: str
     f: Vec3
     l: Vec3
+    f_other: Vec3 = (ZERO, ZERO, ZERO)
+    gravity: Vec3 = (ZERO, ZERO, ZERO)
 
 
 @dataclass(frozen=True)
@@ -118,6 +124,7 @@ class _Accumulator:
         self.f: dict[str, list[se.Basic]] = {b.name: [] for b in self.sys.bodies}
         self.f = {b.name: [[], [], []] for b in self.sys.bodies}  # type: ignore[misc]
         self.l = {b.name: [[], [], []] for b in self.sys.bodies}
+        self.gravity: Vec3 = Z3
 
     def S(self, name: str) -> Mat3:
         return self.kin[name].S.rows  # type: ignore[return-value]
@@ -146,11 +153,13 @@ class _Accumulator:
             self.l[body][a].append(T_B[a])
 
     def result(self) -> tuple[BodyForces, ...]:
-        return tuple(
-            BodyForces(b.name, tuple(se.Add(*c) if c else ZERO for c in self.f[b.name]),  # type: ignore[arg-type]
-                       tuple(se.Add(*c) if c else ZERO for c in self.l[b.name]))  # type: ignore[arg-type]
-            for b in self.sys.bodies
-        )
+        out = []
+        for b in self.sys.bodies:
+            other = tuple(se.Add(*c) if c else ZERO for c in self.f[b.name])
+            weight = _scale(self.gravity, b.mass) if b.mass != 0 else Z3
+            out.append(BodyForces(b.name, _add(other, weight), tuple(  # type: ignore[arg-type]
+                se.Add(*c) if c else ZERO for c in self.l[b.name]), other, self.gravity))
+        return tuple(out)
 
 
 def applied_forces(kin: Kinematics) -> tuple[BodyForces, ...]:
@@ -159,10 +168,7 @@ def applied_forces(kin: Kinematics) -> tuple[BodyForces, ...]:
     sys = kin.system
     for fe in sys.forces:
         if isinstance(fe, Gravity):
-            for b in sys.bodies:
-                if b.mass != 0:
-                    for a in range(3):
-                        acc.f[b.name][a].append(b.mass * fe.vector[a])
+            acc.gravity = _add(acc.gravity, fe.vector)
         elif isinstance(fe, Force):
             F_I, F_B = acc.to_body(fe.vector, fe.frame, fe.body)
             acc.add_force(fe.body, F_I, F_B, fe.point)

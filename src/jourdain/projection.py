@@ -15,8 +15,8 @@ from dataclasses import dataclass
 
 import symengine as se
 
-from .kinematics import _add, _cross, _dot, _mv, _scale
-from .model.joints import IDENTITY, Mat3, Vec3, rotation_matrix
+from .kinematics import ROOT, FrameTag, _add, _cross, _dot, _mv, _scale, relative_rotation
+from .model.joints import Mat3
 from .newton_euler import NewtonEuler
 from .symbolic import SymMatrix
 
@@ -41,6 +41,12 @@ class EquationsOfMotion:
         return self.newton_euler.system
 
     @property
+    def forcing(self) -> SymMatrix:
+        """q - k (f×1), the right-hand side of M·ÿ = q - k, written as one flat sum per row."""
+        return SymMatrix.column(_difference(q, k) for q, k in
+                                zip(self.q.entries(), self.k.entries(), strict=True))
+
+    @property
     def y(self) -> tuple[se.Symbol, ...]:
         return self.newton_euler.kinematics.y
 
@@ -61,16 +67,18 @@ def projection(ne: NewtonEuler) -> EquationsOfMotion:
     mass_of_pair: dict[tuple[int, int], dict[tuple, tuple[tuple, tuple, list]]] = {}
     force_of_col: list[dict[tuple, tuple[tuple, list]]] = [dict() for _ in range(f)]
     gyro_of_col: list[dict[tuple, tuple[tuple, list]]] = [dict() for _ in range(f)]
+    weight_of_col: list[dict[tuple, tuple[tuple, list]]] = [dict() for _ in range(f)]
     M_terms: list[list[list[se.Basic]]] = [[[] for _ in range(f)] for _ in range(f)]
     k_terms: list[list[se.Basic]] = [[] for _ in range(f)]
     q_terms: list[list[se.Basic]] = [[] for _ in range(f)]
     for body, bk, bf in zip(system.bodies, kin.bodies, ne.forces, strict=True):
         m = body.mass
         T = bk.cols_T
-        ma = [(o, _scale(v, m)) for o, v in bk.a_bar_pieces]
+        ma = [(o, v, m) for o, v in bk.a_bar_pieces]
         keys = sorted(T)
         hT = {j: _h(c) for j, c in T.items()}
-        f_nonzero = any(x != 0 for x in bf.f)
+        f_nonzero = any(x != 0 for x in bf.f_other)
+        g_nonzero = any(x != 0 for x in bf.gravity)
         for ii, j in enumerate(keys):
             cj = T[j]
             if m != 0:
@@ -78,8 +86,10 @@ def projection(ne: NewtonEuler) -> EquationsOfMotion:
                     mass_of_pair.setdefault((j, kk), {}).setdefault(
                         hT[j] + hT[kk], (cj, T[kk], []))[2].append(m)
                 gyro_of_col[j].setdefault(hT[j], (cj, []))[1].append(ma)
+                if g_nonzero:
+                    weight_of_col[j].setdefault(hT[j], (cj, []))[1].append((ROOT, bf.gravity, m))
             if f_nonzero:
-                force_of_col[j].setdefault(hT[j], (cj, []))[1].append(bf.f)
+                force_of_col[j].setdefault(hT[j], (cj, []))[1].append(bf.f_other)
         # rotational part
         R = bk.cols_R
         has_I = body.has_inertia
@@ -100,13 +110,15 @@ def projection(ne: NewtonEuler) -> EquationsOfMotion:
                 k_terms[j].append(_dot(cj, gyro_R))
             if l_nonzero:
                 q_terms[j].append(_dot(cj, bf.l))
-    pure = kin.pure_columns
+    dots = _Dots(kin.column_pieces)
     for (j, kk), groups in mass_of_pair.items():
         for cj, ck, masses in groups.values():
-            M_terms[j][kk].append(_column_dot(cj, ck, pure) * se.Add(*masses))
+            M_terms[j][kk].append(dots.columns(cj, ck) * se.Add(*masses))
     for j in range(f):
         for cj, piece_lists in gyro_of_col[j].values():
-            k_terms[j].append(_pieces_dot(cj, [p for ps in piece_lists for p in ps], pure))
+            k_terms[j].append(dots.with_pieces(cj, [p for ps in piece_lists for p in ps]))
+        for cj, weights in weight_of_col[j].values():
+            q_terms[j].append(dots.with_pieces(cj, weights))
         for cj, vecs in force_of_col[j].values():
             q_terms[j].append(_dot(cj, _sum(vecs)))
     M = [[ZERO] * f for _ in range(f)]
@@ -120,60 +132,62 @@ def projection(ne: NewtonEuler) -> EquationsOfMotion:
     return EquationsOfMotion(ne, SymMatrix.from_rows(M), SymMatrix.column(k), SymMatrix.column(q))
 
 
-def _relative(oa: tuple, ob: tuple) -> Mat3 | None:
-    """S_aᵀ·S_b for two frame orientations (kinematics.orientation) when it is simple: the
-    identity within one frame, a single turn for frames turned about one fixed axis; else None."""
-    if oa == ("I",) and ob == ("I",) or (oa[0] == "S" and ob[0] == "S" and oa[1] is ob[1]):
-        return IDENTITY
-    if oa[0] == "axis" and ob == ("I",):
-        return rotation_matrix(oa[1], -oa[2])
-    if oa == ("I",) and ob[0] == "axis":
-        return rotation_matrix(ob[1], ob[2])
-    if oa[0] == "axis" and ob[0] == "axis" and oa[1] == ob[1]:
-        return rotation_matrix(oa[1], ob[2] - oa[2])
-    return None
+def _difference(a: se.Basic, b: se.Basic) -> se.Basic:
+    """a - b with the terms of a sum b negated one by one (SymEngine keeps -(x + y) whole)."""
+    terms_b = b.args if type(b).__name__ == "Add" else (b,)
+    terms_a = a.args if type(a).__name__ == "Add" else (a,)
+    return se.Add(*terms_a, *(-t for t in terms_b))
 
 
-def _inertial(o: tuple, v: Vec3) -> Vec3:
-    if o[0] == "I":
-        return v
-    return _mv(rotation_matrix(o[1], o[2]) if o[0] == "axis" else o[1], v)
+#: largest number of frame pairs for which a dot product is formed piece by piece in local
+#: components; longer sums are dotted in inertial components, which CSE shares better
+PIECE_PAIRS = 4
 
 
-def _column_dot(a: tuple, b: tuple, pure: Mapping[int, tuple]) -> se.Basic:
-    """a·b; for columns a = S_a·x and b = S_b·y formed as x·(S_aᵀS_b·y): x·y in one frame, and
-    a rotation by θ_b - θ_a for frames turned about one fixed axis (so a planar chain gives
-    cos(q2 - q1) rather than the inertial components' sin·sin + cos·cos, and no sin² + cos²)."""
-    ra, rb = pure.get(id(a)), pure.get(id(b))
-    if ra is None or rb is None or ra[0] is not a or rb[0] is not b:
-        return _dot(a, b)
-    R = _relative(ra[1], rb[1])
-    return _dot(a, b) if R is None else _dot(ra[2], _mv(R, rb[2]))
+class _Dots:
+    """Dot products of vectors known as sums of pieces S_k·v_k (kinematics.FrameTag)."""
 
+    def __init__(self, pieces: Mapping[int, tuple]) -> None:
+        self.pieces = pieces
+        self.R: dict[tuple[int, int], Mat3 | None] = {}
 
-def _pieces_dot(c: tuple, pieces: list, pure: Mapping[int, tuple]) -> se.Basic:
-    """c·Σ S_k·v_k, piece by piece in c's frame where the relative rotation is simple, after
-    adding up the pieces of each frame (so terms of one frame cancel before any product)."""
-    by_frame: dict = {}
-    for o, v in pieces:
-        key = id(o[1]) if o[0] == "S" else o
-        entry = by_frame.setdefault(key, [o, []])
-        entry[1].append(v)
-    rc = pure.get(id(c))
-    if rc is not None and rc[0] is not c:
-        rc = None
-    terms = []
-    rest = []
-    for o, vs in by_frame.values():
-        v = _sum(vs)
-        R = None if rc is None else _relative(rc[1], o)
-        if R is None:
-            rest.append(_inertial(o, v))
-        else:
-            terms.append(_dot(rc[2], _mv(R, v)))
-    if rest:
-        terms.append(_dot(c, _sum(rest)))
-    return se.Add(*terms) if terms else ZERO
+    def of(self, c: tuple) -> tuple | None:
+        rec = self.pieces.get(id(c))
+        return rec[1] if rec is not None and rec[0] is c else None
+
+    def rel(self, a: FrameTag, b: FrameTag) -> Mat3 | None:
+        key = (id(a), id(b))
+        if key not in self.R:
+            self.R[key] = relative_rotation(a, b)
+        return self.R[key]
+
+    def local(self, pa: tuple, pb: list) -> se.Basic:
+        terms = []
+        for ta, x in pa:
+            for tb, y in pb:
+                R = self.rel(ta, tb)
+                terms.append(_dot(x, y if R is None else _mv(R, y)))
+        return se.Add(*terms)
+
+    def columns(self, a: tuple, b: tuple) -> se.Basic:
+        """a·b of two Jacobian columns."""
+        pa, pb = self.of(a), self.of(b)
+        if pa is None or pb is None or len(pa) * len(pb) > PIECE_PAIRS:
+            return _dot(a, b)
+        return self.local(pa, list(pb))
+
+    def with_pieces(self, c: tuple, pieces: list) -> se.Basic:
+        """c·Σ m_i S_k·v_k after adding the pieces of each frame, and the masses of bodies that
+        share a piece (inherited from a common ancestor), so terms of one frame cancel first."""
+        by_frame: dict = {}
+        for tag, v, m in pieces:
+            by_frame.setdefault(id(tag), [tag, {}])[1].setdefault(id(v), (v, []))[1].append(m)
+        summed = [(tag, _sum([_scale(v, se.Add(*ms)) for v, ms in shared.values()]))
+                  for tag, shared in by_frame.values()]
+        pc = self.of(c)
+        if pc is not None and len(pc) * len(summed) <= PIECE_PAIRS:
+            return self.local(pc, summed)
+        return _dot(c, _sum([v if tag is ROOT else _mv(tag.S, v) for tag, v in summed]))
 
 
 def _h(v: tuple) -> int:
