@@ -4,8 +4,12 @@
   into a :class:`ModelFile` holding the :class:`~jourdain.System`, nominal motions and simulation
   settings; mistakes raise :class:`ModelFileError` with file, line and key path.
 - :func:`parse_expression`: the restricted expression parser (never ``eval``).
+- :func:`matrix_latex`, :func:`matrix_mathml`, :func:`matrix_text`, :func:`matrices_json`:
+  exports of symbolic matrices (large ones summarized by size and operation count).
+- :func:`write_report`: the self-contained HTML report of ``jourdain run``.
 """
 
+from .export import matrices_json, matrix_latex, matrix_mathml, matrix_text
 from .expressions import FUNCTIONS, ExpressionError, parse_expression, parse_number
 from .modelfile import (
     ModelFile,
@@ -15,8 +19,12 @@ from .modelfile import (
     load_model,
     loads_model,
 )
+from .report import ReportInfo, write_report
 
 __all__ = [
     "FUNCTIONS", "ExpressionError", "parse_expression", "parse_number", "ModelFile",
     "ModelFileError", "NominalMotion", "SimulationSettings", "load_model", "loads_model",
+    "matrices_json", "matrix_latex", "matrix_mathml", "matrix_text", "ReportInfo",
+    "write_report",
 ]
+

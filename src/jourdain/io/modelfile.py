@@ -47,7 +47,7 @@ from ..model import (
     disc,
     rod,
 )
-from .expressions import RESERVED_NAMES, ExpressionError, parse_expression
+from .expressions import RESERVED_NAMES, ExpressionError, _number, parse_expression
 from .toml_positions import Path, key_lines, line_of
 
 __all__ = ["ModelFile", "ModelFileError", "NominalMotion", "SimulationSettings", "load_model",
@@ -314,7 +314,8 @@ class _Loader:
         if isinstance(value, float):
             if not math.isfinite(value):
                 raise self.fail(path, f"expected a finite number, got {value}")
-            return se.Integer(int(value)) if value == int(value) else se.Float(value)
+            # the decimal the user wrote (0.7 is 7/10), as in expression strings
+            return _number(repr(value))
         if not isinstance(value, str):
             raise self.fail(path, f"expected a number or an expression string, got "
                             f"{_type_name(value)}")
