@@ -95,7 +95,7 @@ class _Problem(ctypes.Structure):
         ("u_kind", ctypes.c_void_p), ("tab_off", ctypes.c_void_p), ("tab_t", ctypes.c_void_p),
         ("tab_v", ctypes.c_void_p), ("ev_dir", ctypes.c_void_p), ("ev_term", ctypes.c_void_p),
         ("method", ctypes.c_int), ("rtol", ctypes.c_double), ("atol", ctypes.c_void_p),
-        ("h_max", ctypes.c_double), ("h_first", ctypes.c_double),
+        ("h_max", ctypes.c_double), ("h_first", ctypes.c_double), ("accel", ctypes.c_void_p),
     ]
 
 
@@ -224,7 +224,8 @@ class _Setup:
             ctypes.cast(self._cb, ctypes.c_void_p).value if self._cb else None,
             _ptr(self.p), _ptr(self.u_const), _ptr(self.u_kind), _ptr(self.tab_off),
             _ptr(self.tab_t), _ptr(self.tab_v), _ptr(self.ev_dir), _ptr(self.ev_term), method,
-            float(rtol), _ptr(self.atol), float(max_step), float(first_step))
+            float(rtol), _ptr(self.atol), float(max_step), float(first_step),
+            mkq.accel_address)
 
     def _callback(self, t: float, y: Any, yd: Any, u: Any) -> int:
         try:

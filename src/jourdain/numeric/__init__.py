@@ -65,6 +65,14 @@ class CompiledFunction:
         return sum(n * m for n, m in self.shapes)
 
     @property
+    def accel_address(self) -> int | None:
+        """Address of ``int jd_accel(y, yd, t, p, u, ydd, power)`` when compiled with it."""
+        try:
+            return ctypes.cast(self.lib.jd_accel, ctypes.c_void_p).value
+        except AttributeError:
+            return None
+
+    @property
     def address(self) -> int:
         """Address of the C function ``void fn(y, yd, t, p, u, out)`` (for compiled loops)."""
         return ctypes.cast(getattr(self.lib, self.symbol), ctypes.c_void_p).value or 0
@@ -165,13 +173,15 @@ def _fast_key(system: System, names: tuple[str, ...], shapes: tuple[tuple[int, i
                        " ".join(str(hash(e)) for e in exprs))
 
 
-def lambdify(system: System, matrices: Mapping[str, SymMatrix]) -> CompiledFunction:
+def lambdify(system: System, matrices: Mapping[str, SymMatrix],
+             extra_source: str = "") -> CompiledFunction:
     """Compile the named matrices of ``system`` to machine code.
 
-    Graph CSE (:func:`jourdain.cse.cse`), then C source with one statement per temporary,
-    compiled once with the system's C compiler and cached on disk by content hash
-    (:func:`cache_dir`); a later call with the same expressions loads the cached library
-    without regenerating code.
+    Common-subexpression elimination on the expression graph, then C source with one
+    statement per temporary, compiled once with the system's C compiler and cached on disk by
+    content hash (:func:`cache_dir`); a later call with the same expressions loads the cached
+    library without regenerating code. ``extra_source``: C appended to the generated source
+    (it may call ``jd_fn``), part of the cache key.
     """
     args = arguments(system)
     names = tuple(matrices)
@@ -182,12 +192,13 @@ def lambdify(system: System, matrices: Mapping[str, SymMatrix]) -> CompiledFunct
         if not isinstance(m, SymMatrix):
             m = SymMatrix.from_rows(m)
         exprs.extend(m.entries())
-    key = _fast_key(system, names, shapes, exprs)
+    key = _fast_key(system, names, shapes, exprs) if not extra_source else \
+        content_key(_fast_key(system, names, shapes, exprs), extra_source)
     lib = cached_library(key)
     if lib is None:
         cnames = argument_names(system.y, system.yd, system.t, system.parameter_symbols,
                                 system.inputs)
-        source = HEADER + function_source("jd_fn", exprs, cnames)
+        source = HEADER + function_source("jd_fn", exprs, cnames) + extra_source
         lib = build(key, source)
     vp = ctypes.c_void_p
     lib.jd_fn.restype = None
@@ -209,9 +220,62 @@ def _eom_function(system: System) -> CompiledFunction:
 
 @lru_cache(maxsize=32)
 def mkq_function(system: System) -> CompiledFunction:
-    """Compiled ``M, k, q`` of the equations of motion (memoized per system)."""
+    """Compiled ``M, k, q`` of the equations of motion (memoized per system), with
+    ``jd_accel`` (ÿ = M⁻¹(q − k) by Cholesky, for the integrator) when f ≤ 64."""
     eom = system.equations_of_motion()
-    return lambdify(system, {"M": eom.M, "k": eom.k, "q": eom.q})
+    extra = ACCEL_TEMPLATE.replace("JD_F_VALUE", str(system.f)) if system.f <= 64 else ""
+    return lambdify(system, {"M": eom.M, "k": eom.k, "q": eom.q}, extra_source=extra)
+
+
+# ÿ = M⁻¹(q − k) with the size known to the compiler, which unrolls the small loops and
+# inlines jd_fn; returns 0, 1 (M not positive definite) or 2 (NaN or inf)
+ACCEL_TEMPLATE = r"""
+#define JD_F JD_F_VALUE
+int jd_accel(const double *y, const double *yd, double t, const double *p, const double *u,
+             double *ydd, double *power) {
+    double buf[JD_F * JD_F + 2 * JD_F], L[JD_F * JD_F];
+    jd_fn(y, yd, t, p, u, buf);
+    const double *M = buf, *k = buf + JD_F * JD_F, *q = k + JD_F;
+    double w = 0.0, dmax = 0.0;
+    for (int i = 0; i < JD_F; ++i) {
+        ydd[i] = q[i] - k[i];
+        w += yd[i] * q[i];
+        dmax = fmax(dmax, fabs(M[i * JD_F + i]));
+    }
+    *power = w;
+    /* M = L D Lᵀ (L unit lower triangular): no square roots, one division per column; the
+       pivots D_j are those of the Cholesky factorization squared, so the same test applies */
+    double D[JD_F], Dinv[JD_F];
+    for (int j = 0; j < JD_F; ++j) {
+        double E[JD_F];  /* E[m] = L[j][m] D[m] */
+        double d = M[j * JD_F + j];
+        for (int m = 0; m < j; ++m) {
+            E[m] = L[j * JD_F + m] * D[m];
+            d -= L[j * JD_F + m] * E[m];
+        }
+        if (!(d > 1e-13 * dmax)) return isfinite(d) ? 1 : 2;
+        D[j] = d;
+        Dinv[j] = 1.0 / d;
+        for (int i = j + 1; i < JD_F; ++i) {
+            double s = M[i * JD_F + j];
+            for (int m = 0; m < j; ++m) s -= L[i * JD_F + m] * E[m];
+            L[i * JD_F + j] = s * Dinv[j];
+        }
+    }
+    for (int i = 0; i < JD_F; ++i) {
+        double s = ydd[i];
+        for (int m = 0; m < i; ++m) s -= L[i * JD_F + m] * ydd[m];
+        ydd[i] = s;
+    }
+    for (int i = JD_F - 1; i >= 0; --i) {
+        double s = ydd[i] * Dinv[i];
+        for (int m = i + 1; m < JD_F; ++m) s -= L[m * JD_F + i] * ydd[m];
+        ydd[i] = s;
+    }
+    for (int i = 0; i < JD_F; ++i) if (!isfinite(ydd[i])) return 2;
+    return 0;
+}
+"""
 
 
 def clear_cache(disk: bool = False) -> None:

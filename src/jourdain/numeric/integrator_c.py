@@ -63,6 +63,8 @@ SOURCE = r"""
 typedef void (*jd_model)(const double *y, const double *yd, double t, const double *p,
                          const double *u, double *out);
 typedef int (*jd_input_cb)(double t, const double *y, const double *yd, double *u);
+typedef int (*jd_accel_fn)(const double *y, const double *yd, double t, const double *p,
+                           const double *u, double *ydd, double *power);
 
 /* return codes */
 #define JD_DONE 0
@@ -92,6 +94,7 @@ typedef struct {
     double rtol;
     const double *atol;    /* n = 2f + 1 */
     double h_max, h_first;
+    jd_accel_fn accel;     /* the model's fused M, k, q and Cholesky solve, or NULL */
 } jd_problem;
 
 typedef struct {
@@ -149,6 +152,16 @@ static int rhs(jd_ctx *c, double t, const double *x, double *dx) {
         int r = inputs(c, t, y, yd);
         if (r == JD_ENAN) goto nan;
         if (r) { c->fail_t = t; memcpy(c->fail_x, x, c->n * sizeof(double)); return r; }
+    }
+    if (P->accel) {
+        int r = P->accel(y, yd, t, P->p, c->u, dx + f, dx + 2 * f);
+        for (long i = 0; i < f; ++i) dx[i] = yd[i];
+        if (r == 2) goto nan;
+        if (r == 1) {
+            c->fail_t = t; memcpy(c->fail_x, x, c->n * sizeof(double));
+            return JD_ESINGULAR;
+        }
+        return 0;
     }
     P->mkq(y, yd, t, P->p, c->u, c->buf);
     {
