@@ -284,6 +284,10 @@ def evaluate_all(model: Any, y: np.ndarray, yd: np.ndarray, t: float,
                         for k in reaction_names})
     values = {k: np.asarray(v, float) for k, v in out.items() if isinstance(v, np.ndarray)}
     extra = {k: v for k, v in out.items() if not isinstance(v, np.ndarray)}
+    error = extra.pop("reactions_error", None)
+    if error:
+        missing.update({k: f"the reaction forces could not be formed: {error}"
+                        for k in reaction_names})
     for k in reaction_names:
         if k not in values and k not in missing:
             missing[k] = "the reaction forces are not available yet in this version of jourdain"
