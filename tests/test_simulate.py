@@ -164,6 +164,8 @@ def test_nan_and_bad_arguments_give_clear_errors():
         s.simulate((1, 0), y0, [0, 0], inputs={"F": 0.0})
     with pytest.raises(IntegrationError, match=r"NaN.*t = 0\.5"):
         s.simulate((0, 1), y0, [0, 0], inputs={"F": lambda t: np.nan if t >= 0.5 else 0.0})
+    with pytest.raises(TypeError, match="tolerance"):  # misspelt options are not ignored
+        s.simulate((0, 1), y0, [0, 0], inputs={"F": 0.0}, tolerance=1e-3)
     with pytest.raises(jd.EvaluationError, match="max_step must be positive"):
         s.simulate((0, 1), y0, [0, 0], inputs={"F": 0.0}, max_step=0)
     with pytest.raises(jd.EvaluationError, match=r"expected 1 values for \['F'\]"):
