@@ -147,3 +147,22 @@ def test_evaluate_errors():
     z = se.Symbol("zeta")
     with pytest.raises(jd.EvaluationError, match='"zeta"'):
         numeric.lambdify(s, {"bad": SymMatrix.column([z * s.y[0]])})
+
+
+def test_without_a_compiler_evaluation_falls_back(monkeypatch, rng):
+    """No cc: SymEngine's Lambdify gives the same numbers (slower); simulation says it needs a
+    compiler."""
+    s = n_link_pendulum_on_cart(2)
+    eom = s.equations_of_motion()
+    compiled = numeric.lambdify(s, {"M": eom.M, "k": eom.k})
+    monkeypatch.setenv("CC", "no-such-compiler-jourdain")
+    with pytest.warns(RuntimeWarning, match="no C compiler"):
+        interp = numeric.lambdify(s, {"M": eom.M, "k": eom.k})
+    assert isinstance(interp, numeric.InterpretedFunction)
+    p = numeric.parameter_vector(s, None)
+    Y, YD = rng.uniform(-2, 2, (4, s.f)), rng.uniform(-2, 2, (4, s.f))
+    a, b = compiled.batch(Y, YD, 0.0, p, [1.0]), interp.batch(Y, YD, 0.0, p, [1.0])
+    np.testing.assert_allclose(b["M"], a["M"], rtol=1e-12, atol=1e-13)
+    np.testing.assert_allclose(b["k"], a["k"], rtol=1e-12, atol=1e-13)
+    with pytest.raises(build.CompilerError, match="needs a C compiler"):
+        _ = interp.address

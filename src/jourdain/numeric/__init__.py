@@ -24,7 +24,7 @@ import symengine as se
 from ..errors import EvaluationError
 from ..symbolic import SymMatrix
 from .ccode import HEADER, argument_names, function_source
-from .toolchain import CompilerError, build, cache_dir, cached_library, content_key
+from .toolchain import CompilerError, build, cache_dir, cached_library, compiler, content_key
 
 if TYPE_CHECKING:
     from ..model.system import System
@@ -132,11 +132,49 @@ class CompiledFunction:
             out = np.empty((n, self.size))
         elif out.shape != (n, self.size) or not out.flags.c_contiguous or out.dtype != float:
             raise EvaluationError(f"batch: out must be a C-contiguous float array {(n, self.size)}")
+        self._batch(n, Y, YD, T, P, ps, U, us, out)
+        return self.split(out)
+
+    def _batch(self, n: int, Y: np.ndarray, YD: np.ndarray, T: np.ndarray, P: np.ndarray,
+               ps: int, U: np.ndarray, us: int, out: np.ndarray) -> None:
         getattr(self.lib, self.symbol + "_batch")(
             ctypes.c_long(n), ctypes.c_long(self.f), Y.ctypes.data, YD.ctypes.data,
             T.ctypes.data, P.ctypes.data, ctypes.c_long(ps), U.ctypes.data, ctypes.c_long(us),
             out.ctypes.data)
-        return self.split(out)
+
+
+@dataclass(frozen=True, eq=False)
+class InterpretedFunction(CompiledFunction):
+    """The same interface without a C compiler: SymEngine's ``Lambdify`` (its LLVM backend
+    when available, else its interpreter). Slower; simulation needs the compiled form."""
+
+    def _x(self, y: np.ndarray, yd: np.ndarray, t: Any, p: np.ndarray, u: np.ndarray
+           ) -> np.ndarray:
+        return np.concatenate([y, yd, t, p, u], axis=-1)
+
+    def raw(self, y: np.ndarray, yd: np.ndarray, t: float, p: np.ndarray, u: np.ndarray,
+            out: np.ndarray | None = None) -> np.ndarray:
+        r = np.asarray(self.lib(self._x(y, yd, np.array([t]), p, u)), dtype=float).reshape(-1)
+        if out is None:
+            return r
+        out[:] = r
+        return out
+
+    def _batch(self, n: int, Y: np.ndarray, YD: np.ndarray, T: np.ndarray, P: np.ndarray,
+               ps: int, U: np.ndarray, us: int, out: np.ndarray) -> None:
+        Pn = np.broadcast_to(P[:self.n_p] if ps == 0 else P, (n, self.n_p))
+        Un = np.broadcast_to(U[:self.n_u] if us == 0 else U, (n, self.n_u))
+        for i in range(n):  # one state at a time: no compiled loop without a compiler
+            out[i] = self.raw(Y[i], YD[i], T[i], Pn[i], Un[i])
+
+    @property
+    def address(self) -> int:
+        raise CompilerError("this function was not compiled (no C compiler): simulation needs "
+                            "a C compiler (gcc or clang, or set CC)")
+
+    @property
+    def accel_address(self) -> int | None:
+        return None
 
 
 def _contig(x: Any, n: int, what: str) -> np.ndarray:
@@ -192,6 +230,10 @@ def lambdify(system: System, matrices: Mapping[str, SymMatrix],
         if not isinstance(m, SymMatrix):
             m = SymMatrix.from_rows(m)
         exprs.extend(m.entries())
+    try:
+        compiler()
+    except CompilerError:
+        return _interpreted(system, names, shapes, exprs)
     key = _fast_key(system, names, shapes, exprs) if not extra_source else \
         content_key(_fast_key(system, names, shapes, exprs), extra_source)
     lib = cached_library(key)
@@ -208,6 +250,21 @@ def lambdify(system: System, matrices: Mapping[str, SymMatrix],
                                 ctypes.c_long, vp]
     return CompiledFunction(names, shapes, args, key, system.f, len(system.parameters),
                             len(system.inputs), lib)
+
+
+def _interpreted(system: System, names: tuple[str, ...], shapes: tuple[tuple[int, int], ...],
+                 exprs: list[se.Basic]) -> InterpretedFunction:
+    import warnings
+
+    warnings.warn("no C compiler found: jourdain evaluates with SymEngine's Lambdify (slower); "
+                  "install gcc or clang, or set CC", RuntimeWarning, stacklevel=3)
+    args = arguments(system)
+    try:
+        fn = se.Lambdify(list(args), exprs, backend="llvm", cse=True, real=True)
+    except (RuntimeError, ValueError):  # LLVM not in this SymEngine build
+        fn = se.Lambdify(list(args), exprs, backend="lambda", cse=True, real=True)
+    return InterpretedFunction(names, shapes, args, "", system.f, len(system.parameters),
+                               len(system.inputs), fn)
 
 
 @lru_cache(maxsize=32)
@@ -372,5 +429,5 @@ def evaluate(system: System, y: Any, yd: Any, t: float = 0.0,
 _VECTORS = frozenset({"q_c", "q_e", "k", "q"})
 
 
-__all__ = ["CompiledFunction", "CompilerError", "arguments", "cache_dir", "clear_cache", "evaluate",
+__all__ = ["CompiledFunction", "CompilerError", "InterpretedFunction", "arguments", "cache_dir", "clear_cache", "evaluate",
            "lambdify", "mkq_function", "parameter_vector", "state_vectors"]
