@@ -121,6 +121,10 @@ def test_inputs_constant_expression_table_callable_agree():
     c = 4.0
     fb = s.simulate((0, 2), y0, [1.0, 0.0], inputs={"F": -c * s.yd[0]}, **kw)
     np.testing.assert_allclose(fb.u[:, 0], -c * fb.yd[:, 0], rtol=1e-12)
+    # the same feedback as a Python function of the state
+    py = s.simulate((0, 2), y0, [1.0, 0.0], inputs={"F": lambda t, y, yd: -c * yd[0]}, **kw)
+    np.testing.assert_allclose(py.y, fb.y, atol=1e-9)
+    np.testing.assert_allclose(py.u, fb.u, atol=1e-8)
 
 
 @pytest.mark.parametrize("method", ["DOP853", "RK45", "Radau"])

@@ -15,7 +15,8 @@ Inputs ``u(t)`` are given per input name as
 - a table ``(times, values)`` (linear interpolation, held constant outside; runs in C),
 - an expression in ``t``, the coordinates, their rates and the parameters (compiled into the C
   loop; state feedback is allowed),
-- a Python callable ``u(t) -> float`` (called back from C at every evaluation: much slower).
+- a Python callable ``u(t) -> float`` or ``u(t, y, yd) -> float`` (state feedback), called back
+  from C at every evaluation: much slower.
 
 Events are :class:`Event` objects holding an expression in ``t``, ``y``, ``ẏ``, parameters and
 inputs; the run records the times at which it crosses zero (located on the continuous extension)
@@ -29,6 +30,7 @@ computed: the results say ``interrupted`` and why.
 from __future__ import annotations
 
 import ctypes
+import inspect
 import math
 import numbers
 import sys
@@ -136,6 +138,7 @@ class _Setup:
         tab_t: list[np.ndarray] = []
         tab_v: list[np.ndarray] = []
         self.callables: dict[int, Callable[..., Any]] = {}
+        self.feedback: dict[int, bool] = {}
         self.callback_error: BaseException | None = None
         exprs: list[se.Basic] = [se.Integer(0)] * nu
         names = system.input_names
@@ -179,6 +182,7 @@ class _Setup:
             elif callable(v) and not isinstance(v, se.Basic):
                 self.u_kind[i] = 3
                 self.callables[i] = v
+                self.feedback[i] = _takes_state(v)
             else:
                 try:
                     e = as_expr(v, f'input "{name}"')
@@ -229,8 +233,13 @@ class _Setup:
 
     def _callback(self, t: float, y: Any, yd: Any, u: Any) -> int:
         try:
+            f = self.system.f
             for i, fn in self.callables.items():
-                v = float(fn(t))
+                if self.feedback[i]:
+                    v = float(fn(t, np.ctypeslib.as_array(y, (f,)).copy(),
+                                 np.ctypeslib.as_array(yd, (f,)).copy()))
+                else:
+                    v = float(fn(t))
                 u[i] = v
             return 0
         except BaseException as exc:  # noqa: BLE001 - reported by simulate(), never swallowed
@@ -254,7 +263,8 @@ class _Setup:
                 fn = self.callables[i]
                 for j, tt in enumerate(t):
                     try:
-                        U[j, i] = float(fn(tt))
+                        U[j, i] = float(fn(tt, x[j, :f].copy(), x[j, f:2 * f].copy())
+                                        if self.feedback[i] else fn(tt))
                     except BaseException:  # noqa: BLE001 - the run already reported it
                         U[j, i] = np.nan
         if self.uexpr is not None:
@@ -262,6 +272,16 @@ class _Setup:
             mask = self.u_kind[:nu] == 2
             U[:, mask] = ue[:, mask]
         return U
+
+
+def _takes_state(fn: Callable[..., Any]) -> bool:
+    """True for ``u(t, y, yd)`` (state feedback), False for ``u(t)``."""
+    try:
+        params = inspect.signature(fn).parameters.values()
+    except (TypeError, ValueError):
+        return False
+    positional = [p for p in params if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)]
+    return len(positional) >= 3 or any(p.kind == p.VAR_POSITIONAL for p in params)
 
 
 def _error(code: int, setup: _Setup, fail: np.ndarray) -> JourdainError:
