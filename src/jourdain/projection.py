@@ -74,7 +74,8 @@ def projection(ne: NewtonEuler) -> EquationsOfMotion:
     for body, bk, bf in zip(system.bodies, kin.bodies, ne.forces, strict=True):
         m = body.mass
         T = bk.cols_T
-        ma = [(o, v, m) for o, v in bk.a_bar_pieces]
+        ma = ([(o, v, m) for o, v in bk.a_bar_pieces],
+              _scale((bk.a_bar.rows[0][0], bk.a_bar.rows[1][0], bk.a_bar.rows[2][0]), m))
         keys = sorted(T)
         hT = {j: _h(c) for j, c in T.items()}
         f_nonzero = any(x != 0 for x in bf.f_other)
@@ -116,9 +117,10 @@ def projection(ne: NewtonEuler) -> EquationsOfMotion:
             M_terms[j][kk].append(dots.columns(cj, ck) * se.Add(*masses))
     for j in range(f):
         for cj, piece_lists in gyro_of_col[j].values():
-            k_terms[j].append(dots.with_pieces(cj, [p for ps in piece_lists for p in ps]))
+            k_terms[j].append(dots.with_pieces(cj, [p for ps, _ in piece_lists for p in ps],
+                                               _sum([ma_i for _, ma_i in piece_lists])))
         for cj, weights in weight_of_col[j].values():
-            q_terms[j].append(dots.with_pieces(cj, weights))
+            q_terms[j].append(dots.with_pieces(cj, weights))  # one inertial piece each
         for cj, vecs in force_of_col[j].values():
             q_terms[j].append(_dot(cj, _sum(vecs)))
     M = [[ZERO] * f for _ in range(f)]
@@ -176,9 +178,10 @@ class _Dots:
             return _dot(a, b)
         return self.local(pa, list(pb))
 
-    def with_pieces(self, c: tuple, pieces: list) -> se.Basic:
+    def with_pieces(self, c: tuple, pieces: list, inertial: tuple | None = None) -> se.Basic:
         """c·Σ m_i S_k·v_k after adding the pieces of each frame, and the masses of bodies that
-        share a piece (inherited from a common ancestor), so terms of one frame cancel first."""
+        share a piece (inherited from a common ancestor), so terms of one frame cancel first.
+        ``inertial``: the same sum in inertial components, when known, for long sums."""
         by_frame: dict = {}
         for tag, v, m in pieces:
             by_frame.setdefault(id(tag), [tag, {}])[1].setdefault(id(v), (v, []))[1].append(m)
@@ -187,6 +190,8 @@ class _Dots:
         pc = self.of(c)
         if pc is not None and len(pc) * len(summed) <= PIECE_PAIRS:
             return self.local(pc, summed)
+        if inertial is not None:
+            return _dot(c, inertial)
         return _dot(c, _sum([v if tag is ROOT else _mv(tag.S, v) for tag, v in summed]))
 
 

@@ -366,8 +366,10 @@ def _check_mass(sys: System, b: Body) -> None:
     """Mass ≥ 0 and inertia symmetric positive semi-definite at the default parameter values."""
     subs = {se.Symbol(k): v for k, v in sys.parameters}
     try:
-        m = float(b.mass.subs(subs))
-        I = np.array([[float(x.subs(subs)) for x in row] for row in b.inertia])
+        # one substitution for all ten numbers (each subs call converts the whole dict)
+        vals = se.DenseMatrix(10, 1, [b.mass, *(x for row in b.inertia for x in row)]).subs(subs)
+        m = float(vals[0])
+        I = np.array([float(vals[1 + k]) for k in range(9)]).reshape(3, 3)
     except (RuntimeError, TypeError, ValueError) as exc:
         raise ModelError(f'body "{b.name}": mass data do not evaluate to numbers: {exc}') from None
     if not math.isfinite(m) or m < 0:
