@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import JourdainError
+from ..symbolic import to_sympy
 from . import export
 from .modelfile import ModelFile
 
@@ -568,9 +569,10 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
             s.append(f"<h3>About “{_e(nominal.name)}”</h3>")
             if nominal.description:
                 s.append(f"<p>{_e(nominal.description)}</p>")
-            ys = ", ".join(f"{_e(c)} = {_e(e)}" for c, e in
-                           zip(coords, nominal.y, strict=True))
-            s.append(f"<p>y<sub>s</sub>(t): {ys}</p>")
+            s.append("<p>Nominal motion: " + ", ".join(
+                _math(f"<mrow>{names[c].mathml()}<mo>=</mo>"
+                      f"{export.expr_mathml(to_sympy(e), system)}</mrow>", block=False)
+                for c, e in zip(coords, nominal.y, strict=True)) + "</p>")
             try:
                 res = capabilities.linear_analysis(model, nominal.name, params)
             except JourdainError as exc:
