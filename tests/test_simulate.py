@@ -103,6 +103,27 @@ def test_radau_in_c_on_a_stiff_oscillator():
     assert rad.nfev * 5 < dop.nfev
 
 
+def test_bead_on_a_rod_turned_at_constant_rate():
+    """Rheonomic: a rod driven by R_z(Ω t), a bead sliding on it: ẍ = Ω² x, so
+    x = x0 cosh(Ω t) + v0/Ω sinh(Ω t)."""
+    x, m, W = jd.symbols("x m Omega")
+    rod = jd.Body("rod", "world", jd.General("drive", [jd.Rot("z", W * jd.t)], coordinates=[]),
+                  mass=0, inertia=jd.point_mass())
+    bead = jd.Body("bead", "rod", jd.Prismatic("slot", x, "x"), mass=m, inertia=jd.point_mass())
+    s = jd.System([x], [rod, bead], [], parameters={"m": 0.3, "Omega": 2.0})
+    te = np.linspace(0, 1.5, 16)
+    for method in ("DOP853", "Radau"):
+        r = s.simulate((0, 1.5), [0.1], [0.05], rtol=1e-11, atol=1e-12, t_eval=te,
+                       method=method)
+        exact = 0.1 * np.cosh(2 * te) + 0.05 / 2 * np.sinh(2 * te)
+        np.testing.assert_allclose(r.y[:, 0], exact, rtol=1e-8, err_msg=method)
+    # T includes the rheonomic terms: ½ m (ẋ² + Ω² x²)
+    np.testing.assert_allclose(r.kinetic_energy, 0.15 * (r.yd[:, 0] ** 2 + 4 * r.y[:, 0] ** 2),
+                               rtol=1e-12)
+    assert not r.conservative and r.energy_balance_error is None
+    assert "rheonomic" in r.summary()
+
+
 def test_inputs_constant_expression_table_callable_agree():
     s = n_link_pendulum_on_cart(1)
     t = se.Symbol("t")

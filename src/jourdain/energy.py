@@ -36,6 +36,8 @@ class Energy:
     conservative : True when no force does work other than through ``V`` and the kinematics
         does not depend on time explicitly (then ``T + V`` is constant along a motion)
     nonconservative : names of the force elements whose work is not in ``V``
+    rheonomic : the kinematics depends on time explicitly (a prescribed motion, whose drive
+        does work that no force element accounts for)
     """
 
     kinematics: Kinematics
@@ -43,6 +45,7 @@ class Energy:
     V: se.Basic
     conservative: bool
     nonconservative: tuple[str, ...]
+    rheonomic: bool = False
 
 
 def _dot(a: tuple, b: tuple) -> se.Basic:
@@ -110,7 +113,7 @@ def energy(kin: Kinematics) -> Energy:
         if "t" in free_names(exprs):
             rheonomic = True
     V = se.Add(*V_terms) if V_terms else ZERO
-    return Energy(kin, T, V, not noncons and not rheonomic, tuple(noncons))
+    return Energy(kin, T, V, not noncons and not rheonomic, tuple(noncons), rheonomic)
 
 
 def _point(kin: Kinematics, body: str, p: tuple) -> tuple:

@@ -42,14 +42,14 @@ VERSION = 1
 
 
 @lru_cache(maxsize=32)
-def _energy_function(system: System) -> tuple[Any, bool, tuple[str, ...]]:
+def _energy_function(system: System) -> tuple[Any, bool, tuple[str, ...], bool]:
     from .energy import energy
     from .numeric import lambdify
     from .symbolic import SymMatrix
 
     e = energy(system.kinematics())
     fn = lambdify(system, {"T": SymMatrix.column([e.T]), "V": SymMatrix.column([e.V])})
-    return fn, e.conservative, e.nonconservative
+    return fn, e.conservative, e.nonconservative, e.rheonomic
 
 
 @lru_cache(maxsize=32)
@@ -141,6 +141,8 @@ class Results:
         try:
             if self.conservative:
                 lines.append(f"  relative energy drift {self.energy_drift:.3e} (conservative model)")
+            elif self._energies.get("rheonomic"):
+                lines.append("  no energy balance: the prescribed (rheonomic) motion does work")
             else:
                 lines.append(f"  energy balance error {self.energy_balance_error:.3e} "
                              f"(non-conservative: {', '.join(self._energies['nonconservative'])})")
@@ -168,11 +170,11 @@ class Results:
         if "T" in self._energies:
             return
         system = self._need_system("the energies")
-        fn, cons, noncons = _energy_function(system)
+        fn, cons, noncons, rheonomic = _energy_function(system)
         p = np.array([self.parameters[k] for k, _ in system.parameters])
         out = fn.batch(self.y, self.yd, self.t, p, None)
         self._energies.update(T=out["T"][:, 0, 0].copy(), V=out["V"][:, 0, 0].copy(),
-                              conservative=cons, nonconservative=noncons)
+                              conservative=cons, nonconservative=noncons, rheonomic=rheonomic)
 
     @property
     def kinetic_energy(self) -> np.ndarray:
@@ -216,8 +218,12 @@ class Results:
         return float(np.max(np.abs(E - E[0])) / scale)
 
     @property
-    def energy_balance_error(self) -> float:
-        """Relative error of ``T + V − W_nc = const`` (any model)."""
+    def energy_balance_error(self) -> float | None:
+        """Relative error of ``T + V − W_nc = const`` (any scleronomic model; None for a
+        rheonomic one, whose prescribed motion does work no force element accounts for)."""
+        self._energy()
+        if self._energies.get("rheonomic"):
+            return None
         bal = self.total_energy - self.work_nonconservative
         scale = max(float(np.max(np.abs(self.total_energy))), float(np.max(np.abs(self.kinetic_energy))),
                     1e-300)
