@@ -115,3 +115,33 @@ def test_conservative_run_reports_drift(run):
     assert math.isfinite(res.wall_time) and res.nfev > 0
     text = res.summary()
     assert "finished" in text and f"relative energy drift {res.energy_drift:.3e}" in text
+
+
+def test_spring_potentials_and_energy_conservation():
+    """Elastic pendulum (a point mass on a linear spring hung from the origin, planar polar
+    coordinates) with a torsion spring on the angle: V = ½ c (L − L0)² + ½ k φ² − m g·r."""
+    phi, r, m, c, L0, k, g = jd.symbols("phi r m c L0 k g")
+    arm = jd.Body("arm", "world", jd.Revolute("pivot", phi, "z"), mass=0,
+                  inertia=jd.point_mass())
+    bob = jd.Body("bob", "arm", jd.Prismatic("slide", r, "x"), mass=m, inertia=jd.point_mass())
+    s = jd.System([phi, r], [arm, bob],
+                  [jd.Gravity((0, -g, 0)), jd.SpringDamper("spring", "world", (0, 0, 0), "bob",
+                                                           (0, 0, 0), stiffness=c,
+                                                           rest_length=L0),
+                   jd.RotationalSpringDamper("torsion", phi, stiffness=k)],
+                  parameters={"m": 0.5, "c": 40.0, "L0": 1.0, "k": 2.0, "g": 9.81})
+    res = s.simulate((0, 3), [-1.2, 1.3], [0.5, 0.0], rtol=1e-11, atol=1e-11)
+    assert res.conservative
+    ph, rr = res.y[:, 0], res.y[:, 1]
+    V = 0.5 * 40 * (rr - 1.0) ** 2 + 0.5 * 2.0 * ph**2 + 0.5 * 9.81 * rr * np.sin(ph)
+    np.testing.assert_allclose(res.potential_energy, V, rtol=1e-12, atol=1e-12)
+    T = 0.5 * 0.5 * (res.yd[:, 1] ** 2 + rr**2 * res.yd[:, 0] ** 2)
+    np.testing.assert_allclose(res.kinetic_energy, T, rtol=1e-12, atol=1e-12)
+    assert res.energy_drift < 1e-9
+    # a damper makes it non-conservative; the balance T + V − W_nc stays constant
+    s2 = jd.System(s.coordinates, s.bodies,
+                   [*s.forces[:2], jd.RotationalSpringDamper("torsion", phi, 2.0, 0.3)],
+                   parameters=s.parameter_values)
+    res2 = s2.simulate((0, 3), [-1.2, 1.3], [0.5, 0.0], rtol=1e-11, atol=1e-11)
+    assert not res2.conservative and res2.energy_balance_error < 1e-9
+    assert res2.work_nonconservative[-1] < -0.01
