@@ -332,7 +332,7 @@ def simulate(system: System, t_span: tuple[float, float], y0: Any, yd0: Any,
     events : :class:`Event` objects
     max_step, first_step : step size limits
     progress : True prints the progress to stderr (every 0.5 s); a callable gets ``(t, t1)``
-        after every chunk of the C loop (at most 20000 steps or 1024 output points)
+        after every chunk of the C loop (about 0.2 s of work, at most 1024 output points)
     output : path of a results file (``.h5``) written as the run goes
     raise_on_interrupt : re-raise KeyboardInterrupt after keeping the results
 
@@ -444,6 +444,8 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
     exception: BaseException | None = None
     error: JourdainError | None = None
     written = 0
+    # steps per call of the C loop, adapted so that a call takes about 0.2 s: Ctrl-C and the
+    # progress report wait at most that long, and short runs go in one call
     max_steps = 20000
     t_last_report = time.perf_counter()
     try:
@@ -453,12 +455,18 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
                 out_x = np.empty((cap, n))
                 out_dx = np.empty((cap, n))
                 n_out[0] = 0
+            t_call = time.perf_counter()
             code = lib.jd_integrate(
                 ctypes.byref(setup.problem), t1, st.ctypes.data, x.ctypes.data, k0.ctypes.data,
                 g_old.ctypes.data, cnt.ctypes.data, _ptr(te), 0 if te is None else te.size,
                 i_eval.ctypes.data, out_t.ctypes.data, out_x.ctypes.data, out_dx.ctypes.data, cap,
                 n_out.ctypes.data, ev_t.ctypes.data, ev_x.ctypes.data, ev_i.ctypes.data, ev_cap,
                 n_ev.ctypes.data, max_steps, fail.ctypes.data)
+            took = time.perf_counter() - t_call
+            if took > 0.4:
+                max_steps = max(10, max_steps // 2)
+            elif took < 0.1 and max_steps < 10**6:
+                max_steps *= 2
             if te is None:
                 chunks_t.append(out_t[:n_out[0]])
                 chunks_x.append(out_x[:n_out[0]])
