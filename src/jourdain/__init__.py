@@ -23,6 +23,7 @@ from .analysis import (
 from .energy import Energy, energy
 from .equilibrium import Equilibrium, NoEquilibrium, find_equilibria, find_equilibrium
 from .errors import EvaluationError, JourdainError, ModelError, SingularMassMatrix
+from .io import ModelFile, ModelFileError, load_model
 from .kinematics import BodyKinematics, Kinematics, kinematics
 from .linearization import (
     CompiledLinearization,
@@ -78,6 +79,7 @@ __version__ = "0.1.0"
 __all__ = [
     "atan2", "cos", "exp", "log", "pi", "sin", "sqrt", "tan",
     "EvaluationError", "JourdainError", "ModelError", "SingularMassMatrix",
+    "ModelFile", "ModelFileError", "load_model",
     "BodyKinematics", "Kinematics", "kinematics", "NewtonEuler", "newton_euler",
     "EquationsOfMotion", "projection", "SymMatrix",
     "CompiledLinearization", "Linearization", "NumericLinearization", "TimeVariantError",
