@@ -412,3 +412,37 @@ def test_the_documented_complete_example_loads_and_runs(tmp_path):
     # damping 0.1*0.5 and the rail damping adds -d*0.5: q_x = -0.05 - 0.75
     v = evaluate(s, [0.0, 0.0], [0.5, 0.0], inputs={"F": 0.0})
     assert np.ravel(v["q"])[0] == pytest.approx(-0.8, rel=1e-12)
+
+
+def test_mutated_examples_fail_only_with_located_model_file_errors():
+    """300 random mutations of the examples (lines deleted, duplicated, values replaced by
+    values of other types): every failure is a ModelFileError with a line, never another
+    exception."""
+    import random
+    from pathlib import Path
+
+    rng = random.Random(2024)
+    files = sorted((Path(__file__).resolve().parents[1] / "examples").glob("*.toml"))
+    texts = [f.read_text() for f in files]
+    values = ['1', '-1', '0', '"x"', '"w"', 'true', '[1, 2]', '[1, 2, 3]', '{}', '{ a = 1 }',
+              '"phi1"', '"sin("', '1e400', '"1/0"', '[]', '"world"', '"t"', 'nan', 'inf',
+              '"__x__"', '"a.b"', '[[1, 2, 3], [1, 2, 3], [1, 2, 3]]',
+              '[{ rot = "z", angle = "t" }]']
+    failures = 0
+    for _ in range(300):
+        lines = rng.choice(texts).splitlines()
+        for _ in range(rng.randint(1, 3)):
+            i = rng.randrange(len(lines))
+            op = rng.random()
+            if op < 0.3:
+                del lines[i]
+            elif op < 0.8 and "=" in lines[i] and not lines[i].startswith("#"):
+                lines[i] = lines[i].split("=")[0] + "= " + rng.choice(values)
+            else:
+                lines.insert(i, lines[rng.randrange(len(lines))])
+        try:
+            loads_model("\n".join(lines), "mutant.toml")
+        except ModelFileError as exc:
+            failures += 1
+            assert exc.line is not None and str(exc).startswith(f"mutant.toml:{exc.line}: ")
+    assert failures > 100  # the mutations do break most files

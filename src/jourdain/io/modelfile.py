@@ -374,7 +374,9 @@ class _Loader:
             msg = str(exc)
             m = re.search(r"\(at line (\d+), column (\d+)\)", msg)
             line = int(m.group(1)) if m else None
-            core = re.sub(r"\s*\(at line \d+, column \d+\)", "", msg)
+            if line is None and "(at end of document)" in msg:
+                line = max(1, len(self.text.splitlines()))
+            core = re.sub(r"\s*\(at (?:line \d+, column \d+|end of document)\)", "", msg)
             col = f", column {m.group(2)}" if m else ""
             loc = f"{self.file}:{line}" if line else self.file
             raise ModelFileError(f"{loc}: TOML syntax error{col}: {core}", self.file, line,
