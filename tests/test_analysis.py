@@ -187,6 +187,12 @@ def test_equilibria_which_one_is_meant():
     assert jd.stability(s.linearize(upright)).verdict == "unstable"
     found = jd.find_equilibria(s, [[0.1, 0.1], [3.0, 0.1], [0.1, 3.0], [3.0, 3.0], [0.0, 0.0]])
     assert len(found) == 4
+    # method="stable" goes downhill in the potential: from near the upright position it ends
+    # hanging (at a multiple of 2π)
+    down = jd.find_equilibrium(s, {"phi1": 2.9, "phi2": 0.2}, method="stable")
+    wrapped = np.angle(np.exp(1j * down.y))
+    np.testing.assert_allclose(wrapped, [0.0, 0.0], atol=1e-9)
+    assert jd.stability(s.linearize(down)).verdict == "marginally stable"
     # a pendulum pushed sideways by a constant force F: tan φ = F / (m g)
     phi, m, l, g, F = jd.symbols("phi m l g F")
     bob = jd.Body("bob", "world", jd.Revolute("pivot", phi, "z"), mass=m, com=(0, -l, 0),

@@ -241,3 +241,44 @@ def test_compiled_matches_graph_evaluation():
     a, b = lin.evaluate(parameters=pars), fn(parameters=pars)
     for key in ("M_tilde", "P", "Q", "h", "B", "K", "N"):
         np.testing.assert_allclose(a[key], b[key], rtol=1e-12, atol=1e-12)
+
+
+def test_numeric_path_matches_symbolic(rng):
+    """linearize_numeric (floating-point forward mode) against the symbolic matrices evaluated,
+    on a nominal trajectory with inputs and at a rotor's steady rotation."""
+    s = jd.models.n_link_pendulum_on_cart(3)
+    nominal = {n: float(rng.uniform(-1, 1)) + float(rng.uniform(-1, 1)) * jd.t**2
+               for n in s.coordinate_names}
+    nominal["F"] = 0.7
+    pars = {"m2": 1.4, "g": 9.7}
+    sym = s.linearize(nominal).evaluate(t=0.4, parameters=pars)
+    num = jd.linearize_numeric(s, nominal, t=0.4, parameters=pars)
+    for key in ("M_tilde", "P", "Q", "h", "B"):
+        np.testing.assert_allclose(getattr(num, key), sym[key], rtol=1e-11, atol=1e-11)
+    assert num.time_dependence  # a trajectory: time-variant
+    with pytest.raises(jd.TimeVariantError):
+        _ = num.K
+    r = rotor()
+    nl = jd.linearize_numeric(r, {"alpha": 0, "beta": 0, "phi": jd.symbols("Omega") * jd.t},
+                              t=0.3)
+    assert nl.is_time_invariant
+    np.testing.assert_allclose(abs(nl.G[0, 1]), 0.03 * 100.0, rtol=1e-12)
+    with pytest.raises(jd.EvaluationError):
+        jd.state_space(nl, parameters={"Omega": 5.0})  # numbers for one parameter set only
+
+
+def test_general_form_gives_every_operating_point(rng):
+    """linearization_general (functions of the state) evaluated at a state equals the
+    linearization about a nominal motion through that state (with the same ẏ, ÿ)."""
+    from jourdain.linearization import linearization_general
+
+    s = double_pendulum()
+    gen = linearization_general(s.equations_of_motion())
+    y, yd, ydd = rng.uniform(-1, 1, (3, 2))
+    t0 = 0.8
+    nominal = {n: float(y[i]) + float(yd[i]) * (jd.t - t0) + 0.5 * float(ydd[i]) * (jd.t - t0)**2
+               for i, n in enumerate(s.coordinate_names)}
+    a = gen.evaluate(y, yd, ydd, t=t0)
+    b = s.linearize(nominal).evaluate(t=t0)
+    for key in ("M_tilde", "P", "Q", "h"):
+        np.testing.assert_allclose(a[key], b[key], rtol=1e-12, atol=1e-12)

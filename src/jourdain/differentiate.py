@@ -134,6 +134,7 @@ class Graph:
         atoms: dict[int, Expr] = {}
         children: dict[int, tuple[int, ...]] = {}
         order: list[int] = []
+        kind: dict[int, str] = {}
         if _POINTERS:
             rd, off = _read_pointer, _POINTER_OFFSET
 
@@ -156,6 +157,7 @@ class Graph:
                 if kids is not None:
                     if k not in node:
                         node[k] = e
+                        kind[k] = type(e).__name__
                         children[k] = kids
                         order.append(k)
                     continue
@@ -164,14 +166,18 @@ class Graph:
                 keys = []
                 push = []
                 for a in e.args:
-                    ka = key(a)
+                    # the address read inline: this loop runs once per edge of the graph
+                    ka = rd(id(a) + off).value if _POINTERS else key(a)
                     keys.append(ka)
+                    if ka in node or ka in atoms:
+                        continue
                     if a.is_Atom:
                         atoms[ka] = a
-                    elif ka not in node:
+                    else:
                         push.append((a, ka, None))
                 stack.append((e, k, tuple(keys)))
                 stack.extend(push)
+        self.kind = kind
         self.node = node
         self.atoms = atoms
         self.children = children
@@ -436,22 +442,23 @@ def _float_values(g: Graph, values: Mapping[str, float]) -> dict[int, float]:
             num[ka] = float(a)
     funcs = _FLOAT_FUNCS
     fsum, prod = math.fsum, math.prod
+    kind, children = g.kind, g.children
     for k in g.order:
-        node = g.node[k]
-        args = [num[c] for c in g.children[k]]
-        name = type(node).__name__
+        args = [num[c] for c in children[k]]
+        name = kind[k]
         if name == "Add":
             v = fsum(args)
         elif name == "Mul":
             v = prod(args)
         elif name == "Pow":
-            v = math.exp(args[1]) if node.args[0] == se.E else args[0] ** args[1]
+            b, e = args
+            v = math.exp(e) if g.atoms.get(children[k][0]) == se.E else b**e
+            if isinstance(v, complex):
+                raise JourdainError(f"{b}**{e} has no real value")
         elif name in funcs:
             v = funcs[name](*args)
         else:
-            v = float(node.func(*(se.RealDouble(x) for x in args)))
-        if isinstance(v, complex):
-            raise JourdainError(f"{name} has no real value here (argument {args})")
+            v = float(g.node[k].func(*(se.RealDouble(x) for x in args)))
         num[k] = v
     return num
 
@@ -525,7 +532,7 @@ def _jet_float(g: Graph, variables: Sequence[se.Symbol], values: Mapping[str, fl
         if k not in need:
             continue
         kids = g.children[k]
-        if type(g.node[k]).__name__ == "Mul":
+        if g.kind[k] == "Mul":
             zeros = [c for c in kids if value[c] == 0.0]
             if len(zeros) >= 2:
                 continue
@@ -546,7 +553,7 @@ def _jet_float(g: Graph, variables: Sequence[se.Symbol], values: Mapping[str, fl
             continue
         vals = [value[c] for c in kids]
         node = g.node[k]
-        name = type(node).__name__
+        name = g.kind[k]
         acc = None
         if name == "Add":
             for x in grads:

@@ -71,6 +71,7 @@ def find_equilibrium(system: System, guess: Mapping[str, float] | Sequence[float
                      parameters: Mapping[str, float] | None = None,
                      inputs: Mapping[str, float] | None = None, t: float = 0.0,
                      fixed: Sequence[str] = (), tol: float = 1e-10, max_iterations: int = 50,
+                     method: str = "any",
                      eom: EquationsOfMotion | None = None) -> Equilibrium:
     """Solve ``q(y, 0, t) − k(y, 0, t) = 0`` for ``y`` near ``guess``.
 
@@ -93,6 +94,13 @@ def find_equilibrium(system: System, guess: Mapping[str, float] | Sequence[float
     tol : float
         Convergence when ``max |q − k|`` is below ``tol`` times the largest generalized force
         seen at the guess (at least 1).
+    method : "any" or "stable"
+        ``"any"``: Levenberg–Marquardt on ``|q − k|²``, which converges to the equilibrium near
+        the guess whatever its stability (an upright pendulum). ``"stable"``: Newton steps on
+        ``(J + μ·E)·Δy = −(k − q)`` with ``μ`` at least the most negative eigenvalue of the
+        symmetric part of ``J = ∂(k − q)/∂y``; for potential forces (``k − q = ∂V/∂y``) every
+        step lowers V, so the iteration settles in a minimum of the potential near the guess
+        (a hanging chain).
     eom : EquationsOfMotion, optional
         Reuse equations already derived.
 
@@ -157,10 +165,16 @@ def find_equilibrium(system: System, guess: Mapping[str, float] | Sequence[float
             return Equilibrium(y=y0, coordinate_names=tuple(names), residual=err, iterations=0,
                                parameters=pars, inputs=uvals, t=float(t))
         raise NoEquilibrium(f"all coordinates are fixed and max |q - k| = {err:.3e} there")
-    sol = least_squares(lambda x: at(x)[0], y0[free], jac=lambda x: at(x)[1][:, free],
-                        method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15,
-                        max_nfev=max_iterations * (len(free) + 1))
-    y = full(sol.x)
+    if method == "any":
+        sol = least_squares(lambda x: at(x)[0], y0[free], jac=lambda x: at(x)[1][:, free],
+                            method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15,
+                            max_nfev=max_iterations * (len(free) + 1))
+        x, nfev = sol.x, int(sol.nfev)
+    elif method == "stable":
+        x, nfev = _descend(at, y0[free], free, tol * scale, max_iterations)
+    else:
+        raise EvaluationError(f'method must be "any" or "stable", got {method!r}')
+    y = full(x)
     r, Jm = evaluate(y)
     # polish with plain Newton steps (least squares stops at its own tolerances)
     for _ in range(3):
@@ -177,12 +191,30 @@ def find_equilibrium(system: System, guess: Mapping[str, float] | Sequence[float
     err = float(np.abs(r).max())
     if err <= tol * scale:
         return Equilibrium(y=y, coordinate_names=tuple(names), residual=err,
-                           iterations=int(sol.nfev), parameters=pars, inputs=uvals, t=float(t))
+                           iterations=nfev, parameters=pars, inputs=uvals, t=float(t))
     raise NoEquilibrium(
         f"no equilibrium of {system.name!r} found from the guess "
         f"{_show(names, y0)}: max |q - k| = {err:.3e} at {_show(names, y)} (a local minimum "
         "of the residual; try another guess)"
     )
+
+
+def _descend(at: Any, x: np.ndarray, free: list[int], tol: float,
+             max_iterations: int) -> tuple[np.ndarray, int]:
+    """Regularized Newton steps (J + μE)Δ = −r that go downhill in the potential."""
+    n = len(free)
+    for it in range(max_iterations * 4):
+        r, J = at(x)
+        if np.abs(r).max() <= tol:
+            return x, it + 1
+        Jf = J[:, free]
+        lmin = float(np.linalg.eigvalsh(0.5 * (Jf + Jf.T))[0])
+        mu = max(0.0, -lmin) + float(np.linalg.norm(r))
+        try:
+            x = x - np.linalg.solve(Jf + mu * np.eye(n), r)
+        except np.linalg.LinAlgError:
+            x = x - np.linalg.lstsq(Jf + mu * np.eye(n), r, rcond=None)[0]
+    return x, max_iterations * 4
 
 
 def _show(names: list[str], y: np.ndarray) -> str:
@@ -194,14 +226,15 @@ def find_equilibria(system: System, guesses: Sequence[Mapping[str, float] | Sequ
                     parameters: Mapping[str, float] | None = None,
                     inputs: Mapping[str, float] | None = None, t: float = 0.0,
                     fixed: Sequence[str] = (), tol: float = 1e-10,
-                    distinct: float = 1e-6) -> list[Equilibrium]:
+                    distinct: float = 1e-6, method: str = "any") -> list[Equilibrium]:
     """The distinct equilibria reached from several guesses (guesses that fail are skipped);
     two are the same when their coordinates differ by less than ``distinct``."""
     eom = system.equations_of_motion()
     found: list[Equilibrium] = []
     for g in guesses:
         try:
-            e = find_equilibrium(system, g, parameters, inputs, t, fixed, tol, eom=eom)
+            e = find_equilibrium(system, g, parameters, inputs, t, fixed, tol, method=method,
+                                 eom=eom)
         except NoEquilibrium:
             continue
         if all(np.abs(e.y - o.y).max() > distinct for o in found):

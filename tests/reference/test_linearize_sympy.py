@@ -40,3 +40,18 @@ def test_upright_A_B_match_kanes_linearize(n, rng):
         lam_ref = np.sort_complex(np.linalg.eigvals(A_ref))
         lam = np.sort_complex(np.linalg.eigvals(ss.A))
         np.testing.assert_allclose(lam, lam_ref, atol=1e-8 * max(1.0, np.abs(lam_ref).max()))
+
+
+def test_benchmark_script_runs_on_a_tiny_case(tmp_path):
+    """benchmarks/linearization.py --quick: both tools run and their A, B agree."""
+    import json
+
+    from benchmarks.linearization import main
+
+    out = tmp_path / "lin.json"
+    assert main(["--quick", "--repeat", "1", "--timeout", "120", "--json", str(out)]) == 0
+    rows = json.loads(out.read_text())["pendulum_on_cart"]
+    assert [r["n"] for r in rows] == [1, 2]
+    for r in rows:
+        assert r["sympy_op_s"] is not None and r["AB_max_rel_diff"] < 1e-12
+        assert r["jourdain_ops_op"] > 0 and r["sympy_ops_op"] > 0
