@@ -129,11 +129,16 @@ def test_parse_number_accepts_constant_expressions_only():
     ("x\\y", "backslashes"),
     ("x $ y", "'$'"),
     ("1e999", "too large"),
+    ("sqrt(-1)*x", "is complex"),
+    ("log(0)", "is infinite"),
+    ("x*log(0)", "is infinite"),
+    ("(-8)^(1/2)", "is complex"),
 ])
 def test_rejects_everything_outside_the_grammar(text, message):
     with pytest.raises(ExpressionError, match=re.escape(message)) as info:
         parse_expression(text, NAMES)
-    assert info.value.column is not None or message in ("empty expression", "too large")
+    assert info.value.column is not None or message in (
+        "empty expression", "too large", "is complex", "is infinite")
 
 
 def test_error_column_points_at_the_problem():
@@ -164,3 +169,16 @@ def test_tokenizer_positions():
     toks = tokenize("ab + 2.5*sin(c)")
     assert [(t.kind, t.text, t.pos) for t in toks[:4]] == [
         ("name", "ab", 0), ("op", "+", 3), ("num", "2.5", 5), ("op", "*", 8)]
+
+
+def test_random_text_gives_only_expression_errors():
+    """5000 random strings over the characters of Python and of the grammar: each parses or
+    raises ExpressionError (never another exception, never a hang)."""
+    rng = random.Random(11)
+    alphabet = "xym01._()[]{}+-*/^%@,:;'\"=<>!#~|&\\ \t" + "abcdefghijklmnopqrstuvwxyz" + "sin cos "
+    for _ in range(5000):
+        text = "".join(rng.choice(alphabet) for _ in range(rng.randint(0, 30)))
+        try:
+            parse_expression(text, NAMES)
+        except ExpressionError:
+            pass

@@ -357,7 +357,25 @@ def parse_expression(text: str, names: Container[str] | None = None, *,
     if not isinstance(text, str):
         raise ExpressionError(f"expected an expression string, got {type(text).__name__}")
     parser = _Parser(text, names, symbol or se.Symbol, describe or _no_hint)
-    return parser.parse()
+    return _real_and_finite(parser.parse(), text)
+
+
+_NOT_REAL = {"ImaginaryUnit": "is complex (contains the imaginary unit)",
+             "Complex": "is complex", "ComplexDouble": "is complex",
+             "ComplexInfinity": "is infinite", "Infinity": "is infinite",
+             "NegativeInfinity": "is infinite", "NaN": "is not a number (NaN)"}
+
+
+def _real_and_finite(expr: se.Basic, text: str) -> se.Basic:
+    """Reject constants such as sqrt(-1), log(0) or 0*oo that the arithmetic produced."""
+    stack = [expr]
+    while stack:
+        node = stack.pop()
+        why = _NOT_REAL.get(type(node).__name__)
+        if why:
+            raise ExpressionError(f"the expression {why}: {text.strip()} = {expr}")
+        stack.extend(node.args)
+    return expr
 
 
 def parse_number(text: str) -> float:
