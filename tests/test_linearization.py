@@ -282,3 +282,23 @@ def test_general_form_gives_every_operating_point(rng):
     b = s.linearize(nominal).evaluate(t=t0)
     for key in ("M_tilde", "P", "Q", "h"):
         np.testing.assert_allclose(a[key], b[key], rtol=1e-12, atol=1e-12)
+
+
+def test_graph_tells_apart_expressions_with_equal_hashes():
+    """SymEngine's hash combines the terms of a sum by exclusive-or: cx5 + dx4 and
+    cx5 + dx0 + dx1 + dx2 + dx3 + dx4 collide. The derivative graph must keep them apart."""
+    from jourdain.differentiate import evaluate_float, jet, jet_float
+
+    cx5, dx0, dx1, dx2, dx3, dx4, q = jd.symbols("cx5 dx0 dx1 dx2 dx3 dx4 q")
+    a = cx5 + dx4
+    b = cx5 + dx0 + dx1 + dx2 + dx3 + dx4
+    # hash(a) == hash(b) with SymEngine 0.15 (the pitfall); the test holds either way
+    exprs = [a * jd.sin(q), b * jd.sin(q)]
+    values = {"cx5": 1.0, "dx0": 2.0, "dx1": 3.0, "dx2": 4.0, "dx3": 5.0, "dx4": 6.0, "q": 0.3}
+    np.testing.assert_allclose(evaluate_float(exprs, values),
+                               [7 * np.sin(0.3), 21 * np.sin(0.3)], rtol=1e-15)
+    J = jet_float(exprs, [q], values)
+    np.testing.assert_allclose(J.jacobian[:, 0], [7 * np.cos(0.3), 21 * np.cos(0.3)],
+                               rtol=1e-15)
+    sym = jet(exprs, [q], {q: 0})
+    assert se.expand(sym.gradients[0][0] - a) == 0 and se.expand(sym.gradients[1][0] - b) == 0

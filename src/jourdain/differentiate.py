@@ -452,11 +452,17 @@ def _float_values(g: Graph, values: Mapping[str, float]) -> dict[int, float]:
             v = prod(args)
         elif name == "Pow":
             b, e = args
-            v = math.exp(e) if g.atoms.get(children[k][0]) == se.E else b**e
+            try:
+                v = math.exp(e) if g.atoms.get(children[k][0]) == se.E else b**e
+            except (ZeroDivisionError, OverflowError):
+                raise JourdainError(f"{b}**{e}: division by zero or overflow") from None
             if isinstance(v, complex):
                 raise JourdainError(f"{b}**{e} has no real value")
         elif name in funcs:
-            v = funcs[name](*args)
+            try:
+                v = funcs[name](*args)
+            except (ValueError, ZeroDivisionError, OverflowError):
+                raise JourdainError(f"{name}{tuple(args)} has no real value") from None
         else:
             v = float(g.node[k].func(*(se.RealDouble(x) for x in args)))
         num[k] = v

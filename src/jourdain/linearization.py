@@ -190,7 +190,13 @@ class Linearization:
         values["t"] = tv
         blocks = self._blocks()
         flat = [e for m in blocks.values() for e in m.entries()]
-        nums = evaluate_float(flat, values)
+        try:
+            nums = evaluate_float(flat, values)
+        except EvaluationError:
+            raise
+        except JourdainError as exc:
+            raise EvaluationError(f"linearization of {self.system.name!r} at t = {tv}: "
+                                  f"{exc}") from None
         out: dict[str, np.ndarray] = {}
         i = 0
         for name, m in blocks.items():
