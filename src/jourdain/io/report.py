@@ -474,6 +474,22 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
     s.append(f'<div class="eq">{_headline_eom()}</div>')
     for k in ("M", "k", "q"):
         s.append(_display_matrix(k, mats[k], system, max_ops))
+    if has_capability("reactions"):
+        try:
+            react = system.reactions()
+            q_count = len(react.g_names)
+            s.append(f"<p>Reaction forces: Q̄ ({6 * p}×{q_count}) has one column per "
+                     "constrained direction (" + ", ".join(_e(n) for n in react.g_names[:12])
+                     + (", …" if q_count > 12 else "") + "); N̂·g = k̂ − q̂ gives g "
+                     "without ÿ:</p>")
+            s.append(f'<div class="eq">{_headline_reactions()}</div>')
+            s.append(_display_matrix("Q_bar", react.Q_bar, system, max_ops))
+            mats_json_extra = {"Q_bar": react.Q_bar}
+        except JourdainError as exc:
+            s.append(_note(f"the reaction forces could not be formed: {exc}"))
+            mats_json_extra = {}
+    else:
+        mats_json_extra = {}
     s.append("<p class='meta'>Operation counts after common-subexpression elimination: "
              + ", ".join(f"{k} {v}" for k, v in ops.items()) + ".</p>")
     sections.append("".join(s))
@@ -487,7 +503,7 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
            "coordinates": system.coordinate_names,
            "rates": [f"{c}_d" for c in system.coordinate_names],
            "parameters": system.parameter_values, "inputs": system.input_names}
-    eqj.update(export.matrices_json(mats, system))
+    eqj.update(export.matrices_json({**mats, **mats_json_extra}, system))
     (out / "equations.json").write_text(json.dumps(eqj, indent=1), encoding="utf-8")
     info.files += [out / "equations.tex", out / "equations.json"]
 
@@ -524,10 +540,7 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
         if "g" in values:
             g = np.asarray(values["g"], float).reshape(-1)
             labels = list(extra.get("g_names", [str(i) for i in range(g.size)]))
-            s.append("<h3>Reaction forces g</h3>"
-                     f'<div class="eq">{_headline_reactions()}</div>'
-                     f"<p class='meta'>Q̄ is {6 * p}×{g.size}: one column per constrained "
-                     "direction of every joint.</p>"
+            s.append("<h3>Reaction forces g (N̂·g = k̂ − q̂)</h3>"
                      "<p class='meta'>Components in the child body frame at the joint point; "
                      "forces in N, torques in N·m (in the model's units).</p>")
             s.append(_matrix_table(g[None, :], None, labels))
