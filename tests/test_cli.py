@@ -101,6 +101,12 @@ def test_eval_json_matches_the_python_api(capsys):
     np.testing.assert_allclose(v["K"], 0.5 * (Q + Q.T), rtol=1e-6, atol=1e-7)
     np.testing.assert_allclose(v["G"], 0.5 * (P - P.T), rtol=1e-6, atol=1e-7)
     assert data["not_available"] == {}
+    # the documented contract: these keys, no others (jourdain-eval/1)
+    assert set(data) == {"format", "model", "file", "coordinates", "t", "y", "yd", "parameters",
+                         "inputs", "values", "g_names", "g_undetermined", "not_available"}
+    assert set(data["values"]) == {"M_bar", "J_bar", "q_c", "q_e", "M", "k", "q", "Q_bar",
+                                   "N_hat", "k_hat", "q_hat", "g", "M_tilde", "P", "Q", "h",
+                                   "D", "G", "K", "N"}
 
 
 def test_eval_with_inputs_and_defaults_from_the_model(capsys):
