@@ -26,6 +26,8 @@ if TYPE_CHECKING:
 
 #: Default cap: matrices whose entries need more operations (after CSE) are summarized.
 MAX_DISPLAY_OPS = 600
+#: Matrices with more rows are summarized in text output (a 36×36 M̄ helps nobody on a terminal).
+MAX_TEXT_ROWS = 18
 #: Entries up to this many operations are simplified for display (trigonometric identities).
 SIMPLIFY_OPS = 500
 #: Time budget (seconds) for simplifying the entries of one matrix for display.
@@ -249,8 +251,8 @@ def matrix_text(m: SymMatrix, system: System, max_ops: int = MAX_DISPLAY_OPS) ->
     """Unicode pretty print of ``m`` (SymPy), or a summary for large matrices."""
     import sympy
 
-    if too_large(m, max_ops):
-        n, k = m.shape
+    n, k = m.shape
+    if too_large(m, max_ops) or n > MAX_TEXT_ROWS:
         return f"<{n}×{k} matrix, {display_ops(m)} operations after CSE; use --format json>"
     return sympy.pretty(to_sympy_matrix(m).subs(_text_symbols(system)), use_unicode=True,
                         wrap_line=False)
