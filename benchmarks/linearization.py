@@ -11,7 +11,8 @@ jourdain), n = 1, 2, 4, 6. Reported per case, each sympy stage in a subprocess w
   ``linearization`` (M̃, P, Q, B: M is never inverted) against
   ``KanesMethod.linearize(A_and_B=True, op_point=...)`` (A, B: sympy inverts M symbolically);
   operation counts of both results after CSE, counted by the same function
-  (``jourdain.symbolic.count_ops`` on SymEngine versions);
+  (``jourdain.symbolic.count_ops`` on SymEngine versions), and as trees (without CSE:
+  ``jourdain.cse.tree_ops``);
 * the numeric A, B at the default parameters from both, and their largest relative difference.
 
 Derivation of the equations of motion is timed separately (it is the same work in both tools'
@@ -38,6 +39,7 @@ import symengine as se
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import jourdain as jd  # noqa: E402
+from jourdain.cse import tree_ops  # noqa: E402
 from jourdain.linearization import linearization_general  # noqa: E402
 from jourdain.models import n_link_pendulum_on_cart, spatial_chain  # noqa: E402
 from jourdain.symbolic import count_ops  # noqa: E402
@@ -64,8 +66,10 @@ def _jourdain_case(n: int, repeat: int) -> dict:
         return count_ops([*obj.M_tilde.entries(), *obj.P.entries(), *obj.Q.entries(),
                           *obj.B.entries()])
 
+    tree = sum(tree_ops(e) for m in (lin.M_tilde, lin.P, lin.Q, lin.B) for e in m.entries())
     return {"eom_s": t_eom, "general_s": t_gen, "op_s": t_op, "AB_s": t_ab,
-            "ops_general": ops(gen), "ops_op": ops(lin), "A": ss.A, "B": ss.B,
+            "ops_general": ops(gen), "ops_op": ops(lin), "ops_op_tree": tree,
+            "A": ss.A, "B": ss.B,
             "f": system.f, "parameters": system.parameter_values}
 
 
@@ -88,6 +92,7 @@ def _sympy_worker(stage: str, n: int, params: dict, out: mp.Queue) -> None:
         A, B, _ = kane.linearize(A_and_B=True, op_point=op, new_method=True)
         res["time"] = time.perf_counter() - t0
         res["ops"] = _sympy_ops([*A, *B])
+        res["ops_tree"] = _sympy_ops([*A, *B], tree=True)
         syms = sorted(A.free_symbols | B.free_symbols, key=str)
         names = [str(s) for s in syms]
         f_AB = sp.lambdify(syms, [A, B], cse=True)
@@ -96,14 +101,15 @@ def _sympy_worker(stage: str, n: int, params: dict, out: mp.Queue) -> None:
     out.put(res)
 
 
-def _sympy_ops(entries: list) -> int:
+def _sympy_ops(entries: list, tree: bool = False) -> int:
     import sympy as sp
 
     # count on plain symbols, as for jourdain: q0(t) -> q0
     funcs = set().union(*(e.atoms(sp.Function) for e in entries)) if entries else set()
     plain = {x: sp.Symbol(x.func.__name__) for x in funcs
              if isinstance(x, sp.core.function.AppliedUndef)}
-    return count_ops([se.sympify(e.xreplace(plain)) for e in entries])
+    exprs = [se.sympify(e.xreplace(plain)) for e in entries]
+    return sum(tree_ops(e) for e in exprs) if tree else count_ops(exprs)
 
 
 def _sympy_case(stage: str, n: int, params: dict, timeout: float) -> dict | None:
@@ -150,6 +156,8 @@ def run(ns: list[int], timeout: float, repeat: int) -> list[dict]:
                "jourdain_ops_general": ours["ops_general"],
                "sympy_ops_general": gen["ops"] if gen else None,
                "jourdain_ops_op": ours["ops_op"], "sympy_ops_op": op["ops"] if op else None,
+               "jourdain_ops_op_tree": ours["ops_op_tree"],
+               "sympy_ops_op_tree": op["ops_tree"] if op else None,
                "AB_max_rel_diff": diff}
         rows.append(row)
         dtext = f"{diff:.1e}" if diff is not None else "-"
@@ -161,6 +169,10 @@ def run(ns: list[int], timeout: float, repeat: int) -> list[dict]:
               f"{ours['op_s']:29.4f} {_fmt(row['sympy_op_s'], timeout)} {ro} | "
               f"{ours['ops_general']:>7}/{row['sympy_ops_general'] or '-':<8} | "
               f"{ours['ops_op']:>7}/{row['sympy_ops_op'] or '-':<8} | {dtext}", flush=True)
+    print("operation counts at the operating point without CSE (as trees), jourdain M̃,P,Q,B / "
+          "sympy A,B: " + ", ".join(
+              f"n={r['n']}: {r['jourdain_ops_op_tree']}/{r['sympy_ops_op_tree'] or '-'}"
+              for r in rows))
     return rows
 
 
