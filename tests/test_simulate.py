@@ -290,3 +290,24 @@ def test_failure_keeps_the_motion_up_to_it():
     assert res.status == "failed" and "not positive definite" in res.message
     assert 2.5 < res.t[-1] < 3.0
     np.testing.assert_allclose(res.y[:, 1], np.exp(-5 * res.t), rtol=1e-6, atol=1e-12)
+
+
+def test_ctrl_c_during_the_c_loop_stops_between_chunks():
+    """SIGINT while the C loop runs (raised here from an input function, synchronously): the
+    run stops after the current chunk and keeps the motion."""
+    import signal
+
+    s = n_link_pendulum_on_cart(1)
+    sent = []
+
+    def force(t: float) -> float:
+        if t > 0.7 and not sent:
+            sent.append(t)
+            signal.raise_signal(signal.SIGINT)
+        return 0.0
+
+    before = signal.getsignal(signal.SIGINT)
+    res = s.simulate((0, 100), [0.0, 3.0], [0, 0], inputs={"F": force}, max_step=1e-3)
+    assert sent and res.interrupted and "Ctrl-C" in res.message
+    assert 0.7 < res.t[-1] < 3.0 and np.all(np.diff(res.t) > 0)
+    assert signal.getsignal(signal.SIGINT) is before  # the handler is restored

@@ -33,7 +33,9 @@ import ctypes
 import inspect
 import math
 import numbers
+import signal
 import sys
+import threading
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
@@ -444,10 +446,32 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
     exception: BaseException | None = None
     error: JourdainError | None = None
     written = 0
+    id_chunk = kept = 0
+
+    def _keep_chunk() -> None:
+        nonlocal kept
+        chunks_t.append(out_t[:n_out[0]])
+        chunks_x.append(out_x[:n_out[0]])
+        chunks_dx.append(out_dx[:n_out[0]])
+        kept = id_chunk
     # steps per call of the C loop, adapted so that a call takes about 0.2 s: Ctrl-C and the
     # progress report wait at most that long, and short runs go in one call
     max_steps = 20000
     t_last_report = time.perf_counter()
+    # Ctrl-C sets a flag that is looked at between calls of the C loop, so it never lands in
+    # the middle of bookkeeping; a second Ctrl-C raises at once
+    interrupted = [False]
+    old_handler = None
+    if threading.current_thread() is threading.main_thread():
+        def on_sigint(signum: int, frame: Any) -> None:
+            if interrupted[0]:
+                raise KeyboardInterrupt
+            interrupted[0] = True
+
+        try:
+            old_handler = signal.signal(signal.SIGINT, on_sigint)
+        except ValueError:  # not the main interpreter
+            old_handler = None
     try:
         while True:
             if te is None:
@@ -456,6 +480,7 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
                 out_dx = np.empty((cap, n))
                 n_out[0] = 0
             t_call = time.perf_counter()
+            id_chunk += 1
             code = lib.jd_integrate(
                 ctypes.byref(setup.problem), t1, st.ctypes.data, x.ctypes.data, k0.ctypes.data,
                 g_old.ctypes.data, cnt.ctypes.data, _ptr(te), 0 if te is None else te.size,
@@ -468,9 +493,7 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
             elif took < 0.1 and max_steps < 10**6:
                 max_steps *= 2
             if te is None:
-                chunks_t.append(out_t[:n_out[0]])
-                chunks_x.append(out_x[:n_out[0]])
-                chunks_dx.append(out_dx[:n_out[0]])
+                _keep_chunk()
                 if writer:
                     writer.append(chunks_t[-1], chunks_x[-1])
             elif writer:
@@ -492,6 +515,8 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
                 break
             if code == _DONE:
                 break
+            if interrupted[0]:
+                raise KeyboardInterrupt
             now = time.perf_counter()
             if callable(progress):
                 progress(float(st[0]), t1)
@@ -500,10 +525,14 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
                 print(f"\rsimulating {system.name}: t = {st[0]:.4g} of {t1:.4g} "
                       f"({100 * (st[0] - t0) / (t1 - t0):.0f} %)", end="", file=sys.stderr)
     except KeyboardInterrupt as exc:
+        if te is None and kept < id_chunk:  # Ctrl-C came right after a call returned
+            _keep_chunk()
         status = "interrupted"
-        message = f"interrupted by the user (Ctrl-C) at t = {st[0]:.9g}; results up to there kept"
+        message = "interrupted by the user (Ctrl-C); the motion up to there is kept"
         exception = exc
     finally:
+        if old_handler is not None:
+            signal.signal(signal.SIGINT, old_handler)
         if writer:
             writer.handle.close()
     if progress is True:
@@ -515,6 +544,9 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
         dx_out = np.concatenate(chunks_dx)
     else:  # failed or interrupted at the start: the initial state only
         t_out, x_out, dx_out = np.array([t0]), x0[None, :].copy(), None
+    if isinstance(exception, KeyboardInterrupt):
+        message = (f"interrupted by the user (Ctrl-C) at t = {t_out[-1]:.9g}; the motion up "
+                   "to there is kept")
     m = int(n_ev[0])
     if nev and m == ev_cap:
         message += f"; only the first {ev_cap} event crossings were recorded"
