@@ -27,10 +27,12 @@ from .io import ModelFile, ModelFileError, load_model
 from .kinematics import BodyKinematics, Kinematics, kinematics
 from .linearization import (
     CompiledLinearization,
+    GeneralLinearization,
     Linearization,
     NumericLinearization,
     TimeVariantError,
     linearization,
+    linearization_general,
     linearize_numeric,
 )
 from .model import (
@@ -82,8 +84,8 @@ __all__ = [
     "ModelFile", "ModelFileError", "load_model",
     "BodyKinematics", "Kinematics", "kinematics", "NewtonEuler", "newton_euler",
     "EquationsOfMotion", "projection", "SymMatrix",
-    "CompiledLinearization", "Linearization", "NumericLinearization", "TimeVariantError",
-    "linearization", "linearize_numeric",
+    "CompiledLinearization", "GeneralLinearization", "Linearization", "NumericLinearization",
+    "TimeVariantError", "linearization", "linearization_general", "linearize_numeric",
     "FrequencyResponse", "Modes", "Stability", "StateSpace", "Sweep", "frequency_response",
     "modes", "stability", "stability_boundary", "state_space", "sweep",
     "Equilibrium", "NoEquilibrium", "find_equilibria", "find_equilibrium",

@@ -9,10 +9,17 @@ With ``y = y_s(t) + η`` and inputs ``u = u_s(t) + Δu``, the equations of motio
     Q = (∂(M·ÿ_s)/∂y + ∂k/∂y − ∂q/∂y)|_s
     h = (q − k − M·ÿ_s)|_s             B = ∂q/∂u|_s
 
-All are derived at once as the value and the gradient of the residual
-``r = M·ÿ + k − q`` at the nominal point (:func:`jourdain.differentiate.jet`): ``Q = ∂r/∂y``,
-``P = ∂r/∂ẏ``, ``B = −∂r/∂u`` and ``h = −r``, with ``ÿ`` replaced by ``ÿ_s`` (which gives the
-position term ``∂(M·ÿ_s)/∂y`` of the note in METHOD.md §5). M is never inverted.
+All are the value and the gradient of the residual ``r = M·ÿ + k − q`` at the nominal point:
+``Q = ∂r/∂y``, ``P = ∂r/∂ẏ``, ``B = −∂r/∂u`` and ``h = −r``, with ``ÿ`` replaced by ``ÿ_s``
+(which gives the position term ``∂(M·ÿ_s)/∂y`` of the note in METHOD.md §5). k, q and the
+entries of M are differentiated in one forward-mode pass over their shared expression graph with
+the nominal motion substituted on the way (:func:`jourdain.differentiate.jet`), the gradients of
+M only where ÿ_s ≠ 0. M is never inverted.
+
+Three forms: :func:`linearization` (symbolic in the parameters, about a given nominal motion),
+:func:`linearization_general` (symbolic functions of the state: the general form), and
+:func:`linearize_numeric` (numbers for given parameter values: the fast path to eigenvalues of
+large systems).
 
 For a time-invariant result (M̃, P, Q, B free of t) the matrices split into damping ``D``,
 gyroscopic ``G``, stiffness ``K`` and circulatory ``N`` parts (§6):
