@@ -414,7 +414,8 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
            progress: bool | Callable[[float, float], None], output: str | None) -> dict:
     lib = integrator_library()
     system = setup.system
-    n = 2 * system.f + 1
+    f = system.f
+    n = 2 * f + 1
     nev = len(setup.events)
     st = np.array([t0, 0.0])
     x = x0.copy()
@@ -452,7 +453,7 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
         nonlocal kept
         chunks_t.append(out_t[:n_out[0]])
         chunks_x.append(out_x[:n_out[0]])
-        chunks_dx.append(out_dx[:n_out[0]])
+        chunks_dx.append(out_dx[:n_out[0], f:2 * f].copy())  # ÿ only: half the memory
         kept = id_chunk
     # steps per call of the C loop, adapted so that a call takes about 0.2 s: Ctrl-C and the
     # progress report wait at most that long, and short runs go in one call
@@ -538,7 +539,8 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
     if progress is True:
         print(file=sys.stderr)
     if te is not None:
-        t_out, x_out, dx_out = out_t[:n_out[0]], out_x[:n_out[0]], out_dx[:n_out[0]]
+        t_out, x_out = out_t[:n_out[0]], out_x[:n_out[0]]
+        dx_out = out_dx[:n_out[0], f:2 * f]
     elif chunks_t and sum(len(c) for c in chunks_t):
         t_out, x_out = np.concatenate(chunks_t), np.concatenate(chunks_x)
         dx_out = np.concatenate(chunks_dx)
@@ -550,7 +552,7 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
     m = int(n_ev[0])
     if nev and m == ev_cap:
         message += f"; only the first {ev_cap} event crossings were recorded"
-    return {"t": t_out, "x": x_out, "dx": dx_out, "status": status, "message": message,
+    return {"t": t_out, "x": x_out, "ydd": dx_out, "status": status, "message": message,
             "exception": exception, "error": error, "nfev": int(cnt[0]), "nstep": int(cnt[1]),
             "naccept": int(cnt[2]), "nreject": int(cnt[3]),
             "events": (ev_t[:m].copy(), ev_x[:m].copy(), ev_i[:m].copy())}
@@ -624,9 +626,9 @@ def _results(setup: _Setup, run: dict, method: str, rtol: float, atol: np.ndarra
     f = system.f
     t, x = run["t"], run["x"]
     U = setup.inputs_at(t, x) if len(t) else np.zeros((0, len(system.inputs)))
-    dx = run.get("dx")
-    if dx is not None and len(dx) == len(t):  # from the C loop (NaN where M was singular)
-        ydd = dx[:, f:2 * f].copy()
+    ydd = run.get("ydd")
+    if ydd is not None and len(ydd) == len(t):  # from the C loop (NaN where M was singular)
+        ydd = np.ascontiguousarray(ydd)
     else:
         ydd = accelerations(setup.mkq, x[:, :f], x[:, f:2 * f], t, p, U)
     ev_t, ev_x, ev_i = run["events"]
