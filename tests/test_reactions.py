@@ -3,11 +3,12 @@ the single-joint path against the full solve, and the orthogonality check."""
 
 import numpy as np
 import pytest
+import symengine as se
 import sympy
 
 import jourdain as jd
 from jourdain.models import double_pendulum, n_link_pendulum_on_cart, spatial_chain
-from jourdain.reactions import graph_values
+from jourdain.reactions import check_orthogonality, graph_values
 
 
 def _pendulum(inertia: str):
@@ -337,3 +338,27 @@ def test_unknown_joint_is_named():
         jd.joint_reactions(s, "hinge9", [0, 0], [0, 0])
     with pytest.raises(jd.ModelError, match='unknown joint "hinge9"'):
         s.reactions().joint("hinge9")
+
+
+@pytest.mark.parametrize("make", [lambda: spatial_chain(6), lambda: n_link_pendulum_on_cart(4),
+                                  _zoo], ids=["spatial_chain-6", "cart-pendulum-4", "zoo"])
+def test_assembled_orthogonality(make):
+    """J̄ᵀ·Q̄ = 0 for the assembled matrices (not only joint by joint)."""
+    r = make().reactions()
+    assert check_orthogonality(r, samples=4) < 1e-13
+
+
+def test_assembly_error_is_caught_by_orthogonality():
+    """A Q̄ with a wrong lever arm on the parent (a column of the second hinge without its
+    moment on the first rod) breaks J̄ᵀ·Q̄ = 0, and the error names the joint."""
+    import dataclasses
+
+    r = double_pendulum().reactions()
+    c = r.g_names.index("hinge2.F_x")
+    rows = [list(row) for row in r.Q_bar.rows]
+    p = len(r.system.bodies)
+    for a in range(3):
+        rows[3 * p + a][c] = se.Integer(0)  # rotational rows of rod1 (the parent)
+    bad = dataclasses.replace(r, Q_bar=jd.SymMatrix.from_rows(rows))
+    with pytest.raises(jd.ModelError, match=r'joint "hinge2".*"hinge2.F_x".*J̄ᵀ·Q̄ = 0'):
+        check_orthogonality(bad)

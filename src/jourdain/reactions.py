@@ -653,7 +653,7 @@ def reactions(ne: NewtonEuler) -> Reactions:
         for r, e in col.items():
             Q_rows[r][c] = e
     Q_bar = SymMatrix.from_rows(Q_rows)
-    check_orthogonality(ne, Q_bar, joints)
+    check_joints(system, joints)
     singular, inv = _singular_rows(system)
     # N̂, k̂, q̂ body by body over the regular rows (M̄ block diagonal)
     N = [[[] for _ in range(q)] for _ in range(q)]
@@ -697,58 +697,122 @@ def reactions(ne: NewtonEuler) -> Reactions:
     )
 
 
-def check_orthogonality(ne: NewtonEuler, Q_bar: SymMatrix, joints: Sequence[JointReactions],
-                        samples: int = 3, seed: int = 7) -> float:
-    """Check ``J̄ᵀ·Q̄ = 0`` numerically at random states; returns the largest relative residual.
+def _step_coordinates(joint: Joint, coordinates: Sequence[se.Symbol]) -> list[se.Symbol]:
+    """The coordinates that the joint's elementary steps depend on."""
+    free: set = set()
+    for st in joint.steps:
+        exprs = [st.angle] if isinstance(st, Rot) else list(st.vector)
+        for e in exprs:
+            free |= e.free_symbols
+    return [c for c in coordinates if c in free]
 
-    Coordinates uniform in (−π, π), t in (0, 2), parameters within 10 % of their defaults.
-    Raises :class:`ModelError` naming the joint and the direction of the first column that
-    does work in an admissible motion.
+
+def check_joints(system: System, joints: Sequence[JointReactions], samples: int = 3,
+                 seed: int = 7) -> None:
+    """Joint by joint: every constrained direction does no work in the joint's relative motion
+    (``wᵀ·ξ = 0``, the orthogonality relation ``J̄ᵀ·Q̄ = 0`` restricted to one joint), the
+    directions and the motions of a joint span all six, and the joints' motions are independent
+    (their ranks add up to f).
+
+    Checked numerically at random states (coordinates in (−π, π), t in (0, 2), parameters within
+    10 % of their defaults) on the joint's own short expressions. Raises :class:`ModelError`
+    naming the joint and the direction.
     """
-    system = ne.system
-    J = ne.J_bar
-    n6, f = J.shape
-    q = Q_bar.shape[1]
     rng = np.random.default_rng(seed)
-    exprs = J.entries() + Q_bar.entries()
-    vals = _sample_values(exprs, system.coordinates, system.parameter_values, rng, samples)
-    Jn = vals[:n6 * f].reshape(n6, f, samples)
-    Qn = vals[n6 * f:].reshape(n6, q, samples)
+    params = system.parameter_values
+    total = 0
+    ranks: list[tuple[JointReactions, int]] = []
+    for jr in joints:
+        ys = _step_coordinates(jr.joint, system.coordinates)
+        twist = [x for v, w in relative_twist(jr.joint, ys) for x in (*v, *w)]
+        wr = [x for w in jr.wrenches for x in w]
+        vals = _sample_values(twist + wr, system.coordinates, params, rng, samples)
+        X = vals[:len(twist)].reshape(len(ys), 6, samples)
+        W = vals[len(twist):].reshape(len(jr.wrenches), 6, samples)
+        rank = max((np.linalg.matrix_rank(X[:, :, k], tol=1e-9) for k in range(samples)),
+                   default=0) if ys else 0
+        ranks.append((jr, rank))
+        total += rank
+        for k in range(samples):
+            power = W[:, :, k] @ X[:, :, k].T  # (directions, coordinates)
+            scale = max(1.0, float(np.abs(X[:, :, k]).max(initial=0.0)))
+            for d in range(len(jr.wrenches)):
+                bad = np.nonzero(np.abs(power[d]) > 1e-9 * scale *
+                                 max(1.0, float(np.abs(W[d, :, k]).max())))[0]
+                if bad.size:
+                    raise ModelError(
+                        f'joint "{jr.joint.name}" (body "{jr.child}"): its constrained direction '
+                        f'"{jr.names[d]}" does work in the joint\'s motion with coordinate '
+                        f"{ys[int(bad[0])]} (relative power {abs(power[d, bad[0]]):.2e} per unit "
+                        "rate); the orthogonality relation J̄ᵀ·Q̄ = 0 fails"
+                    )
+            both = np.concatenate([X[:, :, k], W[:, :, k]]) if ys else W[:, :, k]
+            if both.shape[0] < 6 or np.linalg.matrix_rank(both, tol=1e-9) < 6:
+                raise ModelError(
+                    f'joint "{jr.joint.name}" (body "{jr.child}"): its {len(jr.names)} '
+                    f"constrained directions and its {rank} directions of motion do not span "
+                    "all six; a reaction would be missing from Q̄ (give the missing directions "
+                    "in constrained=[...])"
+                )
+    if total > system.f:
+        # a joint that moves with coordinates it does not drive (gears, a screw turned by
+        # another joint's angle) couples two joints: that coupling force is no joint's reaction
+        odd = [f'"{jr.joint.name}" (moves in {r} directions, drives '
+               f"{len(jr.joint.coordinates)} coordinate(s))" for jr, r in ranks
+               if jr.joint.kind == "general" and r != len(jr.joint.coordinates)]
+        raise ModelError(
+            f"the joints move in {total} independent directions but the system has f = "
+            f"{system.f} coordinates: some joints are coupled (a joint moved by another joint's "
+            "coordinate), and the coupling force is no single joint's reaction; "
+            + (f"check joint(s) {', '.join(odd)}" if odd else "check the joints' coordinates")
+        )
+
+
+def check_orthogonality(r: Reactions, samples: int = 3, seed: int = 7, fn: Any = None) -> float:
+    """The orthogonality relation ``J̄ᵀ·Q̄ = 0`` of the assembled matrices, checked with the
+    compiled J̄ and Q̄ (``fn``: a compiled function giving ``J_bar`` and ``Q_bar``, compiled
+    here when not given) at random states (coordinates in (−π, π), t in (0, 2), parameters within
+    10 % of their defaults), and that ``[J̄, Q̄]`` is square and regular (no reaction missing).
+
+    Returns the largest relative residual ``|J̄ᵀQ̄| / (|J̄|ᵀ|Q̄|)`` over the columns; raises
+    :class:`ModelError` naming the joint and the direction of a column that does work.
+    """
+    system = r.system
+    if fn is None:
+        from .numeric import lambdify
+
+        fn = lambdify(system, {"J_bar": r.newton_euler.J_bar, "Q_bar": r.Q_bar})
+    rng = np.random.default_rng(seed)
+    pv = np.array(list(system.parameter_values.values()), dtype=float)
     worst = 0.0
-    for s in range(samples):
-        JQ = Jn[:, :, s].T @ Qn[:, :, s]
-        scale = np.abs(Jn[:, :, s]).T @ np.abs(Qn[:, :, s])
-        scale_col = scale.max(axis=0) + 1e-300
-        rel = np.abs(JQ).max(axis=0) / scale_col
+    n6 = r.Q_bar.shape[0]
+    for _ in range(samples):
+        y = rng.uniform(-math.pi, math.pi, system.f)
+        out = fn(y, np.zeros(system.f), float(rng.uniform(0, 2)), pv * rng.uniform(0.9, 1.1, pv.size),
+                 np.zeros(len(system.inputs)))
+        J, Q = out["J_bar"], out["Q_bar"]
+        JQ = J.T @ Q
+        scale = (np.abs(J).T @ np.abs(Q)).max(axis=0) + 1e-300
+        rel = np.abs(JQ).max(axis=0) / scale
         worst = max(worst, float(rel.max())) if rel.size else worst
         bad = np.nonzero(rel > 1e-9)[0]
         if bad.size:
             c = int(bad[0])
-            jr = next(j for j in joints if c in j.columns)
-            k = int(np.argmax(np.abs(JQ[:, c])))
+            jr = next(j for j in r.joints if c in j.columns)
             raise ModelError(
                 f'joint "{jr.joint.name}" (body "{jr.child}"): its constrained direction '
-                f'"{jr.names[jr.columns.index(c)]}" does work in an admissible motion '
-                f"(J̄ᵀQ̄ ≠ 0 in the row of coordinate {system.coordinates[k]}, relative residual "
-                f"{rel[c]:.2e}); the orthogonality relation J̄ᵀ·Q̄ = 0 fails"
+                f'"{jr.names[jr.columns.index(c)]}" does work in an admissible motion (relative '
+                f"residual {rel[c]:.2e}); the orthogonality relation J̄ᵀ·Q̄ = 0 fails"
             )
-    # completeness: [J̄, Q̄] must span all 6p directions, else some reaction is missing from Q̄
-    A = np.concatenate([Jn[:, :, 0], Qn[:, :, 0]], axis=1)
-    sv = np.linalg.svd(A, compute_uv=False)
-    rank = int((sv > 1e-9 * sv[0]).sum())
-    if rank < n6:
-        # a joint that moves with coordinates it does not drive (gears, a screw turned by
-        # another joint's angle) couples two joints: that coupling force is no joint's reaction
-        odd = [f'"{jr.joint.name}" (moves in {6 - len(jr.names)} directions, drives '
-               f"{len(jr.joint.coordinates)} coordinate(s))" for jr in joints
-               if jr.joint.kind == "general" and 6 - len(jr.names) != len(jr.joint.coordinates)]
-        raise ModelError(
-            f"the joints' constrained directions and the motions span only {rank} of the 6p = "
-            f"{n6} directions: the reactions need every joint to move only with the coordinates "
-            "it drives; "
-            + (f"check joint(s) {', '.join(odd)}" if odd else
-               "check the constrained directions given for general joints")
-        )
+        # redundant directions (more columns) leave components of g undetermined, which the
+        # solve reports; missing ones (rank < 6p) would make every g wrong
+        sv = np.linalg.svd(np.concatenate([J, Q], axis=1), compute_uv=False)
+        rank = int((sv > 1e-9 * sv[0]).sum())
+        if rank < n6:
+            raise ModelError(
+                f"[J̄, Q̄] has rank {rank} < 6p = {n6}: the constrained directions of the "
+                "joints and the motions do not span all directions; a reaction is missing"
+            )
     return worst
 
 
@@ -822,12 +886,20 @@ def _project(jr: JointReactions, W: Wrench) -> list[se.Basic]:
 
 # --- numbers -------------------------------------------------------------------------------------
 @lru_cache(maxsize=32)
-def _reactions_function(system: System) -> tuple[Reactions, Any]:
+def _compiled(system: System) -> tuple[Reactions, Any]:
     from .numeric import lambdify
 
     r = reactions(system.newton_euler())
     return r, lambdify(system, {"Q_bar": r.Q_bar, "N_hat": r.N_hat, "k_hat": r.k_hat,
-                                "q_hat": r.q_hat})
+                                "q_hat": r.q_hat, "J_bar": r.newton_euler.J_bar})
+
+
+@lru_cache(maxsize=32)
+def _reactions_function(system: System) -> tuple[Reactions, Any]:
+    """Compiled reactions of ``system``, after the check of the assembled J̄ᵀ·Q̄ = 0."""
+    r, fn = _compiled(system)
+    check_orthogonality(r, fn=fn)
+    return r, fn
 
 
 def solve_g(Q_bar: np.ndarray, N_hat: np.ndarray, k_hat: np.ndarray, q_hat: np.ndarray,
