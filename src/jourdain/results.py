@@ -218,12 +218,16 @@ class Results:
         return float(np.max(np.abs(E - E[0])) / scale)
 
     @property
-    def energy_balance_error(self) -> float | None:
-        """Relative error of ``T + V − W_nc = const`` (any scleronomic model; None for a
-        rheonomic one, whose prescribed motion does work no force element accounts for)."""
+    def rheonomic(self) -> bool:
+        """The kinematics depends on time explicitly (a prescribed motion)."""
         self._energy()
-        if self._energies.get("rheonomic"):
-            return None
+        return bool(self._energies.get("rheonomic"))
+
+    @property
+    def energy_balance_error(self) -> float:
+        """Relative error of ``T + V − W_nc = const``. Expected small for scleronomic models;
+        for a rheonomic one (:attr:`rheonomic`) the prescribed motion does work that no force
+        element accounts for, and the balance does not close."""
         bal = self.total_energy - self.work_nonconservative
         scale = max(float(np.max(np.abs(self.total_energy))), float(np.max(np.abs(self.kinetic_energy))),
                     1e-300)
