@@ -104,6 +104,12 @@ def test_plots_have_labelled_axes(run):
     assert ax.get_xlabel() == "phi [rad]" and ax.get_ylabel() == "phi_d [rad/s]"
     with pytest.raises(jd.EvaluationError, match="unknown coordinate"):
         res.plot_phase("theta")
+    ax = res.plot("g")
+    assert [t.get_text() for t in ax.get_legend().get_texts()][:2] == ["pivot.F_x", "pivot.F_y"]
+    ax = res.plot_path("bob", "xy", point="com")
+    x, y = ax.get_lines()[0].get_data()
+    np.testing.assert_allclose(np.hypot(x, y), 0.8, rtol=1e-12)  # on the circle of radius l
+    assert ax.get_xlabel() == "x [m]"
 
 
 def test_conservative_run_reports_drift(run):

@@ -396,7 +396,8 @@ class Results:
 
     def plot(self, what: str = "y", coordinates: Sequence[str] | None = None, ax: Any = None
              ) -> Any:
-        """Time histories: ``what`` = "y", "yd", "ydd", "u" or "energy"; returns the Axes."""
+        """Time histories: ``what`` = "y", "yd", "ydd", "u", "energy" or "g" (reaction forces);
+        returns the Axes."""
         import matplotlib.pyplot as plt
 
         if ax is None:
@@ -426,10 +427,37 @@ class Results:
             ax.plot(self.t, self.total_energy, label="T + V")
             ax.plot(self.t, self.work_nonconservative, label="W_nc (non-conservative work)")
             ax.set_ylabel("energy [J]")
+        elif what == "g":
+            for i, n in enumerate(self.g_names):
+                ax.plot(self.t, self.g[:, i], label=n)
+            ax.set_ylabel("reaction forces g [N, N·m]")
         else:
-            raise EvaluationError(f"plot: what must be y, yd, ydd, u or energy, got {what!r}")
+            raise EvaluationError(f"plot: what must be y, yd, ydd, u, energy or g, got {what!r}")
         ax.set_xlabel("t [s]")
         ax.set_title(self.name)
+        ax.legend()
+        ax.grid(True)
+        return ax
+
+    def plot_path(self, body: str, plane: str = "xy", point: str = "origin", ax: Any = None
+                  ) -> Any:
+        """Path of a body's frame origin (or ``point="com"``) projected on a coordinate plane
+        of the inertial frame ("xy", "xz", "yz"); returns the Axes."""
+        import matplotlib.pyplot as plt
+
+        if len(plane) != 2 or set(plane) - set("xyz"):
+            raise EvaluationError(f'plane must be two of "x", "y", "z", got {plane!r}')
+        r = self.positions(body, point)
+        i, j = ("xyz".index(plane[0]), "xyz".index(plane[1]))
+        if ax is None:
+            _, ax = plt.subplots()
+        unit = self.units.get("length", "m")
+        ax.plot(r[:, i], r[:, j], label=f"{body} ({point})")
+        ax.plot(r[:1, i], r[:1, j], "o", label="start")
+        ax.set_xlabel(f"{plane[0]} [{unit}]")
+        ax.set_ylabel(f"{plane[1]} [{unit}]")
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_title(f"{self.name}: path of {body}")
         ax.legend()
         ax.grid(True)
         return ax
