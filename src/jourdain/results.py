@@ -261,10 +261,18 @@ class Results:
             qc, qe = eo["q_c"][:, :, 0], eo["q_e"][:, :, 0]
         else:
             qc = qe = np.zeros((len(self.t), out["Q_bar"].shape[1]))
-        g = np.empty((len(self.t), out["N_hat"].shape[1]))
-        for i in range(len(self.t)):
-            g[i], _ = solve_g(out["Q_bar"][i], out["N_hat"][i], out["k_hat"][i, :, 0],
-                              out["q_hat"][i, :, 0], qc[i], qe[i], r.singular_rows, r.g_names)
+        g = None
+        if not r.singular_rows:  # N̂ g = k̂ − q̂ for all states in one batched solve
+            try:
+                g = np.linalg.solve(out["N_hat"], out["k_hat"] - out["q_hat"])[:, :, 0]
+            except np.linalg.LinAlgError:
+                g = None
+        if g is None:  # bodies without inertia or redundant directions: state by state
+            g = np.empty((len(self.t), out["N_hat"].shape[1]))
+            for i in range(len(self.t)):
+                g[i], _ = solve_g(out["Q_bar"][i], out["N_hat"][i], out["k_hat"][i, :, 0],
+                                  out["q_hat"][i, :, 0], qc[i], qe[i], r.singular_rows,
+                                  r.g_names)
         self._energies["g"] = g
         self._energies["g_names"] = list(r.g_names)
 
