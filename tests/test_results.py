@@ -151,3 +151,14 @@ def test_spring_potentials_and_energy_conservation():
     res2 = s2.simulate((0, 3), [-1.2, 1.3], [0.5, 0.0], rtol=1e-11, atol=1e-11)
     assert not res2.conservative and res2.energy_balance_error < 1e-9
     assert res2.work_nonconservative[-1] < -0.01
+
+
+def test_batched_reactions_equal_single_state_evaluation():
+    from jourdain.models import spatial_chain
+
+    s = spatial_chain(3)
+    res = s.simulate((0, 1), [0.2] * s.f, [0.1] * s.f, t_eval=np.linspace(0, 1, 4))
+    for i in range(4):
+        ref = s.evaluate(res.y[i], res.yd[i], res.t[i])
+        np.testing.assert_allclose(res.g[i], ref["g"], rtol=1e-10, atol=1e-10)
+    assert res.g_names == ref["g_names"]
