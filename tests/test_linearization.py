@@ -258,6 +258,15 @@ def test_numeric_path_matches_symbolic(rng):
     assert num.time_dependence  # a trajectory: time-variant
     with pytest.raises(jd.TimeVariantError):
         _ = num.K
+    # bodies with full inertia tensors (the numeric path forms M̃ = J̄ᵀM̄J̄ and ∂(M·ÿ_s)/∂y
+    # from J̄ and its derivatives)
+    c = spatial_chain(3)
+    nominal = {n: float(rng.uniform(-1, 1)) + float(rng.uniform(-2, 2)) * jd.t**2
+               for n in c.coordinate_names}
+    sym = c.linearize(nominal).evaluate(t=0.6)
+    num = jd.linearize_numeric(c, nominal, t=0.6)
+    for key in ("M_tilde", "P", "Q", "h"):
+        np.testing.assert_allclose(getattr(num, key), sym[key], rtol=1e-11, atol=1e-11)
     r = rotor()
     nl = jd.linearize_numeric(r, {"alpha": 0, "beta": 0, "phi": jd.symbols("Omega") * jd.t},
                               t=0.3)

@@ -541,7 +541,8 @@ def linearize_numeric(source: System | EquationsOfMotion, nominal: Mapping[Any, 
                       t: float = 0.0,
                       parameters: Mapping[str, float] | None = None) -> NumericLinearization:
     """M̃, P, Q, h, B as numbers for given parameter values, by forward-mode differentiation in
-    floating point over the graphs of M, k, q (:func:`jourdain.differentiate.jet_float`).
+    floating point over the graphs of k, q and J̄ (:func:`jourdain.differentiate.jet_float`),
+    with ``M̃ = J̄ᵀ·M̄·J̄`` in numbers.
 
     Same equations and nominal motions as :func:`linearization`, without forming symbolic
     matrices: the way to eigenvalues of large systems (a spatial chain of 16 bodies in well
@@ -562,28 +563,41 @@ def linearize_numeric(source: System | EquationsOfMotion, nominal: Mapping[Any, 
     nominal_exprs = [*y_s, *yd_s, *ydd_s, *u_s]
     nominal_has_t = "t" in free_symbol_names(nominal_exprs)
     ydd_nonzero = [not _is_zero(a) for a in ydd_s]
-    exprs, mask, upper = _residual_parts(eom, ydd_nonzero)
+    f, m = system.f, len(system.inputs)
+    # M = J̄ᵀ·M̄·J̄ (METHOD.md §3) is formed in numbers from J̄: the graph of J̄ is a fraction of
+    # the graph of M's f(f+1)/2 entries, and M̄ holds parameters only
+    ne = eom.newton_euler
+    J_bar = ne.J_bar.entries()
+    n6 = ne.J_bar.shape[0]
+    M_bar = evaluate_float(ne.M_bar.entries(), pars)  # raises if M̄ depended on more
+    M_bar = np.array(M_bar).reshape(n6, n6)
+    exprs = [*eom.k.entries(), *eom.q.entries(), *J_bar]
+    mask = [True] * (2 * f) + [any(ydd_nonzero)] * len(J_bar)
     graph = Graph(exprs)
     variables = [*system.y, *system.yd, *system.inputs]
+    nv = len(variables)
 
     def at(time: float) -> dict[str, np.ndarray]:
         values = {**pars, "t": time}
         nums = evaluate_float(nominal_exprs, values)
-        f, m = system.f, len(system.inputs)
         ys, yds, ydds, us = (nums[:f], nums[f:2 * f], np.array(nums[2 * f:3 * f]),
                              nums[3 * f:])
         values.update({str(s): v for s, v in zip(system.y, ys, strict=True)})
         values.update({str(s): v for s, v in zip(system.yd, yds, strict=True)})
         values.update({str(s): v for s, v in zip(system.inputs, us, strict=True)})
         J = jet_float(graph, variables, values, mask)
-        Mt = np.zeros((f, f))
-        dM = np.zeros((f, f, len(variables)))
-        for (i, j), v, g in zip(upper, J.values[2 * f:], J.jacobian[2 * f:], strict=True):
-            Mt[i, j] = Mt[j, i] = v
-            dM[i, j] = dM[j, i] = g
+        Jb = J.values[2 * f:].reshape(n6, f)
+        MJ = M_bar @ Jb
+        Mt = Jb.T @ MJ
+        Mt = 0.5 * (Mt + Mt.T)
         # r = M·ÿ_s + k − q
         r = Mt @ ydds + J.values[:f] - J.values[f:2 * f]
-        dr = np.einsum("ijv,j->iv", dM, ydds) + J.jacobian[:f] - J.jacobian[f:2 * f]
+        dr = J.jacobian[:f] - J.jacobian[f:2 * f]
+        if np.any(ydds != 0.0):
+            # ∂(J̄ᵀM̄J̄·ÿ_s)/∂y_v = (∂J̄/∂y_v)ᵀ·M̄J̄ÿ_s + J̄ᵀM̄·(∂J̄/∂y_v)·ÿ_s
+            dJ = J.jacobian[2 * f:].reshape(n6, f, nv)
+            dJa = np.einsum("rjv,j->rv", dJ, ydds)
+            dr = dr + np.einsum("rjv,r->jv", dJ, MJ @ ydds) + MJ.T @ dJa
         return {"M_tilde": Mt, "Q": dr[:, :f], "P": dr[:, f:2 * f],
                 "B": -dr[:, 2 * f:2 * f + m], "h": -r}
 
