@@ -216,7 +216,8 @@ def pinocchio_model(data: list[dict]):
     return model
 
 
-def bench_batched(name: str, system: jd.System, data: list[dict], n_states: int = 2000) -> dict:
+def bench_batched(name: str, system: jd.System, data: list[dict], n_states: int = 2000,
+                  rounds: int = 15) -> dict:
     import pinocchio as pin
 
     eom = system.equations_of_motion()
@@ -228,17 +229,22 @@ def bench_batched(name: str, system: jd.System, data: list[dict], n_states: int 
     YD = rng.uniform(-2, 2, (n_states, system.f))
     p = numeric.parameter_vector(system, None)
     out = np.empty((n_states, fn.size))
-    t_batch = best_of(lambda: fn.batch(Y, YD, 0.0, p, None, out=out)) / n_states
     y0, yd0, u0 = Y[0].copy(), YD[0].copy(), np.zeros(1)
     flat = np.empty(fn.size)
-    t_single = best_of(lambda: fn.raw(y0, yd0, 0.0, p, u0, flat))
 
     def pin_loop() -> None:
         for i in range(n_states):
             pin.crba(model, pdata, Y[i])
             pin.nonLinearEffects(model, pdata, Y[i], YD[i])
 
-    t_pin = best_of(pin_loop, repeat=5) / n_states
+    # interleaved rounds, best of each: a busy machine slows both alike
+    t_batch = t_single = t_pin = math.inf
+    for _ in range(rounds):
+        t_batch = min(t_batch, best_of(lambda: fn.batch(Y, YD, 0.0, p, None, out=out),
+                                       repeat=1, min_time=0.02) / n_states)
+        t_single = min(t_single, best_of(lambda: fn.raw(y0, yd0, 0.0, p, u0, flat), repeat=1,
+                                         min_time=0.01))
+        t_pin = min(t_pin, best_of(pin_loop, repeat=1, min_time=0.02) / n_states)
     res = fn.batch(Y[:20], YD[:20], 0.0, p, None)
     err = 0.0
     for i in range(20):
@@ -253,7 +259,7 @@ def bench_batched(name: str, system: jd.System, data: list[dict], n_states: int 
 
 def main(argv: list[str] | None = None) -> dict:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--n", type=int, nargs="+", default=[2, 4, 8])
+    ap.add_argument("--n", type=int, nargs="*", default=[2, 4, 8])
     ap.add_argument("--quick", action="store_true",
                     help="n = 2 and PyDy's lambdify backend only (smoke test)")
     ap.add_argument("--sympy-max-n", type=int, default=10)
@@ -332,7 +338,7 @@ def main(argv: list[str] | None = None) -> dict:
             ad = arm_data()
             cases.append(("7-joint arm", arm_system(ad), ad))
             for name, system, data in cases:
-                b = bench_batched(name, system, data)
+                b = bench_batched(name, system, data, rounds=args.rounds)
                 ratio = b["pinocchio_per_call"] / b["batch_per_state"]
                 print(f"{name:<22} {b['f']:>3} {1e6 * b['batch_per_state']:>15.3f} "
                       f"{1e6 * b['single_call']:>15.3f} {1e6 * b['pinocchio_per_call']:>13.3f} "

@@ -172,6 +172,8 @@ def argument_names(y: Sequence[se.Symbol], yd: Sequence[se.Symbol], t: se.Symbol
 #: the temporaries in an array: C compilers take time superlinear in the size of one function
 #: (a 450 kB function of 12 spatial bodies: 35 s in one piece, a few seconds in parts)
 SPLIT_ABOVE = 600
+#: sin/cos of coordinates and of their sums and differences by the addition theorems
+TRIG_SUMS = True
 PART = 250
 
 
@@ -241,7 +243,7 @@ def function_source(name: str, exprs: Sequence[se.Basic], names: Mapping[str, st
 
     for i, node in enumerate(g.nodes):
         tn = type(node).__name__
-        if tn in ("sin", "cos"):
+        if tn in ("sin", "cos") and TRIG_SUMS:
             arg = node.args[0]
             sc = None
             if type(arg).__name__ == "Symbol":
