@@ -214,3 +214,32 @@ def test_equilibria_which_one_is_meant():
         jd.find_equilibrium(s2, {"phi": 0.0})
     with pytest.raises(jd.EvaluationError, match="unknown coordinate"):
         jd.find_equilibrium(s2, {"psi": 0.0})
+
+
+def test_rotor_internal_damping_stability_threshold():
+    """Jeffcott rotor (disc m on a shaft of stiffness k, whirl coordinates x, y) with external
+    damping c_e and internal (rotating) damping c_i at spin Ω: the internal damping force
+    −c_i·(ẋ + Ωy, ẏ − Ωx) is circulatory (N = ±c_i Ω). With z = x + iy:
+    m z̈ + (c_e + c_i) ż + (k − i c_i Ω) z = 0; at the stability boundary λ = iω gives ω² = k/m
+    and (c_e + c_i) ω = c_i Ω, so Ω_crit = √(k/m)·(1 + c_e/c_i)."""
+    x, y, m, k, ce, ci, Om = jd.symbols("x y m k c_e c_i Omega")
+    slide_x = jd.Body("carrier", "world", jd.Prismatic("sx", x, "x"), mass=0,
+                      inertia=jd.point_mass())
+    disc = jd.Body("disc", "carrier", jd.Prismatic("sy", y, "y"), mass=m,
+                   inertia=jd.point_mass())
+    xd, yd = jd.rate(x), jd.rate(y)
+    forces = [jd.GeneralizedForce("shaft_x", x, -k * x - ce * xd - ci * (xd + Om * y)),
+              jd.GeneralizedForce("shaft_y", y, -k * y - ce * yd - ci * (yd - Om * x))]
+    s = jd.System([x, y], [slide_x, disc], forces,
+                  parameters={"m": 2.0, "k": 800.0, "c_e": 1.5, "c_i": 4.0, "Omega": 0.0})
+    lin = s.linearize({"x": 0, "y": 0})
+    num = lin.evaluate(parameters={"Omega": 30.0})
+    np.testing.assert_allclose(num["N"], [[0.0, 4.0 * 30.0], [-4.0 * 30.0, 0.0]], rtol=1e-14)
+    np.testing.assert_allclose(num["D"], np.diag([5.5, 5.5]), rtol=1e-14)
+    Om_crit = np.sqrt(800.0 / 2.0) * (1 + 1.5 / 4.0)
+    assert jd.stability(lin, parameters={"Omega": 0.95 * Om_crit}).verdict == (
+        "asymptotically stable")
+    st = jd.stability(lin, parameters={"Omega": 1.05 * Om_crit})
+    assert st.verdict == "unstable" and "flutter" in st.reason
+    found = jd.stability_boundary(lin, "Omega", 0.0, 3 * Om_crit)
+    assert abs(found - Om_crit) < 1e-10 * Om_crit

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..errors import EvaluationError
 from ..linearization import CompiledLinearization, Linearization
-from .modes import UNSTABLE, stability
+from .modes import ASYMPTOTICALLY_STABLE, UNSTABLE, stability
 from .state_space import _from_numbers, _linearization_of, numbers, state_space
 
 
@@ -81,29 +81,47 @@ def stability_boundary(lin: Linearization | CompiledLinearization, parameter: st
                        parameters: Mapping[str, float] | None = None,
                        rtol: float = 1e-10) -> float:
     """The value of ``parameter`` in ``[lower, upper]`` at which the verdict changes between
-    stable (asymptotically or marginally) and unstable, by bisection.
+    stable (asymptotically or marginally) and unstable.
 
-    Raises :class:`EvaluationError` when both ends have the same verdict.
+    Bisection on the verdict; where the stable side is asymptotically stable, the crossing of
+    the largest real part through zero is then found by Brent's method (the verdict's tolerance
+    on "zero real part" would otherwise shift the answer by about that tolerance divided by the
+    slope). Raises :class:`EvaluationError` when both ends have the same verdict.
     """
+    from scipy.optimize import brentq
+
     base = _linearization_of(lin)
     _check_parameter(base, parameter)
 
-    def unstable(v: float) -> bool:
+    def analyse(v: float) -> tuple[str, float]:
         pars = {**(parameters or {}), parameter: float(v)}
         ss = _from_numbers(base, numbers(lin, t, pars), float(t), pars)
-        return stability(ss).verdict == UNSTABLE
+        st = stability(ss)
+        return st.verdict, st.max_real_part
 
     state_space(lin, t, parameters)
     a, b = float(lower), float(upper)
-    ua, ub = unstable(a), unstable(b)
+    va, vb = analyse(a)[0], analyse(b)[0]
+    ua, ub = va == UNSTABLE, vb == UNSTABLE
     if ua == ub:
         word = "unstable" if ua else "stable"
         raise EvaluationError(f'stability_boundary: the system is {word} at both {parameter} = '
                               f"{a} and {parameter} = {b}; give a bracket where it changes")
+    # the evaluated point nearest to the boundary that was asymptotically stable
+    asym = a if va == ASYMPTOTICALLY_STABLE else b if vb == ASYMPTOTICALLY_STABLE else None
     while abs(b - a) > rtol * max(1.0, abs(a), abs(b)):
         mid = 0.5 * (a + b)
-        if unstable(mid) == ua:
+        vm, _ = analyse(mid)
+        if vm == ASYMPTOTICALLY_STABLE:
+            asym = mid
+        if (vm == UNSTABLE) == ua:
             a = mid
         else:
             b = mid
+    unstable_end = a if ua else b
+    if asym is not None and analyse(unstable_end)[1] > 0:
+        # the crossing of the largest real part through zero, between the nearest
+        # asymptotically stable point and the unstable end
+        return float(brentq(lambda v: analyse(v)[1], asym, unstable_end, xtol=1e-14,
+                            rtol=4 * np.finfo(float).eps))
     return 0.5 * (a + b)
