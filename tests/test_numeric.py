@@ -108,14 +108,14 @@ def test_cache_is_keyed_by_content_and_safe_to_delete(cache, monkeypatch):
     fn = numeric.mkq_function(s)
     files = sorted(p.name for p in cache.iterdir())
     assert f"{fn.key}.so" in files and f"{fn.key}.c" in files
-    # a second process-level load finds the library without generating code again
+    # a later session finds the library without compiling again
     numeric.clear_cache()
     build._loaded.clear()
 
-    def no_codegen(*a, **k):
-        raise AssertionError("code was generated again although it is cached")
+    def no_compiler(*a, **k):
+        raise AssertionError("compiled again although the library is cached")
 
-    monkeypatch.setattr(numeric, "function_source", no_codegen)
+    monkeypatch.setattr(build.subprocess, "run", no_compiler)
     fn2 = numeric.mkq_function(s)
     assert fn2.key == fn.key
     # a different model gets a different key; deleting the cache forces a rebuild
@@ -129,6 +129,22 @@ def test_cache_is_keyed_by_content_and_safe_to_delete(cache, monkeypatch):
     y = np.full(s.f, 0.4)
     np.testing.assert_array_equal(fn3(y, y, 0, numeric.parameter_vector(s, None), [0.0])["M"],
                                   fn(y, y, 0, numeric.parameter_vector(s, None), [0.0])["M"])
+
+
+def test_models_that_differ_in_a_sign_get_their_own_code(cache):
+    """SymEngine hashes k*(x - x0) and k*(x0 - x) alike; the cache must not mix them up (a
+    user flipping a sign in a model must not get the old library)."""
+    x, k, x0 = se.symbols("x k x0")
+    body = jd.Body("slider", "world", jd.Prismatic("rail", x, "x"), mass=1.0,
+                   inertia=jd.point_mass())
+    pull = {"k": 3.0, "x0": 0.5}
+    a = jd.System([x], [body], [jd.GeneralizedForce("spring", x, -k * (x - x0))], parameters=pull)
+    b = jd.System([x], [body], [jd.GeneralizedForce("spring", x, -k * (x0 - x))], parameters=pull)
+    assert hash(a.equations_of_motion().q[0]) == hash(b.equations_of_motion().q[0])
+    qa = a.evaluate([2.0], [0.0])["q"]
+    qb = b.evaluate([2.0], [0.0])["q"]
+    np.testing.assert_allclose(qa, [-4.5])
+    np.testing.assert_allclose(qb, [4.5])
 
 
 def test_evaluate_errors():

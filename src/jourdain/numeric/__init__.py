@@ -28,7 +28,7 @@ import symengine as se
 from ..errors import EvaluationError
 from ..symbolic import SymMatrix
 from .ccode import HEADER, argument_names, function_source
-from .toolchain import CompilerError, build, cache_dir, cached_library, compiler, content_key
+from .toolchain import CompilerError, build, cache_dir, compiler, content_key
 
 if TYPE_CHECKING:
     from ..model.system import System
@@ -206,15 +206,6 @@ def arguments(system: System) -> tuple[se.Symbol, ...]:
     return (*system.y, *system.yd, system.t, *system.parameter_symbols, *system.inputs)
 
 
-def _fast_key(system: System, names: tuple[str, ...], shapes: tuple[tuple[int, int], ...],
-              exprs: list[se.Basic]) -> str:
-    # SymEngine's structural hashes are deterministic across processes and cached per node,
-    # so this key costs one pass over the entries and lets a later run skip CSE and codegen.
-    arg_names = " ".join(str(a) for a in arguments(system))
-    return content_key(_GENERATOR_VERSION, se.__version__, arg_names, repr(names), repr(shapes),
-                       " ".join(str(hash(e)) for e in exprs))
-
-
 def lambdify(system: System, matrices: Mapping[str, SymMatrix],
              extra_source: str = "") -> CompiledFunction:
     """Compile the named matrices of ``system`` to machine code.
@@ -222,8 +213,11 @@ def lambdify(system: System, matrices: Mapping[str, SymMatrix],
     Common-subexpression elimination on the expression graph, then C source with one
     statement per temporary, compiled once with the system's C compiler and cached on disk by
     content hash (:func:`cache_dir`); a later call with the same expressions loads the cached
-    library without regenerating code. ``extra_source``: C appended to the generated source
-    (it may call ``jd_fn``), part of the cache key.
+    library instead of compiling again. ``extra_source``: C appended to the generated source
+    (it may call ``jd_fn``).
+
+    The cache key is a hash of the generated source itself: SymEngine's own hashes cannot serve,
+    since they do not tell ``k*(x - x0)`` from ``k*(x0 - x)``.
     """
     args = arguments(system)
     names = tuple(matrices)
@@ -238,14 +232,11 @@ def lambdify(system: System, matrices: Mapping[str, SymMatrix],
         compiler()
     except CompilerError:
         return _interpreted(system, names, shapes, exprs)
-    key = _fast_key(system, names, shapes, exprs) if not extra_source else \
-        content_key(_fast_key(system, names, shapes, exprs), extra_source)
-    lib = cached_library(key)
-    if lib is None:
-        cnames = argument_names(system.y, system.yd, system.t, system.parameter_symbols,
-                                system.inputs)
-        source = HEADER + function_source("jd_fn", exprs, cnames) + extra_source
-        lib = build(key, source)
+    cnames = argument_names(system.y, system.yd, system.t, system.parameter_symbols,
+                            system.inputs)
+    source = HEADER + function_source("jd_fn", exprs, cnames) + extra_source
+    key = content_key(_GENERATOR_VERSION, source)
+    lib = build(key, source)  # loads the cached library when there is one
     vp = ctypes.c_void_p
     lib.jd_fn.restype = None
     lib.jd_fn.argtypes = [vp, vp, ctypes.c_double, vp, vp, vp]
