@@ -1,8 +1,9 @@
 """Equilibria: positions ``y_s`` with ``q(y_s, 0, t) − k(y_s, 0, t) = 0`` for given parameters.
 
-Solved by Newton's method with the exact Jacobian ``∂(k − q)/∂y`` at ``ẏ = 0`` (the stiffness
-part of the linearization), obtained together with the residual in one pass over the expression
-graph (:func:`jourdain.differentiate.jet_float`, in floating point). A system usually has
+Solved by Levenberg–Marquardt (any equilibrium) or by regularized Newton steps that go downhill
+in the potential (stable ones), both with the exact Jacobian ``∂(k − q)/∂y`` at ``ẏ = 0`` (the
+stiffness part of the linearization), obtained together with the residual in one pass over the
+expression graph (:func:`jourdain.differentiate.jet_float`, in floating point). A system usually has
 several equilibria (a pendulum hangs or stands); the starting guess says which one is meant,
 :func:`find_equilibria` collects the distinct ones reached from several guesses.
 """
@@ -90,7 +91,8 @@ def find_equilibrium(system: System, guess: Mapping[str, float] | Sequence[float
     fixed : sequence of str
         Coordinates held at their guess (e.g. a cyclic rotor angle that any value satisfies).
     max_iterations : int
-        Limit of Jacobian evaluations, per free coordinate.
+        Iteration limit (Levenberg–Marquardt: evaluations per free coordinate; "stable": four
+        times this many steps).
     tol : float
         Convergence when ``max |q − k|`` is below ``tol`` times the largest generalized force
         seen at the guess (at least 1).
@@ -107,7 +109,7 @@ def find_equilibrium(system: System, guess: Mapping[str, float] | Sequence[float
     Raises
     ------
     NoEquilibrium
-        When Newton's method does not converge (with the last residual).
+        When the iteration ends away from an equilibrium (with the last residual and position).
     """
     from .numeric import parameter_vector
 

@@ -42,7 +42,7 @@ class Modes:
     natural_frequencies : (2f,) array
         ``ω_n = |λ|`` in rad/s.
     damping_ratios : (2f,) array
-        ``ζ = −Re λ / |λ|`` (1 for λ = 0 by convention is avoided: NaN there).
+        ``ζ = −Re λ / |λ|`` (NaN for λ = 0).
     damped_frequencies : (2f,) array
         ``|Im λ|`` in rad/s.
     coordinate_names : tuple of str
