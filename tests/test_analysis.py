@@ -243,3 +243,18 @@ def test_rotor_internal_damping_stability_threshold():
     assert st.verdict == "unstable" and "flutter" in st.reason
     found = jd.stability_boundary(lin, "Omega", 0.0, 3 * Om_crit)
     assert abs(found - Om_crit) < 1e-10 * Om_crit
+
+
+def test_equilibrium_with_a_fixed_cyclic_coordinate():
+    """spatial_chain(3): the base turns about the vertical (a cyclic coordinate, any value is an
+    equilibrium); held fixed at 0.7 it stays there while the rest settles hanging down."""
+    from jourdain.models import spatial_chain
+
+    s = spatial_chain(3)
+    eq = jd.find_equilibrium(s, {"q0": 0.7, "q1": 3.0}, fixed=["q0"], method="stable")
+    assert eq.y[0] == 0.7
+    out = s.evaluate(eq.y, np.zeros(s.f))
+    np.testing.assert_allclose(out["q"] - out["k"], 0.0, atol=1e-9)
+    # hanging: the potential is at a minimum, K has no negative eigenvalue
+    K = jd.linearize_numeric(s, eq).K
+    assert np.linalg.eigvalsh(K).min() > -1e-9

@@ -38,7 +38,7 @@ class Equilibrium:
         The coordinates at equilibrium.
     coordinate_names : tuple of str
     residual : float
-        ``max |q − k|`` at ``y`` (generalized forces, in the units of q).
+        ``max |q − k|`` at ``y`` over the coordinates not fixed (in the units of q).
     iterations : int
     parameters : dict
         All parameter values used (defaults with overrides).
@@ -89,7 +89,8 @@ def find_equilibrium(system: System, guess: Mapping[str, float] | Sequence[float
     t : float
         Time, for systems with explicitly time-dependent forces.
     fixed : sequence of str
-        Coordinates held at their guess (e.g. a cyclic rotor angle that any value satisfies).
+        Coordinates held at their guess as by a lock: their own equations are not solved (e.g.
+        a cyclic rotor angle that any value satisfies, or a joint held by a brake).
     max_iterations : int
         Iteration limit (Levenberg–Marquardt: evaluations per free coordinate; "stable": four
         times this many steps).
@@ -138,7 +139,10 @@ def find_equilibrium(system: System, guess: Mapping[str, float] | Sequence[float
         values = dict(fixed_values)
         values.update({str(s): float(v) for s, v in zip(system.y, y, strict=True)})
         J = jet_float(graph, system.y, values)
-        return J.values[:f] - J.values[f:], J.jacobian[:f] - J.jacobian[f:]
+        r = J.values[:f] - J.values[f:]
+        Jm = J.jacobian[:f] - J.jacobian[f:]
+        # a fixed coordinate is held as by a lock: its own equation is not solved
+        return r[free], Jm[np.ix_(free, free)]
 
     # Levenberg–Marquardt on ||q - k||²: a trust region keeps the steps short where the
     # Jacobian is nearly singular (nearly cyclic coordinates), so the iteration stays with the
@@ -159,21 +163,17 @@ def find_equilibrium(system: System, guess: Mapping[str, float] | Sequence[float
             cache[key] = evaluate(full(x))
         return cache[key]
 
+    if not free:
+        raise EvaluationError("all coordinates are fixed: there is nothing to solve for")
     r0, _ = at(y0[free])
     scale = max(1.0, float(np.abs(r0).max()))
-    if not free:
-        err = float(np.abs(r0).max())
-        if err <= tol * scale:
-            return Equilibrium(y=y0, coordinate_names=tuple(names), residual=err, iterations=0,
-                               parameters=pars, inputs=uvals, t=float(t))
-        raise NoEquilibrium(f"all coordinates are fixed and max |q - k| = {err:.3e} there")
     if method == "any":
-        sol = least_squares(lambda x: at(x)[0], y0[free], jac=lambda x: at(x)[1][:, free],
+        sol = least_squares(lambda x: at(x)[0], y0[free], jac=lambda x: at(x)[1],
                             method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15,
                             max_nfev=max_iterations * (len(free) + 1))
         x, nfev = sol.x, int(sol.nfev)
     elif method == "stable":
-        x, nfev = _descend(at, y0[free], free, tol * scale, max_iterations)
+        x, nfev = _descend(at, y0[free], tol * scale, max_iterations)
     else:
         raise EvaluationError(f'method must be "any" or "stable", got {method!r}')
     y = full(x)
@@ -183,7 +183,7 @@ def find_equilibrium(system: System, guess: Mapping[str, float] | Sequence[float
         err = float(np.abs(r).max())
         if err <= tol * scale:
             break
-        step = np.linalg.lstsq(Jm[:, free], -r, rcond=None)[0]
+        step = np.linalg.lstsq(Jm, -r, rcond=None)[0]
         trial = y.copy()
         trial[free] += step
         rt, Jt = evaluate(trial)
@@ -201,15 +201,14 @@ def find_equilibrium(system: System, guess: Mapping[str, float] | Sequence[float
     )
 
 
-def _descend(at: Any, x: np.ndarray, free: list[int], tol: float,
+def _descend(at: Any, x: np.ndarray, tol: float,
              max_iterations: int) -> tuple[np.ndarray, int]:
     """Regularized Newton steps (J + μE)Δ = −r that go downhill in the potential."""
-    n = len(free)
+    n = x.size
     for it in range(max_iterations * 4):
-        r, J = at(x)
+        r, Jf = at(x)
         if np.abs(r).max() <= tol:
             return x, it + 1
-        Jf = J[:, free]
         lmin = float(np.linalg.eigvalsh(0.5 * (Jf + Jf.T))[0])
         mu = max(0.0, -lmin) + float(np.linalg.norm(r))
         try:
