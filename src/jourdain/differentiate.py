@@ -25,7 +25,6 @@ read (another Python implementation), identity falls back to the hash confirmed 
 
 from __future__ import annotations
 
-import ctypes
 import gc
 import math
 from collections.abc import Iterator, Mapping, Sequence
@@ -35,6 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 import symengine as se
 
+from .cse import _POINTER_OFFSET, POINTERS, NodeIds, _read_pointer
 from .errors import JourdainError
 
 Expr = se.Basic
@@ -66,53 +66,9 @@ def _is_zero(e: Expr) -> bool:
     return e.is_Number and e == 0
 
 
-# --- identity of SymEngine nodes -------------------------------------------------------------
-# A SymEngine wrapper (a Cython object) holds one reference-counted pointer to the C++ node, right
-# after the Python object header. Two wrappers of one shared node hold the same pointer; the
-# pointer stays valid while some wrapper or parent keeps the node alive (the graph walks below keep
-# every node they key in a dict).
-_POINTER_OFFSET = object.__basicsize__
-_read_pointer = ctypes.c_void_p.from_address
-
-
-def _pointer(e: Expr) -> int:
-    return _read_pointer(id(e) + _POINTER_OFFSET).value  # type: ignore[return-value]
-
-
-def _pointers_work() -> bool:
-    try:
-        if se.Basic.__basicsize__ != _POINTER_OFFSET + ctypes.sizeof(ctypes.c_void_p):
-            return False
-        a, b = se.Symbol("_probe_a"), se.Symbol("_probe_b")
-        e = se.sin(a + b) * (a - b)
-        x1, y1 = e.args
-        x2, y2 = e.args
-        twin = se.sin(a + b) * (a - b)
-        return (_pointer(x1) == _pointer(x2) and _pointer(y1) == _pointer(y2)
-                and _pointer(x1) != _pointer(y1) and _pointer(e) != _pointer(twin)
-                and _pointer(e) != 0)
-    except Exception:  # noqa: BLE001 - any failure means: do not use pointers
-        return False
-
-
-_POINTERS = _pointers_work()
-
-
-class _Identity:
-    """Fallback keys where addresses cannot be read: the hash confirmed by ``==``."""
-
-    def __init__(self) -> None:
-        self._by_hash: dict[int, list[tuple[Expr, int]]] = {}
-
-    def __call__(self, e: Expr) -> int:
-        h = hash(e)
-        bucket = self._by_hash.setdefault(h, [])
-        for known, key in bucket:
-            if known == e:
-                return key
-        key = (h << 8) + len(bucket)
-        bucket.append((e, key))
-        return key
+# --- identity of SymEngine nodes: the address of the C++ object (jourdain.cse), read inline in
+# the walk below because it runs once per edge of the graph
+_POINTERS = POINTERS
 
 
 class Graph:
@@ -141,7 +97,7 @@ class Graph:
             def key(e: Expr) -> int:
                 return rd(id(e) + off).value  # type: ignore[return-value]
         else:
-            key = _Identity()
+            key = NodeIds()
         roots = []
         for root in exprs:
             rk = key(root)
