@@ -614,6 +614,9 @@ def reactions(ne: NewtonEuler) -> Reactions:
     params = system.parameter_values
     # columns of Q̄, sparse: per column {row: expression}
     cols: list[dict[int, se.Basic]] = []
+    # per column, its force on each body in that body's own frame (for N̂: SᵀS = E is then
+    # never left for the simplifier to find)
+    local: list[dict[int, Vec3]] = []
     names: list[str] = []
     joints: list[JointReactions] = []
     for body, bk in zip(bodies, kin.bodies, strict=True):
@@ -642,6 +645,7 @@ def reactions(ne: NewtonEuler) -> Reactions:
                     col[3 * k + a] = -SF[a]
                     col[3 * p + 3 * k + a] = -rot_p[a]
             cols.append({r: e for r, e in col.items() if e != 0})
+            local.append({i: F} if parent is None else {i: F, row[parent.name]: _scale(RF, -1)})
             names.append(f"{j.name}.{suffix}")
         joints.append(JointReactions(j, body.name, body.parent, tuple(n for n in names[start:]),
                                      tuple(w for _, w in dirs),
@@ -670,12 +674,20 @@ def reactions(ne: NewtonEuler) -> Reactions:
         if regular:
             blocks.append(([3 * p + 3 * i + a for a in regular], Iinv))
         for rows_, Minv in blocks:
-            touching = [c for c in range(q) if any(r in cols[c] for r in rows_)]
-            vecs = {c: [cols[c].get(r, ZERO) for r in rows_] for c in touching}
+            if rows_[0] < 3 * p:  # translational: forces and loads in the body's frame
+                S_i = kin.bodies[i].S.rows
+                touching = [c for c in range(q) if i in local[c]
+                            and any(x != 0 for x in local[c][i])]
+                vecs = {c: list(local[c][i]) for c in touching}
+                cvec = list(_mtv(S_i, tuple(qc[r] for r in rows_)))  # type: ignore[arg-type]
+                evec = list(_mtv(S_i, tuple(qe[r] for r in rows_)))  # type: ignore[arg-type]
+            else:
+                touching = [c for c in range(q) if any(r in cols[c] for r in rows_)]
+                vecs = {c: [cols[c].get(r, ZERO) for r in rows_] for c in touching}
+                cvec = [qc[r] for r in rows_]
+                evec = [qe[r] for r in rows_]
             mv = {c: [se.Add(*(Minv[a][b] * vecs[c][b] for b in range(len(rows_))))
                       for a in range(len(rows_))] for c in touching}
-            cvec = [qc[r] for r in rows_]
-            evec = [qe[r] for r in rows_]
             for ia, ca in enumerate(touching):
                 for cb in touching[ia:]:
                     N[ca][cb].append(se.Add(*(x * y for x, y in zip(mv[ca], vecs[cb], strict=True))))
