@@ -330,6 +330,9 @@ def test_redundant_directions_are_undetermined():
     assert g_["hinge.F_y"] == pytest.approx(2.0 * 1.0 + 2.0 * 9.81, rel=1e-12)
     with pytest.raises(jd.JourdainError, match="undetermined"):
         s.reactions().g()
+    one = jd.joint_reactions(s, "hinge", [0.0], [1.0])
+    assert np.isnan(one["hinge.F_x"]) and np.isnan(one["hinge.F_x2"])
+    assert one["hinge.F_y"] == pytest.approx(g_["hinge.F_y"], rel=1e-12)
 
 
 def test_unknown_joint_is_named():

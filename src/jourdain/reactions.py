@@ -50,7 +50,7 @@ import symengine as se
 from .errors import EvaluationError, JourdainError, ModelError
 from .kinematics import Z3, _add, _cross, _dot, _mm, _mtv, _mv, _scale
 from .model.bodies import WORLD
-from .model.joints import IDENTITY, Joint, Mat3, Rot, Trans, Vec3, rotation_matrix
+from .model.joints import IDENTITY, Joint, Mat3, Rot, Vec3, rotation_matrix
 from .newton_euler import NewtonEuler
 from .symbolic import SymMatrix
 
@@ -837,41 +837,59 @@ def _subtree(system: System, root: str) -> list[str]:
     return [b.name for b in system.bodies if b.name in below]
 
 
-def _subtree_wrench(ne: NewtonEuler, child: str) -> Wrench:
+def _subtree_parts(ne: NewtonEuler, child: str) -> tuple[Wrench, list[Wrench]]:
     """Residual wrench of the sub-tree below (and including) ``child``, at the child frame's
-    origin, in the child frame, with ÿ as symbols."""
+    origin, in the child frame, split as ``W0 + Σ_j W_j·ÿ_j`` (it is linear in ÿ): ``W0`` from
+    the local accelerations, the gyroscopic and the applied forces, ``W_j`` from the Jacobian
+    columns of coordinate j."""
     kin = ne.kinematics
     system = kin.system
-    ydd = kin.ydd
+    f = len(kin.y)
     forces = {bf.name: bf for bf in ne.forces}
     bc = kin[child]
     Sc = bc.S.rows
     rO = _v(bc.r_O)
-    F_tot: Vec3 = Z3
-    T_tot: Vec3 = Z3
+    W0: list[se.Basic] = [ZERO] * 6
+    Wy: list[list[se.Basic]] = [[ZERO] * 6 for _ in range(f)]
+
+    def add(acc: list[se.Basic], name: str, F: Vec3, tau: Vec3, arm: Vec3) -> None:
+        # move a force (inertial, at the COM) and a torque (body frame) to the child frame
+        Fc = _mtv(Sc, F)
+        tau_c = tau if name == child else _mtv(Sc, _mv(kin[name].S.rows, tau))  # type: ignore[arg-type]
+        T = _add(tau_c, _cross(arm, Fc))
+        for a in range(3):
+            acc[a] = acc[a] + Fc[a]
+            acc[3 + a] = acc[3 + a] + T[a]
+
     for name in _subtree(system, child):
         body = system.body(name)
         bk = kin[name]
         bf = forces[name]
-        a = _v(bk.a_bar)
-        for j, c in bk.cols_T.items():
-            a = _add(a, _scale(c, ydd[j]))
-        F = (body.mass * a[0] - bf.f[0], body.mass * a[1] - bf.f[1], body.mass * a[2] - bf.f[2])
-        tau: Vec3 = (-bf.l[0], -bf.l[1], -bf.l[2])
-        if body.has_inertia:
-            I = body.inertia
-            al = _v(bk.alpha_bar)
-            for j, c in bk.cols_R.items():
-                al = _add(al, _scale(c, ydd[j]))
-            w = _v(bk.omega)
-            tau = _add(tau, _add(_mv(I, al), _cross(w, _mv(I, w))))
-        Fc = _mtv(Sc, F)
         r = _v(bk.r)
         arm = _mtv(Sc, (r[0] - rO[0], r[1] - rO[1], r[2] - rO[2]))
-        tau_c = tau if name == child else _mtv(Sc, _mv(bk.S.rows, tau))  # type: ignore[arg-type]
-        F_tot = _add(F_tot, Fc)
-        T_tot = _add(T_tot, _add(tau_c, _cross(arm, Fc)))
-    return (*F_tot, *T_tot)  # type: ignore[return-value]
+        m = body.mass
+        a_bar = _v(bk.a_bar)
+        F = (m * a_bar[0] - bf.f[0], m * a_bar[1] - bf.f[1], m * a_bar[2] - bf.f[2])
+        tau: Vec3 = (-bf.l[0], -bf.l[1], -bf.l[2])
+        I = body.inertia
+        if body.has_inertia:
+            w = _v(bk.omega)
+            tau = _add(tau, _add(_mv(I, _v(bk.alpha_bar)), _cross(w, _mv(I, w))))
+        add(W0, name, F, tau, arm)
+        for j in set(bk.cols_T) | set(bk.cols_R):
+            Fj = _scale(bk.cols_T.get(j, Z3), m)
+            tj = _mv(I, bk.cols_R[j]) if body.has_inertia and j in bk.cols_R else Z3
+            add(Wy[j], name, Fj, tj, arm)
+    return tuple(W0), [tuple(w) for w in Wy]  # type: ignore[return-value]
+
+
+def _subtree_wrench(ne: NewtonEuler, child: str) -> Wrench:
+    """Residual wrench of the sub-tree below ``child`` (see :func:`_subtree_parts`) with ÿ as
+    the symbols ``<coordinate>_dd``."""
+    W0, Wy = _subtree_parts(ne, child)
+    ydd = ne.kinematics.ydd
+    return tuple(se.Add(W0[a], *(Wy[j][a] * ydd[j] for j in range(len(Wy))))  # type: ignore[return-value]
+                 for a in range(6))
 
 
 def _v(m: SymMatrix) -> Vec3:
@@ -984,17 +1002,33 @@ def evaluate_reactions(system: System, y: Any, yd: Any, t: float = 0.0,
             "g_names": list(r.g_names), "g_undetermined": und}
 
 
-@lru_cache(maxsize=32)
-def _frames_function(system: System) -> Any:
+@lru_cache(maxsize=64)
+def _joint_function(system: System, joints: tuple[str, ...]) -> tuple[list, Any]:
+    """Compiled M, k, q and, per joint, ``Eᵀ·W0``, ``Eᵀ·W_y`` and ``EᵀE`` (E: its constrained
+    directions), so that ``EᵀE·g_j = Eᵀ·(W0 + W_y·ÿ)``."""
     from .numeric import lambdify
 
-    kin = system.kinematics()
-    mats = {}
-    for i, bk in enumerate(kin.bodies):
-        mats[f"S{i}"] = bk.S
-        mats[f"r{i}"] = bk.r
-        mats[f"rO{i}"] = bk.r_O
-    return lambdify(system, mats)
+    eom = system.equations_of_motion()
+    ne = eom.newton_euler
+    by_joint = {b.joint.name: b for b in system.bodies}
+    params = system.parameter_values
+    mats: dict[str, SymMatrix] = {"M": eom.M, "k": eom.k, "q": eom.q}
+    info = []
+    for k, name in enumerate(joints):
+        body = by_joint[name]
+        dirs = constrained_directions(body.joint, system.coordinates, params)
+        info.append((name, [sfx for sfx, _ in dirs]))
+        if not dirs:
+            continue
+        W0, Wy = _subtree_parts(ne, body.name)
+
+        def dot(w: Wrench, v: Wrench) -> se.Basic:
+            return se.Add(*(x * y for x, y in zip(w, v, strict=True) if x != 0 and y != 0))
+
+        mats[f"G0_{k}"] = SymMatrix.column([dot(w, W0) for _, w in dirs])
+        mats[f"Gy_{k}"] = SymMatrix.from_rows([[dot(w, Wj) for Wj in Wy] for _, w in dirs])
+        mats[f"EE_{k}"] = SymMatrix.from_rows([[dot(w, v) for _, v in dirs] for _, w in dirs])
+    return info, lambdify(system, mats)
 
 
 def joint_reactions(system: System, joints: str | Sequence[str], y: Any, yd: Any,
@@ -1004,11 +1038,14 @@ def joint_reactions(system: System, joints: str | Sequence[str], y: Any, yd: Any
     """Reaction components of the named joints only, without forming ``N̂`` or all of ``g``.
 
     ÿ comes from the equations of motion; the residual ``M̄·J̄·ÿ + q̄^c − q̄^e`` of the sub-tree
-    each joint carries, moved to the joint point and the child frame, is the wrench the joint
-    transmits; its components along the joint's constrained directions (least squares when they
-    are not orthonormal) are returned as ``{"<joint>.<direction>": value}``.
+    each joint carries, moved to the joint point and the child frame, is the wrench ``W`` the
+    joint transmits, and ``EᵀE·g_j = Eᵀ·W`` gives its components along the joint's constrained
+    directions ``E``. Compiled once per system and set of joints (``M, k, q`` and, per joint,
+    ``Eᵀ·W`` split into its part without ÿ and its coefficients of ÿ).
+
+    Returns ``{"<joint>.<direction>": value}``; directions that others of the same joint repeat
+    share their force and come back as NaN (undetermined).
     """
-    from .numeric import evaluate as evaluate_eom
     from .numeric import state_vectors
 
     if isinstance(joints, str):
@@ -1018,42 +1055,28 @@ def joint_reactions(system: System, joints: str | Sequence[str], y: Any, yd: Any
         if name not in by_joint:
             raise ModelError(f'unknown joint "{name}"; joints are: {", ".join(by_joint)}')
     args = state_vectors(system, y, yd, t, parameters, inputs)
-    eom = evaluate_eom(system, y, yd, t=t, parameters=parameters, inputs=inputs)
-    M = np.atleast_2d(eom["M"])
+    info, fn = _joint_function(system, tuple(joints))
+    out_ = fn(*args)
     try:
-        ydd = np.linalg.solve(M, eom["q"] - eom["k"])
+        ydd = np.linalg.solve(np.atleast_2d(out_["M"]), (out_["q"] - out_["k"]).reshape(-1))
     except np.linalg.LinAlgError:
         from .errors import SingularMassMatrix
 
         raise SingularMassMatrix("the mass matrix M is singular at this state") from None
-    res = eom["M_bar"] @ (eom["J_bar"] @ ydd) + eom["q_c"] - eom["q_e"]
-    fr = _frames_function(system)(*args)
-    p = len(system.bodies)
-    idx = _body_rows(system)
-    params = system.parameter_values
     out: dict[str, float] = {}
-    for name in joints:
-        body = by_joint[name]
-        c = idx[body.name]
-        Sc, rO = fr[f"S{c}"], fr[f"rO{c}"].reshape(-1)
-        W = np.zeros(6)
-        for bn in _subtree(system, body.name):
-            i = idx[bn]
-            F = Sc.T @ res[3 * i:3 * i + 3]
-            tau = Sc.T @ (fr[f"S{i}"] @ res[3 * p + 3 * i:3 * p + 3 * i + 3])
-            arm = Sc.T @ (fr[f"r{i}"].reshape(-1) - rO)
-            W[:3] += F
-            W[3:] += tau + np.cross(arm, F)
-        dirs = constrained_directions(body.joint, system.coordinates, params)
-        sym = [x for _, w in dirs for x in w]
-        vals = {**{s: v for s, v in zip(system.y, args[0], strict=True)},
-                system.t: args[2],
-                **{s: v for s, v in zip(system.parameter_symbols, args[3], strict=True)}}
-        E = np.array(graph_values(sym, vals), dtype=float).reshape(len(dirs), 6).T \
-            if dirs else np.zeros((6, 0))
-        gj = np.linalg.lstsq(E, W, rcond=None)[0] if dirs else np.zeros(0)
-        for (suffix, _), v in zip(dirs, gj, strict=True):
-            out[f"{name}.{suffix}"] = float(v)
+    for k, (name, suffixes) in enumerate(info):
+        if not suffixes:
+            continue
+        rhs = out_[f"G0_{k}"].reshape(-1) + out_[f"Gy_{k}"] @ ydd
+        EE = out_[f"EE_{k}"]
+        gj, *_ = np.linalg.lstsq(EE, rhs, rcond=None)
+        # directions that the others repeat (a rank-deficient Gram matrix) share their force
+        _, sv, Vt = np.linalg.svd(EE)
+        null = Vt[int((sv > 1e-10 * sv[0]).sum()):]
+        if null.size:
+            gj[np.abs(null).max(axis=0) > 1e-8] = np.nan
+        for sfx, v in zip(suffixes, gj, strict=True):
+            out[f"{name}.{sfx}"] = float(v)
     return out
 
 
@@ -1074,4 +1097,3 @@ def evaluate_keys(system: System, y: Any, yd: Any, t: float, parameters: Any, in
     return evaluate_reactions(system, y, yd, t, parameters, inputs, eom=eom)
 
 
-_ = (Trans, _mm)
