@@ -228,6 +228,8 @@ def test_every_joint_type(rng):
     assert r.joint("screw").names == tuple(f"screw.{n}" for n in ("F_x", "F_y", "T_x", "T_y",
                                                                      "W_1"))
     assert r.joint("cardan").names[-1] == "cardan.T_n"
+    # each joint's directions are orthogonal to its motions identically (expanded products)
+    assert dict(r.orthogonality) == dict.fromkeys(counts, "symbolic")
     for _ in range(3):
         y = rng.uniform(-np.pi, np.pi, s.f)
         yd = rng.uniform(-2, 2, s.f)
@@ -392,3 +394,13 @@ def test_heavy_top_axial_pivot_force_closed_form(rng):
     num = s.evaluate(y, yd)["g"]
     closed = sympy.lambdify(args, G, "numpy")(*y, *yd, p["m"], p["L"], p["A"], p["C"], p["g"])
     np.testing.assert_allclose(num, np.asarray(closed, float).ravel(), rtol=1e-12, atol=1e-12)
+
+
+def test_benchmark_script_tiny_case():
+    """benchmarks/reactions.py on a 3-body chain: runs, and agrees with Pinocchio."""
+    pytest.importorskip("pinocchio")
+    from benchmarks import reactions as bench
+
+    (row,) = bench.run([3], states=5, repeat=1)
+    assert row["q"] == 12 and row["max_rel_diff"] < 1e-12
+    assert row["jourdain_g"] > 0 and row["pinocchio"] > 0

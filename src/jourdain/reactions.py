@@ -444,6 +444,9 @@ class Reactions:
     joints : tuple of JointReactions
     singular_rows : tuple of int
         Rows of the 6p-vectors where M̄ is zero (no inertia); see the module docstring.
+    orthogonality : tuple of (joint name, "symbolic" | "numeric")
+        How ``J̄ᵀ·Q̄ = 0`` was verified for each joint's directions (:func:`check_joints`); the
+        assembled matrices are checked by :func:`check_orthogonality` before numbers are made.
     newton_euler : NewtonEuler
         The stage this came from.
     """
@@ -456,6 +459,7 @@ class Reactions:
     g_names: tuple[str, ...]
     joints: tuple[JointReactions, ...]
     singular_rows: tuple[int, ...]
+    orthogonality: tuple[tuple[str, str], ...] = ()
 
     @property
     def system(self) -> System:
@@ -657,7 +661,7 @@ def reactions(ne: NewtonEuler) -> Reactions:
         for r, e in col.items():
             Q_rows[r][c] = e
     Q_bar = SymMatrix.from_rows(Q_rows)
-    check_joints(system, joints)
+    verified = check_joints(system, joints)
     singular, inv = _singular_rows(system)
     # N̂, k̂, q̂ body by body over the regular rows (M̄ block diagonal)
     N = [[[] for _ in range(q)] for _ in range(q)]
@@ -706,6 +710,7 @@ def reactions(ne: NewtonEuler) -> Reactions:
         k_hat=SymMatrix.column([se.Add(*t) if t else ZERO for t in kh]),
         q_hat=SymMatrix.column([se.Add(*t) if t else ZERO for t in qh]),
         g_names=tuple(names), joints=tuple(joints), singular_rows=singular,
+        orthogonality=tuple(verified.items()),
     )
 
 
@@ -720,24 +725,32 @@ def _step_coordinates(joint: Joint, coordinates: Sequence[se.Symbol]) -> list[se
 
 
 def check_joints(system: System, joints: Sequence[JointReactions], samples: int = 3,
-                 seed: int = 7) -> None:
+                 seed: int = 7) -> dict[str, str]:
     """Joint by joint: every constrained direction does no work in the joint's relative motion
     (``wᵀ·ξ = 0``, the orthogonality relation ``J̄ᵀ·Q̄ = 0`` restricted to one joint), the
     directions and the motions of a joint span all six, and the joints' motions are independent
     (their ranks add up to f).
 
-    Checked numerically at random states (coordinates in (−π, π), t in (0, 2), parameters within
-    10 % of their defaults) on the joint's own short expressions. Raises :class:`ModelError`
-    naming the joint and the direction.
+    The orthogonality is shown symbolically where the expanded products ``wᵀ·ξ`` vanish (unit
+    directions, the torque normal to two axes); the rest, and the ranks, are checked numerically
+    at random states (coordinates in (−π, π), t in (0, 2), parameters within 10 % of their
+    defaults) on the joint's own short expressions. Raises :class:`ModelError` naming the joint
+    and the direction. Returns, per joint, ``"symbolic"`` or ``"numeric"``: how its
+    orthogonality was verified.
     """
     rng = np.random.default_rng(seed)
     params = system.parameter_values
     total = 0
     ranks: list[tuple[JointReactions, int]] = []
+    how: dict[str, str] = {}
     for jr in joints:
         ys = _step_coordinates(jr.joint, system.coordinates)
-        twist = [x for v, w in relative_twist(jr.joint, ys) for x in (*v, *w)]
+        cols = relative_twist(jr.joint, ys)
+        twist = [x for v, w in cols for x in (*v, *w)]
         wr = [x for w in jr.wrenches for x in w]
+        how[jr.joint.name] = "symbolic" if all(
+            se.expand(_dot(w[:3], v) + _dot(w[3:], om)) == 0
+            for w in jr.wrenches for v, om in cols) else "numeric"
         vals = _sample_values(twist + wr, system.coordinates, params, rng, samples)
         X = vals[:len(twist)].reshape(len(ys), 6, samples)
         W = vals[len(twist):].reshape(len(jr.wrenches), 6, samples)
@@ -778,6 +791,7 @@ def check_joints(system: System, joints: Sequence[JointReactions], samples: int 
             "coordinate), and the coupling force is no single joint's reaction; "
             + (f"check joint(s) {', '.join(odd)}" if odd else "check the joints' coordinates")
         )
+    return how
 
 
 def check_orthogonality(r: Reactions, samples: int = 3, seed: int = 7, fn: Any = None) -> float:
