@@ -404,3 +404,16 @@ def test_benchmark_script_tiny_case():
     (row,) = bench.run([3], states=5, repeat=1)
     assert row["q"] == 12 and row["max_rel_diff"] < 1e-12
     assert row["jourdain_g"] > 0 and row["pinocchio"] > 0
+
+
+def test_unbalanced_load_on_a_point_mass_has_no_reactions():
+    """A torque about the hinge axis on a point mass sitting on the axis: nothing can balance it
+    (0 = l_z), so there are no reaction forces; evaluate says so instead of giving numbers."""
+    phi, m = jd.symbols("phi m")
+    body = jd.Body("bead", "world", jd.Revolute("hinge", phi, "z"), mass=m,
+                   inertia=jd.point_mass())
+    s = jd.System([phi], [body], [jd.Torque("drive", "bead", (0, 0, 1.5))], parameters={"m": 1.0})
+    with pytest.raises(jd.EvaluationError, match="no solution"):
+        jd.evaluate_reactions(s, [0.1], [0.0])
+    out = s.evaluate([0.1], [0.0])
+    assert "g" not in out and "no solution" in out["reactions_error"]

@@ -1100,14 +1100,15 @@ def evaluate_keys(system: System, y: Any, yd: Any, t: float, parameters: Any, in
     g_names, g_undetermined``.
 
     A model whose reactions cannot be formed (a joint moved by another joint's coordinate, a
-    symbolic joint axis, constrained directions that do work) still has equations of motion:
-    then the only entry is ``reactions_error``, the message that :func:`reactions` raises, so
-    that no reaction numbers appear for it.
+    symbolic joint axis, constrained directions that do work), or a state where they have no
+    solution (a load on a body without inertia that nothing balances), still has equations of
+    motion: then the only entry is ``reactions_error``, the message that
+    :func:`evaluate_reactions` raises, so that no reaction numbers appear for it.
     """
     try:
         _reactions_function(system)
+        return evaluate_reactions(system, y, yd, t, parameters, inputs, eom=eom)
     except JourdainError as exc:
         return {"reactions_error": str(exc)}
-    return evaluate_reactions(system, y, yd, t, parameters, inputs, eom=eom)
 
 
