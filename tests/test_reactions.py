@@ -40,6 +40,7 @@ def test_pendulum_rod_force_closed_form():
     r = s.reactions()
     assert r.g_names == ("hinge.F_x", "hinge.F_y", "hinge.F_z", "hinge.T_x", "hinge.T_y")
     assert len(r.singular_rows) == 3  # the rotational rows of the point mass
+    assert repr(r).startswith("Reactions(") and "Q_bar 6x5" in repr(r)
     phi, phi_d, m, l, g = sympy.symbols("phi phi_d m l g")
     G = r.g()
     expected = [0, m * l * phi_d**2 + m * g * sympy.cos(phi), 0, 0, 0]

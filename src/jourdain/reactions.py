@@ -424,7 +424,7 @@ def _sample_values(exprs: list[se.Basic], coordinates: Sequence[se.Symbol],
 
 
 # --- the stage ----------------------------------------------------------------------------------
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Reactions:
     """Result of :func:`reactions` (METHOD.md §4).
 
@@ -464,6 +464,12 @@ class Reactions:
     @property
     def system(self) -> System:
         return self.newton_euler.system
+
+    def __repr__(self) -> str:
+        n6, q = self.Q_bar.shape
+        names = ", ".join(self.g_names[:6]) + (", ..." if q > 6 else "")
+        return (f"Reactions({self.system.name!r}: Q_bar {n6}x{q}, g = [{names}], "
+                f"{len(self.singular_rows)} rows without inertia)")
 
     def joint(self, name: str) -> JointReactions:
         """The constrained directions of the joint called ``name``."""
