@@ -325,9 +325,9 @@ def _key1(e: se.Basic) -> tuple:
 
 
 def _node_key(e: se.Basic) -> tuple:
-    """Structural fingerprint of a node over three levels. SymEngine's hash of a sum ignores
-    the coefficients of its terms (x + y and 2x + 2y share it), its children's hashes do not;
-    ``==`` cannot be used, it walks whole trees on distinct but equal nodes of a DAG."""
+    """Structural fingerprint of a node over three levels, the bucket key of
+    :func:`graph_values`. SymEngine's hash of a sum ignores the coefficients of its terms
+    (x + y and 2x + 2y share it), its children's hashes do not."""
     args = e.args
     if not args:
         return (type(e).__name__, hash(e), str(e))
@@ -340,7 +340,9 @@ def graph_values(exprs: Sequence[se.Basic], values: Mapping[se.Basic, Any]) -> l
 
     Nodes are looked up by :func:`_node_key` and confirmed with ``==``, which SymEngine answers
     at once for the same shared node; a fingerprint alone is not exact (two different nodes of
-    a large graph can share it, which gave wrong numbers here).
+    a large graph can share it, which gave wrong numbers here). ``==`` walks whole trees on
+    distinct but equal nodes, so this is meant for the short expressions of single joints; the
+    matrices of whole systems are evaluated by the compiled code of :mod:`jourdain.numeric`.
     """
     given = {k: np.asarray(v, dtype=float) for k, v in values.items()}
 
@@ -479,7 +481,7 @@ class Reactions:
         raise ModelError(f'unknown joint "{name}"; joints are: '
                          f'{", ".join(j.joint.name for j in self.joints)}')
 
-    def g(self, max_unknowns: int = 30, simplify: bool = True) -> Any:
+    def g(self, max_unknowns: int = 16, simplify: bool = True) -> Any:
         """``g`` in closed form, a :class:`sympy.Matrix` (q×1) in y, ẏ, t, parameters, inputs.
 
         Solves ``N̂·g = k̂ − q̂`` (with the rows of bodies without inertia, see the module
