@@ -91,7 +91,9 @@ def _sympy_worker(family: str, n: int, check: bool, out: mp.Queue) -> None:
 
 
 def _sympy_case(family: str, n: int, timeout: float, check: bool) -> dict | None:
-    ctx = mp.get_context("fork")
+    # spawn: a fresh interpreter per case (fork after threads were started can hang, and sympy
+    # would start with the caches of earlier cases)
+    ctx = mp.get_context("spawn")
     queue: mp.Queue = ctx.Queue()
     proc = ctx.Process(target=_sympy_worker, args=(family, n, check, queue))
     proc.start()
