@@ -1,7 +1,7 @@
 """Reaction forces along a motion: jourdain against Pinocchio, in one run.
 
 Model: ``spatial_chain(n)`` (revolute, universal and spherical joints, full inertia tensors) and
-the same chain in Pinocchio (``tests/reference/pinocchio_models.py``). Per state, all joint
+the same chain in Pinocchio (``benchmarks/pinocchio_models.py``). Per state, all joint
 reaction forces:
 
 * jourdain ``evaluate_reactions``: compiled Q̄, N̂, k̂, q̂ and a Cholesky solve of N̂·g = k̂ − q̂
@@ -49,10 +49,10 @@ def run(ns: list[int], states: int = 200, repeat: int = 3, seed: int = 0) -> lis
 def _case(n: int, states: int, repeat: int, rng: np.random.Generator) -> dict:
     import pinocchio as pin
 
-    from tests.reference.pinocchio_models import spatial_chain_model
+    from benchmarks.pinocchio_models import chain_model
 
     system = spatial_chain(n)
-    model = spatial_chain_model(spatial_chain_data(n))
+    model = chain_model(spatial_chain_data(n))
     data = model.createData()
     t0 = time.perf_counter()
     r = reactions(system.newton_euler())

@@ -36,10 +36,18 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import jourdain as jd  # noqa: E402
+from benchmarks.pinocchio_models import chain_model  # noqa: E402
 from jourdain import numeric  # noqa: E402
-from jourdain.models import n_link_pendulum_on_cart, spatial_chain, spatial_chain_data  # noqa: E402
+from jourdain.models import (  # noqa: E402
+    n_link_pendulum_on_cart,
+    robot_arm,
+    robot_arm_data,
+    spatial_chain,
+    spatial_chain_data,
+)
 from jourdain.numeric import toolchain  # noqa: E402
 from jourdain.simulate import integrator_library  # noqa: E402
 
@@ -147,82 +155,13 @@ def bench_pydy(n: int, solver: str, generator: str, params: dict) -> dict:
 
 
 # --- Pinocchio -----------------------------------------------------------------------------------
-ARM_AXES = ("z", "y", "z", "y", "z", "y", "z")
-ARM_OFFSETS = ((0, 0, 0.333), (0, 0, 0.0), (0, 0, 0.316), (0.0825, 0, 0), (-0.0825, 0, 0.384),
-               (0, 0, 0), (0.088, 0, 0.107))
-ARM_MASSES = (4.97, 0.65, 3.23, 3.59, 1.23, 1.67, 0.74)
-
-
-def arm_data() -> list[dict]:
-    """A 7-joint revolute arm with the link lengths and masses of a common research arm and
-    full inertia tensors."""
-    rng = np.random.default_rng(7)
-    out = []
-    for i in range(7):
-        a, b = rng.uniform(0.005, 0.03, 2)
-        c = rng.uniform(abs(a - b) + 0.002, a + b - 0.002)
-        Qm, _ = np.linalg.qr(rng.normal(size=(3, 3)))
-        inertia = Qm @ np.diag([a, b, c]) @ Qm.T
-        out.append({"joint": "revolute", "axes": (ARM_AXES[i],), "mass": ARM_MASSES[i],
-                    "com": np.round(rng.uniform(-0.05, 0.05, 3), 4),
-                    "inertia": 0.5 * (inertia + inertia.T),
-                    "offset": np.array(ARM_OFFSETS[i], dtype=float)})
-    return out
-
-
-def arm_system(data: list[dict]) -> jd.System:
-    import symengine as se
-
-    coords, bodies, params = [], [], {"g": 9.81}
-    comp = "xyz"
-    for i, d in enumerate(data):
-        q = se.Symbol(f"q{i}")
-        coords.append(q)
-        pos = (0, 0, 0) if i == 0 else tuple(se.Symbol(f"d{c}{i - 1}") for c in comp)
-        m = se.Symbol(f"m{i}")
-        com = tuple(se.Symbol(f"c{c}{i}") for c in comp)
-        I = [[se.Symbol(f"I{i}{comp[min(a, b)]}{comp[max(a, b)]}") for b in range(3)]
-             for a in range(3)]
-        bodies.append(jd.Body(f"link{i}", "world" if i == 0 else f"link{i - 1}",
-                              jd.Revolute(f"joint{i}", q, d["axes"][0], position=pos), mass=m,
-                              com=com, inertia=I))
-        params[f"m{i}"] = float(d["mass"])
-        for a in range(3):
-            params[f"c{comp[a]}{i}"] = float(d["com"][a])
-            params[f"d{comp[a]}{i}"] = float(d["offset"][a])
-            for b in range(a, 3):
-                params[f"I{i}{comp[a]}{comp[b]}"] = float(d["inertia"][a, b])
-    return jd.System(coords, bodies, [jd.Gravity((0, 0, -se.Symbol("g")))], parameters=params,
-                     name="7-joint arm")
-
-
-def pinocchio_model(data: list[dict]):
-    import pinocchio as pin
-
-    axis = {"x": pin.JointModelRX, "y": pin.JointModelRY, "z": pin.JointModelRZ}
-    model = pin.Model()
-    parent = 0
-    offset = np.zeros(3)
-    for i, d in enumerate(data):
-        seq = {"revolute": list(d["axes"][:1]), "universal": list(d["axes"]),
-               "spherical": ["x", "y", "z"]}[d["joint"]]
-        for k, a in enumerate(seq):
-            placement = pin.SE3(np.eye(3), offset) if k == 0 else pin.SE3.Identity()
-            parent = model.addJoint(parent, axis[a](), placement, f"joint{i}_{k}")
-        model.appendBodyToJoint(parent, pin.Inertia(float(d["mass"]), np.asarray(d["com"]),
-                                                    np.asarray(d["inertia"])), pin.SE3.Identity())
-        offset = np.asarray(d["offset"], dtype=float)
-    model.gravity.linear = np.array([0.0, 0.0, -9.81])
-    return model
-
-
 def bench_batched(name: str, system: jd.System, data: list[dict], n_states: int = 2000,
                   rounds: int = 15) -> dict:
     import pinocchio as pin
 
     eom = system.equations_of_motion()
     fn = numeric.lambdify(system, {"M": eom.M, "k": eom.k, "q": eom.q})
-    model = pinocchio_model(data)
+    model = chain_model(data)
     pdata = model.createData()
     rng = np.random.default_rng(1)
     Y = rng.uniform(-math.pi, math.pi, (n_states, system.f))
@@ -335,8 +274,7 @@ def main(argv: list[str] | None = None) -> dict:
             print(f"{'model':<22} {'f':>3} {'batch us/state':>15} {'single call us':>15} "
                   f"{'pinocchio us':>13} {'ratio':>7} {'max diff':>9}")
             cases = [("spatial_chain(6)", spatial_chain(6), spatial_chain_data(6))]
-            ad = arm_data()
-            cases.append(("7-joint arm", arm_system(ad), ad))
+            cases.append(("7-joint arm", robot_arm(), robot_arm_data()))
             for name, system, data in cases:
                 b = bench_batched(name, system, data, rounds=args.rounds)
                 ratio = b["pinocchio_per_call"] / b["batch_per_state"]

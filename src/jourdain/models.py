@@ -139,7 +139,44 @@ def spatial_chain(n: int, seed: int = 0) -> System:
     parameters whose default values come from :func:`spatial_chain_data` (so a peer tool can be
     built from the same numbers). Coordinates ``q0, q1, …`` in joint order.
     """
-    data = spatial_chain_data(n, seed)
+    return chain_from_data(spatial_chain_data(n, seed), name=f"spatial chain of {n} bodies")
+
+
+#: the 7-joint arm of :func:`robot_arm`: joint axes, joint offsets (m) and link masses (kg) of a
+#: common research arm
+ARM_AXES = ("z", "y", "z", "y", "z", "y", "z")
+ARM_OFFSETS = ((0, 0, 0.333), (0, 0, 0.0), (0, 0, 0.316), (0.0825, 0, 0), (-0.0825, 0, 0.384),
+               (0, 0, 0), (0.088, 0, 0.107))
+ARM_MASSES = (4.97, 0.65, 3.23, 3.59, 1.23, 1.67, 0.74)
+
+
+def robot_arm_data(seed: int = 7) -> list[dict]:
+    """Numeric data of :func:`robot_arm`, in the form of :func:`spatial_chain_data`: link
+    lengths and masses of a common 7-joint research arm, full inertia tensors drawn at random."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for i in range(7):
+        a, b = rng.uniform(0.005, 0.03, 2)
+        c = rng.uniform(abs(a - b) + 0.002, a + b - 0.002)
+        Qm, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+        inertia = Qm @ np.diag([a, b, c]) @ Qm.T
+        out.append({"joint": "revolute", "axes": (ARM_AXES[i],), "mass": ARM_MASSES[i],
+                    "com": np.round(rng.uniform(-0.05, 0.05, 3), 4),
+                    "inertia": 0.5 * (inertia + inertia.T),
+                    "offset": np.array(ARM_OFFSETS[i], dtype=float)})
+    return out
+
+
+def robot_arm(seed: int = 7) -> System:
+    """A 7-joint revolute arm (axes z-y-z-y-z-y-z) under gravity, built by
+    :func:`chain_from_data` from :func:`robot_arm_data`."""
+    return chain_from_data(robot_arm_data(seed), name="7-joint arm")
+
+
+def chain_from_data(data: list[dict], name: str = "chain") -> System:
+    """A serial chain from numeric data in the form of :func:`spatial_chain_data` (one dict per
+    body: ``joint``, ``axes``, ``mass``, ``com``, ``inertia``, ``offset``), with every number a
+    named parameter (``m{i}``, ``cx{i}``, ``I{i}xy``, ``dx{i}``, ...; gravity ``g`` along -z)."""
     coords: list[se.Symbol] = []
     bodies = []
     params: dict[str, float] = {"g": 9.81}
@@ -149,13 +186,13 @@ def spatial_chain(n: int, seed: int = 0) -> System:
         qs = [se.Symbol(f"q{len(coords) + k}") for k in range(nq)]
         coords.extend(qs)
         pos = (0, 0, 0) if i == 0 else tuple(se.Symbol(f"d{c}{i - 1}") for c in comp)
-        name = f"joint{i}"
+        jname = f"joint{i}"
         if d["joint"] == "revolute":
-            joint = Revolute(name, qs[0], d["axes"][0], position=pos)
+            joint = Revolute(jname, qs[0], d["axes"][0], position=pos)
         elif d["joint"] == "universal":
-            joint = Universal(name, qs, d["axes"], position=pos)
+            joint = Universal(jname, qs, d["axes"], position=pos)
         else:
-            joint = Spherical(name, qs, "xyz", position=pos)
+            joint = Spherical(jname, qs, "xyz", position=pos)
         m = se.Symbol(f"m{i}")
         com = tuple(se.Symbol(f"c{c}{i}") for c in comp)
         I = [[se.Symbol(f"I{i}{comp[min(a, b)]}{comp[max(a, b)]}") for b in range(3)]
@@ -169,5 +206,4 @@ def spatial_chain(n: int, seed: int = 0) -> System:
             for b in range(a, 3):
                 params[f"I{i}{comp[a]}{comp[b]}"] = float(d["inertia"][a, b])
     g = se.Symbol("g")
-    return System(coords, bodies, [Gravity((0, 0, -g))], parameters=params,
-                  name=f"spatial chain of {n} bodies")
+    return System(coords, bodies, [Gravity((0, 0, -g))], parameters=params, name=name)

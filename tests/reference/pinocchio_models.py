@@ -1,28 +1,12 @@
-"""Pinocchio models built from the same numbers as jourdain's sample models."""
+"""Pinocchio models for the reference tests (skipped where Pinocchio is not installed)."""
 
-from __future__ import annotations
+import pytest
 
-import numpy as np
+pin = pytest.importorskip("pinocchio")
 
-pin = __import__("pytest").importorskip("pinocchio")
+from benchmarks.pinocchio_models import chain_model  # noqa: E402
 
-_AXIS = {"x": pin.JointModelRX, "y": pin.JointModelRY, "z": pin.JointModelRZ}
+#: the Pinocchio model of jourdain.models.spatial_chain(n) from spatial_chain_data(n)
+spatial_chain_model = chain_model
 
-
-def spatial_chain_model(data: list[dict]):
-    """Pinocchio model of jourdain.models.spatial_chain: each jourdain joint becomes one
-    Pinocchio revolute joint per elementary rotation (universal: 2, spherical Cardan xyz: 3)."""
-    model = pin.Model()
-    parent = 0
-    offset = np.zeros(3)
-    for i, d in enumerate(data):
-        seq = {"revolute": list(d["axes"][:1]), "universal": list(d["axes"]),
-               "spherical": ["x", "y", "z"]}[d["joint"]]
-        for k, a in enumerate(seq):
-            placement = pin.SE3(np.eye(3), offset) if k == 0 else pin.SE3.Identity()
-            parent = model.addJoint(parent, _AXIS[a](), placement, f"joint{i}_{k}")
-        model.appendBodyToJoint(parent, pin.Inertia(d["mass"], np.asarray(d["com"]),
-                                                    np.asarray(d["inertia"])), pin.SE3.Identity())
-        offset = np.asarray(d["offset"], dtype=float)
-    model.gravity.linear = np.array([0.0, 0.0, -9.81])
-    return model
+__all__ = ["chain_model", "pin", "spatial_chain_model"]
