@@ -260,15 +260,21 @@ def _generalized_force(acc: _Accumulator, sys: System, fe: GeneralizedForce) -> 
     )
 
 
-def joint_child_origin(joint: Joint) -> Vec3:
-    """Origin of the child body frame in the parent's body frame."""
+def joint_transform(joint: Joint) -> tuple[Mat3, Vec3]:
+    """(R, p): the child body frame's axes and origin in the parent's body frame
+    (x_parent = p + R·x_child), from the joint's position, orientation and steps."""
     R, pvec = joint.orientation, joint.position
     for s in joint.steps:
         if isinstance(s, Rot):
             R = _mm(R, rotation_matrix(s.axis, s.angle))
         else:
             pvec = _add(pvec, _mv(R, s.vector))
-    return pvec
+    return R, pvec
+
+
+def joint_child_origin(joint: Joint) -> Vec3:
+    """Origin of the child body frame in the parent's body frame."""
+    return joint_transform(joint)[1]
 
 
 _ = Trans  # re-exported type used in annotations elsewhere

@@ -51,7 +51,7 @@ from .errors import EvaluationError, JourdainError, ModelError
 from .kinematics import Z3, _add, _cross, _dot, _mm, _mtv, _mv, _scale
 from .model.bodies import WORLD
 from .model.joints import IDENTITY, Joint, Mat3, Rot, Vec3, rotation_matrix
-from .newton_euler import NewtonEuler
+from .newton_euler import NewtonEuler, joint_transform
 from .symbolic import SymMatrix
 
 if TYPE_CHECKING:
@@ -115,17 +115,6 @@ def _perpendicular(u: Vec3, joint: Joint, what: str) -> list[tuple[str, Vec3]]:
 
 def _wrench(F: Vec3 = Z3, T: Vec3 = Z3) -> Wrench:
     return (*F, *T)  # type: ignore[return-value]
-
-
-def _joint_rotation(joint: Joint) -> tuple[Mat3, Vec3]:
-    """(R_pc, o_pc): child frame → parent frame rotation and the child origin in the parent."""
-    R, p = joint.orientation, joint.position
-    for s in joint.steps:
-        if isinstance(s, Rot):
-            R = _mm(R, rotation_matrix(s.axis, s.angle))
-        else:
-            p = _add(p, _mv(R, s.vector))
-    return R, p
 
 
 def relative_twist(joint: Joint, coordinates: Sequence[se.Symbol]) -> list[tuple[Vec3, Vec3]]:
@@ -635,7 +624,7 @@ def reactions(ne: NewtonEuler) -> Reactions:
         j = body.joint
         dirs = constrained_directions(j, system.coordinates, params)
         S = bk.S.rows
-        R_pc, o_pc = _joint_rotation(j)
+        R_pc, o_pc = joint_transform(j)
         c_c = body.com
         i = row[body.name]
         parent = None if body.parent == WORLD else system.body(body.parent)
