@@ -27,9 +27,10 @@ from __future__ import annotations
 
 import gc
 import math
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import symengine as se
@@ -159,6 +160,27 @@ def _no_gc() -> Iterator[None]:
             gc.enable()
 
 
+def _needed(g: Graph, value: Mapping[int, Any], mask: list[bool], atom_keys: set[int],
+            is_zero: Callable[[Any], bool]) -> set[int]:
+    """Nodes whose gradient is needed, top-down (reverse post-order): the masked roots and their
+    descendants, except through a product with two factors that vanish at the point (its
+    gradient is zero) or, with one vanishing factor, through the other factors."""
+    need: set[int] = {k for k, m in zip(g.roots, mask, strict=True) if m} - atom_keys
+    for k in reversed(g.order):
+        if k not in need:
+            continue
+        kids = g.children[k]
+        if g.kind[k] == "Mul":
+            zeros = [c for c in kids if is_zero(value[c])]
+            if len(zeros) >= 2:
+                continue
+            if len(zeros) == 1:
+                need.add(zeros[0])
+                continue
+        need.update(kids)
+    return need
+
+
 def jet(exprs: Sequence[Expr], variables: Sequence[se.Symbol],
         point: Mapping[se.Symbol, Expr], differentiate: Sequence[bool] | None = None) -> Jet:
     """Values and first derivatives of ``exprs`` with respect to ``variables`` at ``point``.
@@ -220,19 +242,7 @@ def _jet(exprs: list[Expr], variables: Sequence[se.Symbol], point: Mapping[se.Sy
 
     # 2. which nodes need a gradient, top-down (reverse post-order): a factor of a product
     #    whose other factors vanish at the point contributes nothing
-    need: set[int] = {k for k, m in zip(g.roots, mask, strict=True) if m} - atom_keys
-    for k in reversed(g.order):
-        if k not in need:
-            continue
-        kids = g.children[k]
-        if type(g.node[k]).__name__ == "Mul":
-            zeros = [c for c in kids if _is_zero(value[c])]
-            if len(zeros) >= 2:
-                continue
-            if len(zeros) == 1:
-                need.add(zeros[0])
-                continue
-        need.update(kids)
+    need = _needed(g, value, mask, atom_keys, _is_zero)
 
     # 3. gradients of the needed nodes, bottom-up
     for k in g.order:
@@ -489,19 +499,7 @@ def _jet_float(g: Graph, variables: Sequence[se.Symbol], values: Mapping[str, fl
     atom_keys = set(g.atoms)
 
     # nodes that need a gradient (a product with two vanishing factors needs none)
-    need: set[int] = {k for k, m in zip(g.roots, mask, strict=True) if m} - atom_keys
-    for k in reversed(g.order):
-        if k not in need:
-            continue
-        kids = g.children[k]
-        if g.kind[k] == "Mul":
-            zeros = [c for c in kids if value[c] == 0.0]
-            if len(zeros) >= 2:
-                continue
-            if len(zeros) == 1:
-                need.add(zeros[0])
-                continue
-        need.update(kids)
+    need = _needed(g, value, mask, atom_keys, lambda v: v == 0.0)
 
     # gradients (None: does not depend on the variables)
     prod = math.prod

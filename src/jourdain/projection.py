@@ -123,15 +123,9 @@ def projection(ne: NewtonEuler) -> EquationsOfMotion:
             q_terms[j].append(dots.with_pieces(cj, weights))  # one inertial piece each
         for cj, vecs in force_of_col[j].values():
             q_terms[j].append(_dot(cj, _sum(vecs)))
-    M = [[ZERO] * f for _ in range(f)]
-    for j in range(f):
-        for kk in range(j, f):
-            e = se.Add(*M_terms[j][kk]) if M_terms[j][kk] else ZERO
-            M[j][kk] = e
-            M[kk][j] = e
     k = [se.Add(*ts) if ts else ZERO for ts in k_terms]
     q = [se.Add(*ts) if ts else ZERO for ts in q_terms]
-    return EquationsOfMotion(ne, SymMatrix.from_rows(M), SymMatrix.column(k), SymMatrix.column(q))
+    return EquationsOfMotion(ne, SymMatrix.symmetric_from_terms(M_terms), SymMatrix.column(k), SymMatrix.column(q))
 
 
 def _difference(a: se.Basic, b: se.Basic) -> se.Basic:

@@ -696,14 +696,8 @@ def reactions(ne: NewtonEuler) -> Reactions:
                     kh[ca].append(se.Add(*(x * y for x, y in zip(mv[ca], cvec, strict=True))))
                 if any(x != 0 for x in evec):
                     qh[ca].append(se.Add(*(x * y for x, y in zip(mv[ca], evec, strict=True))))
-    N_rows = [[ZERO] * q for _ in range(q)]
-    for a in range(q):
-        for b in range(a, q):
-            e = se.Add(*N[a][b]) if N[a][b] else ZERO
-            N_rows[a][b] = e
-            N_rows[b][a] = e
     return Reactions(
-        newton_euler=ne, Q_bar=Q_bar, N_hat=SymMatrix.from_rows(N_rows),
+        newton_euler=ne, Q_bar=Q_bar, N_hat=SymMatrix.symmetric_from_terms(N),
         k_hat=SymMatrix.column([se.Add(*t) if t else ZERO for t in kh]),
         q_hat=SymMatrix.column([se.Add(*t) if t else ZERO for t in qh]),
         g_names=tuple(names), joints=tuple(joints), singular_rows=singular,

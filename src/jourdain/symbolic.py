@@ -35,6 +35,19 @@ class SymMatrix:
         return cls(tuple((e,) for e in entries))
 
     @classmethod
+    def symmetric_from_terms(cls, terms: Sequence[Sequence[Sequence[Expr]]]) -> SymMatrix:
+        """An exactly symmetric n×n matrix whose entry (i, j), i ≤ j, is the sum of
+        ``terms[i][j]`` (the lower triangle of ``terms`` is not read)."""
+        n = len(terms)
+        zero = se.Integer(0)
+        rows = [[zero] * n for _ in range(n)]
+        for i in range(n):
+            for j in range(i, n):
+                e = se.Add(*terms[i][j]) if terms[i][j] else zero
+                rows[i][j] = rows[j][i] = e
+        return cls.from_rows(rows)
+
+    @classmethod
     def zeros(cls, n: int, m: int) -> SymMatrix:
         z = se.Integer(0)
         return cls(tuple((z,) * m for _ in range(n)))
