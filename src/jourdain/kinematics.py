@@ -155,9 +155,6 @@ def _mtm(A: Mat3, B: Mat3) -> Mat3:
 class _Frame:
     """State of a moving frame during the recursion (mutable scratch, never returned)."""
 
-    S: Mat3 = IDENTITY
-    identity: bool = True
-    axis: tuple[Vec3, se.Basic] | None = None  # all rotations so far about this fixed axis
     r: Vec3 = Z3
     JT: dict[int, Vec3] = field(default_factory=dict)
     v_bar: Vec3 = Z3
@@ -168,12 +165,20 @@ class _Frame:
     alpha_bar: Vec3 = Z3
     # a_bar as the sum of its pieces S_k·v_k: ((tag of frame k, v_k), ...)
     a_pieces: tuple = ()
+    # the orientation: S, and the single axis when all rotations so far are about one
     tag: FrameTag = ROOT
 
+    @property
+    def S(self) -> Mat3:
+        return self.tag.S
+
+    @property
+    def identity(self) -> bool:
+        return self.tag is ROOT
+
     def copy(self) -> _Frame:
-        return _Frame(self.S, self.identity, self.axis, self.r, dict(self.JT), self.v_bar,
-                      self.a_bar, dict(self.JR), self.omega, self.omega_bar, self.alpha_bar,
-                      self.a_pieces, self.tag)
+        return _Frame(self.r, dict(self.JT), self.v_bar, self.a_bar, dict(self.JR), self.omega,
+                      self.omega_bar, self.alpha_bar, self.a_pieces, self.tag)
 
 
 class _Rates:
@@ -226,15 +231,15 @@ def _rotate(F: _Frame, u: Vec3, angle: se.Basic, ctx: _Context) -> None:
     rt = _Rates(angle, ctx)
     A = rotation_matrix(u, angle)
     # orientation, merging rotations about one fixed axis into a single angle
+    axis = F.tag.axis
     if F.identity:
-        F.S, F.axis = A, (u, angle)
-    elif F.axis is not None and F.axis[0] == u:
-        theta = F.axis[1] + angle
-        F.S, F.axis = rotation_matrix(u, theta), (u, theta)
+        S, axis = A, (u, angle)
+    elif axis is not None and axis[0] == u:
+        theta = axis[1] + angle
+        S, axis = rotation_matrix(u, theta), (u, theta)
     else:
-        F.S, F.axis = _mm(F.S, A), None
-    F.identity = False
-    F.tag = FrameTag(F.tag, A, F.S, F.axis)
+        S, axis = _mm(F.S, A), None
+    F.tag = FrameTag(F.tag, A, S, axis)
     # angular velocity and acceleration in the new frame: ω' = Aᵀ(ω + u·θ̇)
     keys = set(F.JR) | set(rt.dy)
     F.JR = {
@@ -251,9 +256,7 @@ def _reorient(F: _Frame, R0: Mat3) -> None:
     """Apply a constant change of axes R0 (new axes in current-frame components)."""
     if R0 == IDENTITY:
         return
-    F.S = R0 if F.identity else _mm(F.S, R0)
-    F.identity, F.axis = False, None
-    F.tag = FrameTag(F.tag, R0, F.S, None)
+    F.tag = FrameTag(F.tag, R0, R0 if F.identity else _mm(F.S, R0), None)
     F.JR = {j: _mtv(R0, c) for j, c in F.JR.items()}
     F.omega, F.omega_bar, F.alpha_bar = (_mtv(R0, F.omega), _mtv(R0, F.omega_bar),
                                          _mtv(R0, F.alpha_bar))

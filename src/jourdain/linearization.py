@@ -190,9 +190,9 @@ class Linearization:
         expression graph once in floating point (no compilation); for many evaluations use
         :meth:`compile`.
         """
-        from .numeric import parameter_vector
+        from .numeric import parameter_vector, time_value
 
-        tv = _time(t)
+        tv = time_value(t)
         p = parameter_vector(self.system, parameters)
         values = {str(s): float(v) for s, v in zip(self.system.parameter_symbols, p, strict=True)}
         values["t"] = tv
@@ -259,12 +259,12 @@ class CompiledLinearization:
 
     def __call__(self, t: float = 0.0,
                  parameters: Mapping[str, float] | None = None) -> dict[str, np.ndarray]:
-        from .numeric import parameter_vector
+        from .numeric import parameter_vector, time_value
 
         system = self.linearization.system
         p = parameter_vector(system, parameters)
         f = system.f
-        out = self.function(np.zeros(f), np.zeros(f), _time(t), p, np.zeros(len(system.inputs)))
+        out = self.function(np.zeros(f), np.zeros(f), time_value(t), p, np.zeros(len(system.inputs)))
         return self.linearization._finish(dict(out))
 
 
@@ -459,15 +459,6 @@ def _describe_nominal(lin: Linearization) -> str:
     return text if len(text) < 120 else text[:117] + "..."
 
 
-def _time(t: float) -> float:
-    try:
-        tv = float(t)
-    except (TypeError, ValueError):
-        raise EvaluationError(f"t must be a number, got {t!r}") from None
-    if not np.isfinite(tv):
-        raise EvaluationError(f"t = {t!r} is not finite")
-    return tv
-
 
 @dataclass(frozen=True)
 class NumericLinearization:
@@ -549,12 +540,12 @@ def linearize_numeric(source: System | EquationsOfMotion, nominal: Mapping[Any, 
     matrices: the way to eigenvalues of large systems (a spatial chain of 16 bodies in well
     under a second, derivation included).
     """
-    from .numeric import parameter_vector
+    from .numeric import parameter_vector, time_value
     from .projection import EquationsOfMotion
 
     eom = source if isinstance(source, EquationsOfMotion) else source.equations_of_motion()
     system = eom.system
-    tv = _time(t)
+    tv = time_value(t)
     y_s, u_s = _nominal(system, nominal)
     ts = system.t
     yd_s = [se.diff(e, ts) for e in y_s]

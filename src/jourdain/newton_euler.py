@@ -17,7 +17,7 @@ from .errors import ModelError
 from .kinematics import Z3, BodyKinematics, Kinematics, _add, _cross, _dot, _mm, _mtv, _mv, _scale
 from .model.bodies import WORLD, Body
 from .model.forces import Force, GeneralizedForce, Gravity, SpringDamper, Torque
-from .model.joints import IDENTITY, Joint, Mat3, Rot, Trans, Vec3, rotation_matrix
+from .model.joints import IDENTITY, Joint, Mat3, Rot, Vec3, rotation_matrix
 from .symbolic import SymMatrix
 
 if TYPE_CHECKING:
@@ -121,8 +121,7 @@ class _Accumulator:
     def __init__(self, kin: Kinematics) -> None:
         self.kin = kin
         self.sys = kin.system
-        self.f: dict[str, list[se.Basic]] = {b.name: [] for b in self.sys.bodies}
-        self.f = {b.name: [[], [], []] for b in self.sys.bodies}  # type: ignore[misc]
+        self.f: dict[str, list[list[se.Basic]]] = {b.name: [[], [], []] for b in self.sys.bodies}
         self.l = {b.name: [[], [], []] for b in self.sys.bodies}
         self.gravity: Vec3 = Z3
 
@@ -276,5 +275,3 @@ def joint_child_origin(joint: Joint) -> Vec3:
     """Origin of the child body frame in the parent's body frame."""
     return joint_transform(joint)[1]
 
-
-_ = Trans  # re-exported type used in annotations elsewhere

@@ -77,7 +77,7 @@ def projection(ne: NewtonEuler) -> EquationsOfMotion:
         ma = ([(o, v, m) for o, v in bk.a_bar_pieces],
               _scale((bk.a_bar.rows[0][0], bk.a_bar.rows[1][0], bk.a_bar.rows[2][0]), m))
         keys = sorted(T)
-        hT = {j: _h(c) for j, c in T.items()}
+        hT = {j: id(c) for j, c in T.items()}
         f_nonzero = any(x != 0 for x in bf.f_other)
         g_nonzero = any(x != 0 for x in bf.gravity)
         for ii, j in enumerate(keys):
@@ -187,10 +187,6 @@ class _Dots:
         if inertial is not None:
             return _dot(c, inertial)
         return _dot(c, _sum([v if tag is ROOT else _mv(tag.S, v) for tag, v in summed]))
-
-
-def _h(v: tuple) -> int:
-    return id(v)
 
 
 def _sum(vecs: list) -> tuple:

@@ -292,8 +292,6 @@ def _validate(sys: System) -> None:
             raise ModelError(
                 f'duplicate joint name "{j.name}" (bodies "{joint_names[j.name]}" and "{b.name}")'
             )
-        if j.name in {bb.name for bb in sys.bodies} and j.name != b.name:
-            pass  # a joint may share a name with its own body only
         joint_names[j.name] = b.name
         for c in j.coordinates:
             cn = str(c)

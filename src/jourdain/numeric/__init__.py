@@ -351,12 +351,7 @@ def state_vectors(system: System, y: Any, yd: Any, t: float,
     f = system.f
     yv = _vector(y, f, "y", system.coordinate_names)
     ydv = _vector(yd, f, "yd", [f"{n}_d" for n in system.coordinate_names])
-    try:
-        tv = float(t)
-    except (TypeError, ValueError):
-        raise EvaluationError(f"t must be a number, got {t!r}") from None
-    if not math.isfinite(tv):
-        raise EvaluationError(f"t = {t!r} is not finite")
+    tv = time_value(t)
     pv = parameter_vector(system, parameters)
     names = system.input_names
     if inputs is None:
@@ -376,6 +371,17 @@ def state_vectors(system: System, y: Any, yd: Any, t: float,
     if not np.all(np.isfinite(uv)):
         raise EvaluationError(f"inputs contain NaN or inf: {dict(zip(names, uv, strict=True))}")
     return yv, ydv, tv, pv, uv
+
+
+def time_value(t: Any) -> float:
+    """``t`` as a finite float (EvaluationError otherwise)."""
+    try:
+        tv = float(t)
+    except (TypeError, ValueError):
+        raise EvaluationError(f"t must be a number, got {t!r}") from None
+    if not math.isfinite(tv):
+        raise EvaluationError(f"t = {t!r} is not finite")
+    return tv
 
 
 def parameter_vector(system: System, parameters: Mapping[str, float] | None) -> np.ndarray:
