@@ -65,17 +65,20 @@ class NodeIds:
     def __init__(self) -> None:
         self._alive: list[Expr] = []
         self._by_hash: dict[int, list[tuple[Expr, int]]] = {}
+        self._count = 0
 
     def __call__(self, e: Expr) -> int:
         self._alive.append(e)
         if POINTERS:
             return _pointer(e)
-        h = hash(e)
-        bucket = self._by_hash.setdefault(h, [])
+        # fallback: the hash only picks the bucket, == decides, and the identity is a serial
+        # number (never arithmetic on the hash: different nodes could then share a key)
+        bucket = self._by_hash.setdefault(hash(e), [])
         for known, key in bucket:
             if known == e:
                 return key
-        key = (h << 8) + len(bucket)
+        key = self._count
+        self._count += 1
         bucket.append((e, key))
         return key
 

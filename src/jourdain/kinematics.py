@@ -29,6 +29,7 @@ from typing import TYPE_CHECKING
 
 import symengine as se
 
+from .identity import IdentityMap
 from .model.forces import acceleration, rate
 from .model.joints import IDENTITY, Mat3, Rot, Trans, Vec3, rotation_matrix
 from .symbolic import SymMatrix
@@ -220,8 +221,8 @@ class _Context:
     index: dict[se.Symbol, int]
     yd: tuple[se.Symbol, ...]
     t: se.Symbol
-    # columns of J_T as sums of rotated local vectors S_k·v_k: id(col) -> (col, ((tag, v), ...))
-    pieces: dict[int, tuple] = field(default_factory=dict)
+    # columns of J_T as sums of rotated local vectors S_k·v_k: col -> ((tag, v), ...)
+    pieces: IdentityMap[tuple] = field(default_factory=IdentityMap)
 
 
 def _rotate(F: _Frame, u: Vec3, angle: se.Basic, ctx: _Context) -> None:
@@ -296,11 +297,11 @@ def _translate(F: _Frame, d: Vec3, ctx: _Context) -> None:
             col, pieces = toI(local), ((F.tag, local),)
         else:
             col = _add(old, toI(local))
-            rec = ctx.pieces.get(id(old))
-            pieces = None if rec is None or rec[0] is not old else _append(rec[1], F.tag, local)
+            rec = ctx.pieces.get(old)
+            pieces = None if rec is None else _append(rec, F.tag, local)
         newJT[j] = col
         if pieces is not None:
-            ctx.pieces[id(col)] = (col, pieces)
+            ctx.pieces[col] = pieces
     F.JT = newJT
     d_t: Vec3 = tuple(rt.dt for rt in rates)  # type: ignore[assignment]
     d_1: Vec3 = tuple(rt.d1 for rt in rates)  # type: ignore[assignment]
@@ -385,9 +386,9 @@ class Kinematics:
     yd: tuple[se.Symbol, ...]
     ydd: tuple[se.Symbol, ...]
     t: se.Symbol
-    #: columns of J_T as sums of rotated local vectors: id(col) -> (col, ((FrameTag, v), ...))
-    column_pieces: MappingProxyType = field(default_factory=lambda: MappingProxyType({}),
-                                           repr=False, compare=False)
+    #: columns of J_T as sums of rotated local vectors: col -> ((FrameTag, v), ...), by identity
+    column_pieces: IdentityMap[tuple] = field(default_factory=IdentityMap, repr=False,
+                                              compare=False)
 
     def __getitem__(self, name: str) -> BodyKinematics:
         for b in self.bodies:
@@ -437,4 +438,4 @@ def kinematics(system: System) -> Kinematics:
             cols_T_O=MappingProxyType(F.JT), a_bar_pieces=C.a_pieces,
         ))
     return Kinematics(system, tuple(out), y, ctx.yd, tuple(acceleration(c) for c in y), system.t,
-                      MappingProxyType(ctx.pieces))
+                      ctx.pieces)

@@ -10,11 +10,11 @@ exactly symmetric.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from dataclasses import dataclass
 
 import symengine as se
 
+from .identity import IdentityMap
 from .kinematics import ROOT, FrameTag, _add, _cross, _dot, _mv, _scale, relative_rotation
 from .model.joints import Mat3
 from .newton_euler import NewtonEuler
@@ -61,13 +61,13 @@ def projection(ne: NewtonEuler) -> EquationsOfMotion:
     system = kin.system
     f = len(kin.y)
     # translational part: group bodies by identical Jacobian columns
-    # Bodies down a chain inherit the very same column tuples from their parents, so groups are
-    # keyed by object identity: exact and O(1), where == on deep expressions may walk whole trees
-    # and SymEngine's hash confuses x + y with -x - y. The stored column keeps the id valid.
-    mass_of_pair: dict[tuple[int, int], dict[tuple, tuple[tuple, tuple, list]]] = {}
-    force_of_col: list[dict[tuple, tuple[tuple, list]]] = [dict() for _ in range(f)]
-    gyro_of_col: list[dict[tuple, tuple[tuple, list]]] = [dict() for _ in range(f)]
-    weight_of_col: list[dict[tuple, tuple[tuple, list]]] = [dict() for _ in range(f)]
+    # Bodies down a chain inherit the very same column objects from their parents, so groups are
+    # keyed by object identity (jourdain.identity): exact and O(1), where == on deep expressions
+    # may walk whole trees and SymEngine's hash confuses x + y with -x - y.
+    mass_of_pair: dict[tuple[int, int], IdentityMap[tuple[tuple, tuple, list]]] = {}
+    force_of_col: list[IdentityMap[tuple[tuple, list]]] = [IdentityMap() for _ in range(f)]
+    gyro_of_col: list[IdentityMap[tuple[tuple, list]]] = [IdentityMap() for _ in range(f)]
+    weight_of_col: list[IdentityMap[tuple[tuple, list]]] = [IdentityMap() for _ in range(f)]
     M_terms: list[list[list[se.Basic]]] = [[[] for _ in range(f)] for _ in range(f)]
     k_terms: list[list[se.Basic]] = [[] for _ in range(f)]
     q_terms: list[list[se.Basic]] = [[] for _ in range(f)]
@@ -77,20 +77,20 @@ def projection(ne: NewtonEuler) -> EquationsOfMotion:
         ma = ([(o, v, m) for o, v in bk.a_bar_pieces],
               _scale((bk.a_bar.rows[0][0], bk.a_bar.rows[1][0], bk.a_bar.rows[2][0]), m))
         keys = sorted(T)
-        hT = {j: id(c) for j, c in T.items()}
         f_nonzero = any(x != 0 for x in bf.f_other)
         g_nonzero = any(x != 0 for x in bf.gravity)
         for ii, j in enumerate(keys):
             cj = T[j]
             if m != 0:
                 for kk in keys[ii:]:
-                    mass_of_pair.setdefault((j, kk), {}).setdefault(
-                        hT[j] + hT[kk], (cj, T[kk], []))[2].append(m)
-                gyro_of_col[j].setdefault(hT[j], (cj, []))[1].append(ma)
+                    ck = T[kk]
+                    mass_of_pair.setdefault((j, kk), IdentityMap()).setdefault(
+                        (*cj, *ck), (cj, ck, []))[2].append(m)
+                gyro_of_col[j].setdefault(cj, (cj, []))[1].append(ma)
                 if g_nonzero:
-                    weight_of_col[j].setdefault(hT[j], (cj, []))[1].append((ROOT, bf.gravity, m))
+                    weight_of_col[j].setdefault(cj, (cj, []))[1].append((ROOT, bf.gravity, m))
             if f_nonzero:
-                force_of_col[j].setdefault(hT[j], (cj, []))[1].append(bf.f_other)
+                force_of_col[j].setdefault(cj, (cj, []))[1].append(bf.f_other)
         # rotational part
         R = bk.cols_R
         has_I = body.has_inertia
@@ -143,19 +143,15 @@ PIECE_PAIRS = 4
 class _Dots:
     """Dot products of vectors known as sums of pieces S_k·v_k (kinematics.FrameTag)."""
 
-    def __init__(self, pieces: Mapping[int, tuple]) -> None:
+    def __init__(self, pieces: IdentityMap[tuple]) -> None:
         self.pieces = pieces
-        self.R: dict[tuple[int, int], Mat3 | None] = {}
+        self.R: IdentityMap[Mat3 | None] = IdentityMap()
 
     def of(self, c: tuple) -> tuple | None:
-        rec = self.pieces.get(id(c))
-        return rec[1] if rec is not None and rec[0] is c else None
+        return self.pieces.get(c)
 
     def rel(self, a: FrameTag, b: FrameTag) -> Mat3 | None:
-        key = (id(a), id(b))
-        if key not in self.R:
-            self.R[key] = relative_rotation(a, b)
-        return self.R[key]
+        return self.R.get_or_make((a, b), lambda: relative_rotation(a, b))
 
     def local(self, pa: tuple, pb: list) -> se.Basic:
         terms = []
@@ -176,9 +172,9 @@ class _Dots:
         """c·Σ m_i S_k·v_k after adding the pieces of each frame, and the masses of bodies that
         share a piece (inherited from a common ancestor), so terms of one frame cancel first.
         ``inertial``: the same sum in inertial components, when known, for long sums."""
-        by_frame: dict = {}
+        by_frame: IdentityMap[list] = IdentityMap()
         for tag, v, m in pieces:
-            by_frame.setdefault(id(tag), [tag, {}])[1].setdefault(id(v), (v, []))[1].append(m)
+            by_frame.setdefault(tag, [tag, IdentityMap()])[1].setdefault(v, (v, []))[1].append(m)
         summed = [(tag, _sum([_scale(v, se.Add(*ms)) for v, ms in shared.values()]))
                   for tag, shared in by_frame.values()]
         pc = self.of(c)
