@@ -439,3 +439,48 @@ def kinematics(system: System) -> Kinematics:
         ))
     return Kinematics(system, tuple(out), y, ctx.yd, tuple(acceleration(c) for c in y), system.t,
                       ctx.pieces)
+
+
+@dataclass(frozen=True)
+class JointMotion:
+    """Motion of a joint's child frame relative to its parent body frame (the joint alone).
+
+    ``A`` (3×3): child axes in parent components (v_parent = A·v_child); ``d`` (3): child origin
+    in the parent frame. ``J_T`` (coordinate index -> 3-vector, parent frame) and ``J_R``
+    (child frame): the columns of the relative origin velocity ``ḋ = J_T·ẏ + v̄`` and relative
+    angular velocity ``ρ = J_R·ẏ + ω̄``; ``v_bar`` (parent), ``omega_bar`` (child): their
+    rheonomic parts; ``a_bar`` (parent), ``alpha_bar`` (child): the relative accelerations at
+    ÿ = 0 (``d̈`` and ``ρ̇``). The recursive numeric evaluation (:mod:`jourdain.numeric.recursive`)
+    composes these body by body, as the symbolic :func:`kinematics` composes the same steps.
+    """
+
+    A: Mat3
+    d: Vec3
+    J_T: MappingProxyType
+    J_R: MappingProxyType
+    v_bar: Vec3
+    omega_bar: Vec3
+    a_bar: Vec3
+    alpha_bar: Vec3
+
+
+def joint_motions(system: System) -> tuple[JointMotion, ...]:
+    """:class:`JointMotion` of every body's joint, in body order: the same elementary steps as
+    :func:`kinematics`, started from a parent frame at rest."""
+    y = system.coordinates
+    ctx = _Context({c: i for i, c in enumerate(y)}, tuple(rate(c) for c in y), system.t)
+    out = []
+    for body in system.bodies:
+        j = body.joint
+        F = _Frame()
+        _translate(F, j.position, ctx)
+        _reorient(F, j.orientation)
+        for step in j.steps:
+            if isinstance(step, Rot):
+                _rotate(F, step.axis, step.angle, ctx)
+            elif isinstance(step, Trans):
+                _translate(F, step.vector, ctx)
+        out.append(JointMotion(F.S, F.r, MappingProxyType(dict(F.JT)),
+                               MappingProxyType(dict(F.JR)), F.v_bar, F.omega_bar, F.a_bar,
+                               F.alpha_bar))
+    return tuple(out)

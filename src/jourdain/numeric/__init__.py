@@ -28,13 +28,14 @@ import symengine as se
 from ..errors import EvaluationError
 from ..symbolic import SymMatrix
 from .ccode import HEADER, argument_names, function_source
+from .recursive import recursive_source
 from .toolchain import CompilerError, build, cache_dir, compiler, content_key
 
 if TYPE_CHECKING:
     from ..model.system import System
 
 
-_GENERATOR_VERSION = "c2"
+_GENERATOR_VERSION = "c3"
 
 
 @dataclass(frozen=True, eq=False)
@@ -262,27 +263,60 @@ def _interpreted(system: System, names: tuple[str, ...], shapes: tuple[tuple[int
                                len(system.inputs), fn)
 
 
+def _recursive(system: System, full: bool, extra_source: str = "") -> CompiledFunction:
+    """Compile :func:`.recursive.recursive_source` (no symbolic M is formed)."""
+    f, p = system.f, len(system.bodies)
+    names: tuple[str, ...] = ("M", "k", "q")
+    shapes: tuple[tuple[int, int], ...] = ((f, f), (f, 1), (f, 1))
+    if full:
+        names = ("M_bar", "J_bar", "q_c", "q_e", *names)
+        shapes = ((6 * p, 6 * p), (6 * p, f), (6 * p, 1), (6 * p, 1), *shapes)
+    try:
+        compiler()
+    except CompilerError:
+        eom = system.equations_of_motion()
+        mats = {"M": eom.M, "k": eom.k, "q": eom.q}
+        if full:
+            ne = eom.newton_euler
+            mats = {"M_bar": ne.M_bar, "J_bar": ne.J_bar, "q_c": ne.q_c, "q_e": ne.q_e, **mats}
+        return lambdify(system, mats, extra_source)
+    source = HEADER + recursive_source(system, full) + extra_source
+    key = content_key(_GENERATOR_VERSION, source)
+    lib = build(key, source)
+    vp = ctypes.c_void_p
+    lib.jd_fn.restype = None
+    lib.jd_fn.argtypes = [vp, vp, ctypes.c_double, vp, vp, vp]
+    lib.jd_fn_batch.restype = None
+    lib.jd_fn_batch.argtypes = [ctypes.c_long, ctypes.c_long, vp, vp, vp, vp, ctypes.c_long, vp,
+                                ctypes.c_long, vp]
+    return CompiledFunction(names, shapes, arguments(system), key, f, len(system.parameters),
+                            len(system.inputs), lib)
+
+
 @lru_cache(maxsize=32)
 def _eom_function(system: System) -> CompiledFunction:
-    eom = system.equations_of_motion()
-    ne = eom.newton_euler
-    return lambdify(system, {"M_bar": ne.M_bar, "J_bar": ne.J_bar, "q_c": ne.q_c,
-                             "q_e": ne.q_e, "M": eom.M, "k": eom.k, "q": eom.q})
+    return _recursive(system, full=True)
+
+
+#: largest f for which the integrator's jd_accel is compiled (its work arrays live on the stack)
+ACCEL_MAX_F = 128
 
 
 @lru_cache(maxsize=32)
 def mkq_function(system: System) -> CompiledFunction:
     """Compiled ``M, k, q`` of the equations of motion (memoized per system), with
-    ``jd_accel`` (ÿ = M⁻¹(q − k) by Cholesky, for the integrator) when f ≤ 64."""
-    eom = system.equations_of_motion()
-    extra = ACCEL_TEMPLATE.replace("JD_F_VALUE", str(system.f)) if system.f <= 64 else ""
-    return lambdify(system, {"M": eom.M, "k": eom.k, "q": eom.q}, extra_source=extra)
+    ``jd_accel`` (ÿ = M⁻¹(q − k) by Cholesky, for the integrator) when f ≤ ACCEL_MAX_F."""
+    extra = (ACCEL_TEMPLATE.replace("JD_F_VALUE", str(system.f))
+             if system.f <= ACCEL_MAX_F else "")
+    return _recursive(system, full=False, extra_source=extra)
 
 
 # ÿ = M⁻¹(q − k) with the size known to the compiler, which unrolls the small loops and
 # inlines jd_fn; returns 0, 1 (M not positive definite) or 2 (NaN or inf)
 ACCEL_TEMPLATE = r"""
+#ifndef JD_F
 #define JD_F JD_F_VALUE
+#endif
 int jd_accel(const double *y, const double *yd, double t, const double *p, const double *u,
              double *ydd, double *power) {
     double buf[JD_F * JD_F + 2 * JD_F], L[JD_F * JD_F];

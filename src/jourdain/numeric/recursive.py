@@ -1,0 +1,366 @@
+"""Compiled evaluation that follows the kinematic recursion body by body (METHOD.md §1–§3).
+
+The symbolic stages give every entry of M = J̄ᵀM̄J̄ as an expression; for a chain of p bodies
+with f coordinates those expressions hold O(f³) operations, and compiling them took minutes at
+f = 63. Here the same products are formed numerically in the order of the tree, in generated C
+whose size grows with the number of bodies, not with f²:
+
+1. **Per joint, symbolic and short** (:func:`jourdain.kinematics.joint_motions`): the relative
+   rotation ``A`` and position ``d`` of the child frame, the relative Jacobian columns
+   ``J_T``, ``J_R``, and the rheonomic and ÿ-free relative velocities and accelerations; per
+   body its mass data and the resultant applied force ``f`` (inertial) and torque ``l`` (body
+   frame) of :func:`jourdain.newton_euler.applied_forces`. These are compiled as one function
+   of (y, ẏ, t, p, u) with the graph CSE of :mod:`jourdain.numeric.ccode`.
+2. **Forward pass** (generic C, parents first): S_i = S_λ·A_i, the origin r_O,i = r_O,λ + S_λ·d_i,
+   ω_i, v_i, and the local accelerations ᾱ_i, ā_i (METHOD.md §1) composed from the parent's;
+   every Jacobian column of the joint as a spatial twist at the inertial origin,
+   ``V = (w, u)`` with ``w = S_i·J_R,j`` and ``u = S_λ·J_T,j + r_O,i × w`` — a column keeps this
+   form unchanged in every body below the joint, which is what makes the sums below short.
+3. **Composite bodies** (backward pass): the spatial inertia of each body about the inertial
+   origin (inertial components) and the wrenches of q̄^c and q̄^e of each body about the origin
+   are summed over each sub-tree (plain sums: all in one frame about one point).
+4. **Projection**: with I^c_b the composite inertia of the sub-tree of body b,
+
+       M_jk = Σ_b Σ_(a ancestor-or-self of b) V_a,jᵀ · I^c_b · V_b,k   (and its transpose)
+       k_j  = Σ_a V_a,jᵀ · (Σ_(i below a) q̄^c_i as a wrench),   q_j likewise with q̄^e_i,
+
+   which is J̄ᵀM̄J̄, J̄ᵀq̄^c and J̄ᵀq̄^e with the body sums gathered first (associativity only).
+   A coordinate that enters several joints (absolute angles of a chain) has a column in each;
+   the double sum over joint pairs covers it exactly.
+
+The cost per state is O(Σ_b columns·depth), like Pinocchio's CRBA, and the generated source is a
+few hundred bytes per body plus a fixed engine. The symbolic equations stay what
+:func:`jourdain.projection.projection` gives, for display and export; tests compare both, and
+both with Pinocchio.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import symengine as se
+
+from ..kinematics import joint_motions
+from .ccode import argument_names, function_source
+
+if TYPE_CHECKING:
+    from ..model.system import System
+
+#: numbers per body in the local array: A 9, d 3, ω̄ 3, v̄ 3, ᾱ 3, ā 3, m 1, com 3, I 6, f 3, l 3
+BODY_BLOCK = 40
+#: numbers per Jacobian column: J_R 3 (child frame), J_T 3 (parent frame)
+COLUMN_BLOCK = 6
+
+
+@dataclass(frozen=True)
+class RecursiveLayout:
+    """Tables of the generated code: ``parent[i]`` (-1: world), the columns of each body's joint
+    ``columns[i]`` (coordinate indices), and the local expressions in array order."""
+
+    parent: tuple[int, ...]
+    columns: tuple[tuple[int, ...], ...]
+    exprs: tuple[se.Basic, ...]
+
+    @property
+    def n_columns(self) -> int:
+        return sum(len(c) for c in self.columns)
+
+
+def layout(system: System) -> RecursiveLayout:
+    """The local expressions of every joint and body, in the order of the C arrays."""
+    from ..kinematics import kinematics
+    from ..newton_euler import applied_forces
+
+    motions = joint_motions(system)
+    index = {b.name: i for i, b in enumerate(system.bodies)}
+    forces = applied_forces(kinematics(system)) if system.forces else None
+    zero = se.Integer(0)
+    exprs: list[se.Basic] = []
+    cols: list[tuple[int, ...]] = []
+    col_exprs: list[se.Basic] = []
+    for i, (body, jm) in enumerate(zip(system.bodies, motions, strict=True)):
+        exprs.extend(x for row in jm.A for x in row)
+        exprs.extend((*jm.d, *jm.omega_bar, *jm.v_bar, *jm.alpha_bar, *jm.a_bar))
+        I = body.inertia
+        exprs.extend((body.mass, *body.com, I[0][0], I[0][1], I[0][2], I[1][1], I[1][2],
+                      I[2][2]))
+        if forces is None:
+            exprs.extend((zero,) * 6)
+        else:
+            exprs.extend((*forces[i].f, *forces[i].l))
+        js = tuple(sorted(set(jm.J_T) | set(jm.J_R)))
+        z3 = (zero, zero, zero)
+        for j in js:
+            col_exprs.extend((*jm.J_R.get(j, z3), *jm.J_T.get(j, z3)))
+        cols.append(js)
+    parent = tuple(-1 if b.parent == "world" else index[b.parent] for b in system.bodies)
+    return RecursiveLayout(parent, tuple(cols), tuple(exprs + col_exprs))
+
+
+def _table(name: str, values: list[int]) -> str:
+    body = ", ".join(str(v) for v in values) if values else "0"
+    return f"static const int {name}[{max(len(values), 1)}] = {{{body}}};\n"
+
+
+def recursive_source(system: System, full: bool = False) -> str:
+    """C source of ``jd_fn(y, yd, t, p, u, out)`` with ``out = [M (f×f), k (f), q (f)]``, and
+    with ``full`` ``out = [M_bar, J_bar, q_c, q_e, M, k, q]`` (the layout of
+    :func:`jourdain.numeric.evaluate`); plus ``jd_fn_batch``."""
+    lay = layout(system)
+    p = len(lay.parent)
+    f = system.f
+    names = argument_names(system.y, system.yd, system.t, system.parameter_symbols,
+                           system.inputs)
+    local = function_source("jd_local", list(lay.exprs), names)
+    col_start = [0]
+    col_coord: list[int] = []
+    for c in lay.columns:
+        col_coord.extend(c)
+        col_start.append(col_start[-1] + len(c))
+    size = (36 * p * p + 6 * p * f + 12 * p if full else 0) + f * f + 2 * f
+    head = (f"#define JD_P {p}\n#define JD_F {f}\n#define JD_NC {max(len(col_coord), 1)}\n"
+            f"#define JD_NL {len(lay.exprs)}\n#define JD_COLS {p * BODY_BLOCK}\n"
+            f"#define JD_SIZE {size}\n#define JD_FULL {1 if full else 0}\n"
+            + _table("jd_parent", list(lay.parent))
+            + _table("jd_col_start", col_start)
+            + _table("jd_col_coord", col_coord))
+    return local + head + ENGINE
+
+
+# The engine: generic in the tables above. Spatial vectors about the inertial origin in inertial
+# components: twists (w, u) with u the velocity of the body point at the origin, wrenches
+# (moment about the origin, force); the power of a wrench on a twist is w·m + u·F.
+ENGINE = r"""
+typedef struct { double R[9], o[3], w[3], v[3], al[3], a[3]; } jd_frame;
+
+static inline void jd_mv(const double *A, const double *x, double *r) {
+    r[0] = A[0] * x[0] + A[1] * x[1] + A[2] * x[2];
+    r[1] = A[3] * x[0] + A[4] * x[1] + A[5] * x[2];
+    r[2] = A[6] * x[0] + A[7] * x[1] + A[8] * x[2];
+}
+static inline void jd_mtv(const double *A, const double *x, double *r) {
+    r[0] = A[0] * x[0] + A[3] * x[1] + A[6] * x[2];
+    r[1] = A[1] * x[0] + A[4] * x[1] + A[7] * x[2];
+    r[2] = A[2] * x[0] + A[5] * x[1] + A[8] * x[2];
+}
+static inline void jd_cross(const double *a, const double *b, double *r) {
+    double r0 = a[1] * b[2] - a[2] * b[1], r1 = a[2] * b[0] - a[0] * b[2];
+    double r2 = a[0] * b[1] - a[1] * b[0];
+    r[0] = r0; r[1] = r1; r[2] = r2;
+}
+static inline double jd_dot6(const double *a, const double *b) {
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] + a[4] * b[4] + a[5] * b[5];
+}
+/* composite inertia (Ī 9, h 3, m) times a twist (w, u): (Ī·w + h × u, m·u + w × h) */
+static inline void jd_inertia_twist(const double *I, const double *V, double *F) {
+    double t[3];
+    jd_mv(I, V, F);
+    jd_cross(I + 9, V + 3, t);
+    F[0] += t[0]; F[1] += t[1]; F[2] += t[2];
+    jd_cross(V, I + 9, t);
+    F[3] = I[12] * V[3] + t[0]; F[4] = I[12] * V[4] + t[1]; F[5] = I[12] * V[5] + t[2];
+}
+
+/* everything but the projection: frames, twist columns V (6 per column), composite inertias
+   Ic (13 per body), composite wrenches of q_c (Bc) and q_e (Wc), per body also the centre of
+   mass acceleration, Euler term and applied force rows for the full output */
+typedef struct {
+    jd_frame fr[JD_P];
+    double V[6 * JD_NC];
+    double Ic[13 * JD_P], Bc[6 * JD_P], Wc[6 * JD_P];
+    double c[3 * JD_P], qc[6 * JD_P];
+} jd_work;
+
+static void jd_recursion(const double *L, const double *yd, jd_work *W) {
+    static const double I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, Z[3] = {0, 0, 0};
+    for (int i = 0; i < JD_P; ++i) {
+        const double *b = L + i * 40;
+        const double *A = b, *d = b + 9, *wb = b + 12, *vb = b + 15, *abr = b + 18, *abl = b + 21;
+        const double m = b[24], *com = b + 25, *In = b + 28, *fe = b + 34, *le = b + 37;
+        int lam = jd_parent[i];
+        const double *Rl = lam < 0 ? I3 : W->fr[lam].R, *ol = lam < 0 ? Z : W->fr[lam].o;
+        const double *wl = lam < 0 ? Z : W->fr[lam].w, *vl = lam < 0 ? Z : W->fr[lam].v;
+        const double *all = lam < 0 ? Z : W->fr[lam].al, *al = lam < 0 ? Z : W->fr[lam].a;
+        jd_frame *F = &W->fr[i];
+        /* S_i = S_λ A_i, r_O,i = r_O,λ + S_λ d_i */
+        for (int r = 0; r < 3; ++r)
+            for (int s = 0; s < 3; ++s)
+                F->R[3 * r + s] = Rl[3 * r] * A[s] + Rl[3 * r + 1] * A[3 + s] + Rl[3 * r + 2] * A[6 + s];
+        double dw[3], rho[3], dd[3], rhow[3], ddw[3], t1[3], t2[3];
+        jd_mv(Rl, d, dw);
+        for (int a = 0; a < 3; ++a) { F->o[a] = ol[a] + dw[a]; rho[a] = wb[a]; dd[a] = vb[a]; }
+        /* relative velocities from the joint's columns */
+        const double *cl = L + JD_COLS + 6 * jd_col_start[i];
+        for (int c = jd_col_start[i]; c < jd_col_start[i + 1]; ++c, cl += 6) {
+            double s = yd[jd_col_coord[c]];
+            for (int a = 0; a < 3; ++a) { rho[a] += cl[a] * s; dd[a] += cl[3 + a] * s; }
+        }
+        jd_mv(F->R, rho, rhow);
+        jd_mv(Rl, dd, ddw);
+        /* ω_i, v_i (origin), and the accelerations at ÿ = 0 */
+        jd_cross(wl, dw, t1);
+        jd_cross(wl, rhow, t2);
+        for (int a = 0; a < 3; ++a) {
+            F->w[a] = wl[a] + rhow[a];
+            F->v[a] = vl[a] + t1[a] + ddw[a];
+            F->al[a] = all[a] + t2[a];
+        }
+        jd_mv(F->R, abr, t2);
+        for (int a = 0; a < 3; ++a) F->al[a] += t2[a];
+        double acc[3];
+        jd_cross(all, dw, acc);
+        jd_cross(wl, t1, t2);  /* ω_λ × (ω_λ × d) */
+        for (int a = 0; a < 3; ++a) acc[a] += t2[a];
+        jd_cross(wl, ddw, t2);
+        jd_mv(Rl, abl, t1);
+        for (int a = 0; a < 3; ++a) F->a[a] = al[a] + acc[a] + 2.0 * t2[a] + t1[a];
+        /* twist columns about the origin: w = S_i J_R, u = S_λ J_T + r_O × w */
+        cl = L + JD_COLS + 6 * jd_col_start[i];
+        for (int c = jd_col_start[i]; c < jd_col_start[i + 1]; ++c, cl += 6) {
+            double *V = W->V + 6 * c;
+            jd_mv(F->R, cl, V);
+            jd_mv(Rl, cl + 3, V + 3);
+            jd_cross(F->o, V, t1);
+            for (int a = 0; a < 3; ++a) V[3 + a] += t1[a];
+        }
+        /* centre of mass and the body's rows of q_c: m ā, I ᾱ + ω × I ω (body frame) */
+        double cw[3], *cc = W->c + 3 * i, ac[3], wB[3], aB[3], Iw[3], tau[3];
+        jd_mv(F->R, com, cw);
+        for (int a = 0; a < 3; ++a) cc[a] = F->o[a] + cw[a];
+        jd_cross(F->al, cw, ac);
+        jd_cross(F->w, cw, t1);
+        jd_cross(F->w, t1, t2);
+        for (int a = 0; a < 3; ++a) ac[a] += F->a[a] + t2[a];
+        jd_mtv(F->R, F->w, wB);
+        jd_mtv(F->R, F->al, aB);
+        const double Is[9] = {In[0], In[1], In[2], In[1], In[3], In[4], In[2], In[4], In[5]};
+        jd_mv(Is, wB, Iw);
+        jd_mv(Is, aB, tau);
+        jd_cross(wB, Iw, t1);
+        for (int a = 0; a < 3; ++a) { tau[a] += t1[a]; W->qc[6 * i + a] = m * ac[a]; W->qc[6 * i + 3 + a] = tau[a]; }
+        /* wrenches about the origin: (c × F + S τ, F) */
+        double *B = W->Bc + 6 * i, *Wr = W->Wc + 6 * i;
+        for (int a = 0; a < 3; ++a) { B[3 + a] = m * ac[a]; Wr[3 + a] = fe[a]; }
+        jd_cross(cc, B + 3, B);
+        jd_mv(F->R, tau, t1);
+        for (int a = 0; a < 3; ++a) B[a] += t1[a];
+        jd_cross(cc, fe, Wr);
+        jd_mv(F->R, le, t1);
+        for (int a = 0; a < 3; ++a) Wr[a] += t1[a];
+        /* spatial inertia about the origin: Ī = S I Sᵀ + m(|c|² E − c cᵀ), h = m c, m */
+        double *Ic = W->Ic + 13 * i, SI[9];
+        for (int r = 0; r < 3; ++r)
+            for (int s = 0; s < 3; ++s)
+                SI[3 * r + s] = F->R[3 * r] * Is[s] + F->R[3 * r + 1] * Is[3 + s] + F->R[3 * r + 2] * Is[6 + s];
+        double c2 = cc[0] * cc[0] + cc[1] * cc[1] + cc[2] * cc[2];
+        for (int r = 0; r < 3; ++r)
+            for (int s = 0; s < 3; ++s)
+                Ic[3 * r + s] = SI[3 * r] * F->R[3 * s] + SI[3 * r + 1] * F->R[3 * s + 1]
+                                + SI[3 * r + 2] * F->R[3 * s + 2]
+                                + m * ((r == s ? c2 : 0.0) - cc[r] * cc[s]);
+        for (int a = 0; a < 3; ++a) Ic[9 + a] = m * cc[a];
+        Ic[12] = m;
+    }
+    /* composite bodies: sums over each sub-tree, children before parents */
+    for (int i = JD_P - 1; i >= 0; --i) {
+        int lam = jd_parent[i];
+        if (lam < 0) continue;
+        for (int a = 0; a < 13; ++a) W->Ic[13 * lam + a] += W->Ic[13 * i + a];
+        for (int a = 0; a < 6; ++a) {
+            W->Bc[6 * lam + a] += W->Bc[6 * i + a];
+            W->Wc[6 * lam + a] += W->Wc[6 * i + a];
+        }
+    }
+}
+
+/* M = J̄ᵀM̄J̄, k = J̄ᵀq̄^c, q = J̄ᵀq̄^e from the composite bodies */
+static void jd_project(const jd_work *W, double *M, double *k, double *q) {
+    for (int a = 0; a < JD_F * JD_F; ++a) M[a] = 0.0;
+    for (int a = 0; a < JD_F; ++a) { k[a] = 0.0; q[a] = 0.0; }
+    for (int b = 0; b < JD_P; ++b) {
+        for (int c = jd_col_start[b]; c < jd_col_start[b + 1]; ++c) {
+            const double *V = W->V + 6 * c;
+            int kc = jd_col_coord[c];
+            k[kc] += jd_dot6(V, W->Bc + 6 * b);
+            q[kc] += jd_dot6(V, W->Wc + 6 * b);
+            double Fv[6];
+            jd_inertia_twist(W->Ic + 13 * b, V, Fv);
+            /* the upper triangle only, then mirrored: M is exactly symmetric */
+            for (int a = b; a >= 0; a = jd_parent[a]) {
+                int last = a == b ? c + 1 : jd_col_start[a + 1];
+                for (int e = jd_col_start[a]; e < last; ++e) {
+                    double val = jd_dot6(W->V + 6 * e, Fv);
+                    int je = jd_col_coord[e];
+                    if (je == kc && a != b) val *= 2.0;  /* V_a,jᵀI V_b,j and its transpose */
+                    if (je <= kc) M[je * JD_F + kc] += val; else M[kc * JD_F + je] += val;
+                }
+            }
+        }
+    }
+    for (int r = 1; r < JD_F; ++r)
+        for (int s = 0; s < r; ++s) M[r * JD_F + s] = M[s * JD_F + r];
+}
+
+#if JD_FULL
+/* M_bar, J_bar, q_c, q_e in the row order of jourdain.newton_euler */
+static void jd_newton_euler(const double *L, const jd_work *W, double *out) {
+    const long n = 6 * JD_P;
+    double *Mb = out, *Jb = out + n * n, *qc = Jb + n * JD_F, *qe = qc + n;
+    for (long a = 0; a < n * n; ++a) Mb[a] = 0.0;
+    for (long a = 0; a < n * JD_F; ++a) Jb[a] = 0.0;
+    for (int i = 0; i < JD_P; ++i) {
+        const double *b = L + i * 40, *In = b + 28;
+        const double Is[9] = {In[0], In[1], In[2], In[1], In[3], In[4], In[2], In[4], In[5]};
+        for (int a = 0; a < 3; ++a) {
+            long rT = 3 * i + a, rR = 3 * JD_P + 3 * i + a;
+            Mb[rT * n + rT] = b[24];
+            for (int s = 0; s < 3; ++s) Mb[rR * n + 3 * JD_P + 3 * i + s] = Is[3 * a + s];
+            qc[rT] = W->qc[6 * i + a];
+            qc[rR] = W->qc[6 * i + 3 + a];
+            qe[rT] = b[34 + a];
+            qe[rR] = b[37 + a];
+        }
+        /* J_T: velocity of the centre of mass u + w × c; J_R: Sᵀ w, summed over the columns
+           of every joint above the body */
+        const double *cc = W->c + 3 * i, *R = W->fr[i].R;
+        for (int a = i; a >= 0; a = jd_parent[a]) {
+            for (int e = jd_col_start[a]; e < jd_col_start[a + 1]; ++e) {
+                const double *V = W->V + 6 * e;
+                int j = jd_col_coord[e];
+                double t[3], wB[3];
+                jd_cross(V, cc, t);
+                jd_mtv(R, V, wB);
+                for (int s = 0; s < 3; ++s) {
+                    Jb[(3 * i + s) * JD_F + j] += V[3 + s] + t[s];
+                    Jb[(3 * JD_P + 3 * i + s) * JD_F + j] += wB[s];
+                }
+            }
+        }
+    }
+}
+#endif
+
+void jd_fn(const double *y, const double *yd, double t, const double *p, const double *u,
+           double *out) {
+    double L[JD_NL > 0 ? JD_NL : 1];
+    jd_work *W = (jd_work *)malloc(sizeof(jd_work));
+    if (!W) { for (long a = 0; a < JD_SIZE; ++a) out[a] = NAN; return; }
+    jd_local(y, yd, t, p, u, L);
+    jd_recursion(L, yd, W);
+#if JD_FULL
+    jd_newton_euler(L, W, out);
+    double *M = out + 36L * JD_P * JD_P + 6L * JD_P * JD_F + 12L * JD_P;
+#else
+    double *M = out;
+#endif
+    jd_project(W, M, M + JD_F * JD_F, M + JD_F * JD_F + JD_F);
+    free(W);
+}
+
+void jd_fn_batch(long n, long f, const double *y, const double *yd, const double *t,
+                 const double *p, long p_stride, const double *u, long u_stride, double *out) {
+    for (long i = 0; i < n; ++i)
+        jd_fn(y + i * f, yd + i * f, t[i], p + i * p_stride, u + i * u_stride, out + i * JD_SIZE);
+}
+"""
