@@ -2,9 +2,11 @@
 parameter at fault; evaluation rejects bad states with an EvaluationError."""
 
 import dataclasses
+import math
 
 import numpy as np
 import pytest
+import symengine as se
 
 import jourdain as jd
 from jourdain.models import double_pendulum
@@ -46,7 +48,13 @@ CASES = [
      'body "bob": a massless body cannot have rotational inertia'),
     ("cycle", lambda: make([pendulum(parent="b2"), pendulum(name="b2", parent="bob",
                                                             joint=jd.Revolute("p2", psi))],
-                           coords=(phi, psi)), "not connected to the inertial frame"),
+                           coords=(phi, psi)),
+     'body "bob" is not connected to the inertial frame (a cycle of parents: bob → b2 → bob)'),
+    ("child before its parent", lambda: make([pendulum(name="b2", parent="bob",
+                                                       joint=jd.Revolute("p2", psi)), pendulum()],
+                                             coords=(phi, psi)),
+     'body "b2" (position 1) comes before its parent "bob" (position 2): list parents before '
+     "their children"),
     ("undeclared symbol in joint", lambda: make([pendulum(
         joint=jd.Revolute("pivot", phi, position=(0, jd.symbols("h"), 0)))]),
      'joint "pivot" (body "bob"): undeclared symbol(s) [\'h\']'),
@@ -65,7 +73,19 @@ CASES = [
     ("spring on one body", lambda: make(forces=[jd.SpringDamper("s", "bob", (0, 0, 0), "bob", (1, 0, 0))]),
      'spring-damper "s": both ends are on body "bob"'),
     ("bad axis name", lambda: jd.Revolute("pivot", phi, "w"), 'expected one of x, y, z or a 3-vector, got \'w\''),
-    ("axis not unit", lambda: jd.Revolute("pivot", phi, (1, 1, 0)), "is not a unit vector"),
+    ("zero axis", lambda: jd.Revolute("pivot", phi, (0, 0, 0)),
+     'joint "pivot" axis must not be the zero vector'),
+    ("zero float axis", lambda: jd.Prismatic("rail", phi, (0.0, 0.0, 0.0)),
+     'joint "rail" axis must not be the zero vector'),
+    ("zero second universal axis", lambda: jd.Universal("u", (phi, psi), ("x", (0, 0, 0))),
+     'joint "u" axes[1] must not be the zero vector'),
+    ("zero Rot axis", lambda: jd.Rot((0, 0, 0), phi), "Rot axis must not be the zero vector"),
+    ("axis zero at the default values", lambda: make([pendulum(
+        joint=jd.Revolute("pivot", phi, (l - 1, 0, 0)))]),
+     'joint "pivot" (body "bob"): the axis is the zero vector at the default parameter values'),
+    ("axis depending on a coordinate", lambda: make([pendulum(
+        joint=jd.General("pivot", [jd.Rot((phi, 1, 0), phi)], coordinates=[phi]))]),
+     'joint "pivot" (body "bob"): the axis uses [\'phi\']; axes may depend on parameters only'),
     ("axis wrong length", lambda: jd.Revolute("pivot", phi, (1, 0)), "expected a 3-vector, got 2 components"),
     ("expression as revolute coordinate", lambda: jd.Revolute("pivot", 2 * phi),
      'joint "pivot": coordinate must be a symbol'),
@@ -130,3 +150,85 @@ def test_parameters_override_without_changing_the_model():
     b = s.evaluate([0.3, 0.1], [0, 0], parameters={"m2": 1.0})["M"]
     assert b[1, 1] == pytest.approx(a[1, 1] * 2.0)
     assert s.parameter_values["m2"] == 0.5
+
+
+def _four_bodies():
+    """a ← world, b ← a, c ← b, d ← a: d, a child of a, is listed after c."""
+    q1, q2, q3, q4 = jd.symbols("q1 q2 q3 q4")
+
+    def body(name, parent, q, mass):
+        pos = None if parent == "world" else (l, 0, 0)
+        return jd.Body(name, parent, jd.Revolute(f"j{name}", q, "z", position=pos), mass=mass,
+                       com=(l, 0, 0), inertia=(0.1 * mass, 0.2 * mass, 0.3 * mass))
+
+    bodies = [body("a", "world", q1, 1), body("b", "a", q2, 2), body("c", "b", q3, 3),
+              body("d", "a", q4, 4)]
+    return (q1, q2, q3, q4), bodies
+
+
+def test_bodies_keep_the_order_given():
+    """A parent-before-child order is kept as written: in system.bodies, the kinematics, the
+    rows of M̄ and J̄ and the joints of g (a breadth-first reordering would give a, b, d, c)."""
+    y, bodies = _four_bodies()
+    s = jd.System(y, bodies, [jd.Gravity((0, -g, 0))], parameters=P)
+    assert s.body_names == ["a", "b", "c", "d"]
+    ne = s.newton_euler()
+    assert [bk.name for bk in ne.kinematics.bodies] == ["a", "b", "c", "d"]
+    assert [child for _, child, _ in ne.joints] == ["a", "b", "c", "d"]
+    v = s.evaluate([0.1, 0.2, 0.3, 0.4], [0.5, -0.2, 0.1, 0.3])
+    # M̄ = diag(m_a E, m_b E, m_c E, m_d E, I_a, ..., I_d) with m = 1, 2, 3, 4
+    masses = np.repeat([1.0, 2.0, 3.0, 4.0], 3)
+    np.testing.assert_allclose(np.diag(v["M_bar"])[:12], masses)
+    inertias = np.outer([1.0, 2.0, 3.0, 4.0], [0.1, 0.2, 0.3]).ravel()
+    np.testing.assert_allclose(np.diag(v["M_bar"])[12:], inertias)
+    # J̄'s translational rows of body k (3k..3k+2): d (rows 9..11) moves with q1 and q4 only,
+    # c (rows 6..8) with q1, q2, q3
+    J = v["J_bar"]
+    assert np.abs(J[9:12, [1, 2]]).max() == 0 and np.abs(J[9:12, 3]).max() > 0
+    assert np.abs(J[6:9, 3]).max() == 0 and np.abs(J[6:9, 2]).max() > 0
+    joints = list(dict.fromkeys(n.split(".")[0] for n in v["g_names"]))
+    assert joints == ["ja", "jb", "jc", "jd"]
+
+
+def test_a_child_before_its_parent_is_refused():
+    y, (a, b, c, d) = _four_bodies()
+    with pytest.raises(jd.ModelError) as err:
+        jd.System(y, [a, c, d, b], parameters=P)
+    assert str(err.value) == ('body "c" (position 2) comes before its parent "b" (position 4): '
+                              "list parents before their children")
+
+
+AXIS = (1, 1, 0)
+UNIT = (se.sqrt(2) / 2, se.sqrt(2) / 2, 0)
+FLOAT_UNIT = (1 / math.sqrt(2), 1 / math.sqrt(2), 0.0)
+
+
+@pytest.mark.parametrize("build", [
+    lambda ax: jd.Revolute("j", phi, ax),
+    lambda ax: jd.Prismatic("j", phi, ax),
+    lambda ax: jd.Cylindrical("j", (phi, psi), ax),
+    lambda ax: jd.Universal("j", (phi, psi), (ax, "z")),
+    lambda ax: jd.Universal("j", (phi, psi), ("z", ax)),
+    lambda ax: jd.General("j", [jd.Rot(ax, phi)]),
+    lambda ax: jd.General("j", [jd.Trans(ax, phi)]),
+], ids=["Revolute", "Prismatic", "Cylindrical", "Universal0", "Universal1", "Rot", "Trans"])
+def test_a_vector_axis_is_normalized(build):
+    """An axis is a direction: (1, 1, 0) is the unit axis (√2/2, √2/2, 0), exactly."""
+    assert build(AXIS) == build(UNIT)
+    steps = build(AXIS).steps
+    for ref, step in zip(build(FLOAT_UNIT).steps, steps, strict=True):
+        np.testing.assert_allclose([float(c) for c in step.axis], [float(c) for c in ref.axis],
+                                   rtol=1e-15)
+    assert all(step.axis is None or se.expand(sum(c * c for c in step.axis)) == 1
+               for step in steps)
+
+
+def test_unit_axes_are_kept_and_axes_with_parameters_divided_by_their_length():
+    a, b, beta = jd.symbols("a b beta")
+    assert jd.Rot((0.6, 0.8, 0), phi).axis == (se.Float(0.6), se.Float(0.8), 0)
+    assert jd.Rot((3, 4, 0), phi).axis == (se.Rational(3, 5), se.Rational(4, 5), 0)
+    assert jd.Rot((se.sin(beta), 0, se.cos(beta)), phi).axis == (se.sin(beta), 0, se.cos(beta))
+    n = se.sqrt(a**2 + b**2)
+    assert jd.Rot((a, b, 0), phi).axis == (a / n, b / n, 0)
+    # normalizing twice gives the same axis
+    assert jd.Rot(jd.Rot((a, b, 0), phi).axis, phi).axis == (a / n, b / n, 0)

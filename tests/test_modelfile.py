@@ -225,6 +225,57 @@ def test_every_joint_and_force_type_matches_the_python_api():
         np.testing.assert_allclose(A[key], B[key], rtol=1e-12, atol=1e-12)
 
 
+@pytest.mark.parametrize("spec, python", [
+    ('{ type = "revolute", coordinate = "phi2", axis = [1, 1, 0] }',
+     lambda q, ax: jd.Revolute("link2", q, ax)),
+    ('{ type = "prismatic", coordinate = "phi2", axis = [1, 1, 0] }',
+     lambda q, ax: jd.Prismatic("link2", q, ax)),
+    ('{ type = "universal", coordinates = ["phi2", "phi3"], axes = ["z", [1, 1, 0]] }',
+     lambda q, ax: jd.Universal("link2", (q, jd.symbols("phi3")), ("z", ax))),
+    ('{ type = "general", steps = [{ rot = [1, 1, 0], angle = "phi2" }, '
+     '{ trans = [1, 1, 0], distance = "phi3" }] }',
+     lambda q, ax: jd.General("link2", [jd.Rot(ax, q), jd.Trans(ax, jd.symbols("phi3"))],
+                              coordinates=[q, jd.symbols("phi3")])),
+], ids=["revolute", "prismatic", "universal", "general"])
+def test_a_vector_axis_is_the_same_joint_in_a_file_and_in_python(spec, python):
+    """One rule: [1, 1, 0] in a file, (1, 1, 0) and (√2/2, √2/2, 0) in Python give one joint."""
+    coords = 'phi2 = "rad"\nphi3 = "rad"' if "phi3" in spec else 'phi2 = "rad"'
+    text = BASE.replace('phi2 = "rad"', coords).replace(
+        '[bodies.link2.joint]\ntype = "revolute"\ncoordinate = "phi2"\naxis = "z"\n'
+        'position = [0, "-l1", 0]\n', "").replace(
+        'inertia = [0.1, 0.01, 0.1]\n', f"inertia = [0.1, 0.01, 0.1]\njoint = {spec}\n")
+    joint = loads_model(text).system.body("link2").joint
+    q = jd.symbols("phi2")
+    assert joint == python(q, (1, 1, 0)) == python(q, (se.sqrt(2) / 2, se.sqrt(2) / 2, 0))
+
+
+def test_an_axis_with_parameters_is_the_same_joint_in_a_file_and_in_python():
+    text = BASE.replace('axis = "z"\nposition', 'axis = ["l1", "l2", 0]\nposition')
+    joint = loads_model(text).system.body("link2").joint
+    phi2, l1, l2 = jd.symbols("phi2 l1 l2")
+    assert joint == jd.Revolute("link2", phi2, (l1, l2, 0), position=(0, -l1, 0))
+    n = se.sqrt(l1**2 + l2**2)
+    assert joint.steps[0].axis == (l1 / n, l2 / n, 0)
+
+
+def test_bodies_keep_the_file_order_and_a_child_before_its_parent_is_refused():
+    head, rest = BASE.split("[bodies.link1]\n")
+    link1, rest = rest.split("[bodies.link2]\n")
+    link2, tail = rest.split("[forces.gravity]\n")
+    assert loads_model(BASE).system.body_names == ["link1", "link2"]
+    text = (f"{head}[bodies.link2]\n{link2}[bodies.link1]\n{link1}"
+            f"[forces.gravity]\n{tail}")
+    with pytest.raises(ModelFileError) as info:
+        loads_model(text, "swapped.toml")
+    err = info.value
+    parent_line = _line(text, "[bodies.link1]")
+    assert err.line == _line(text, 'parent = "link1"')
+    assert str(err) == (
+        f'swapped.toml:{err.line}: body "link2" → parent: body "link2" (position 1) comes '
+        f'before its parent "link1" (position 2, line {parent_line}): list parents before '
+        "their children")
+
+
 def test_nominal_motion_rates_are_time_derivatives():
     text = BASE.replace("[nominal.down]\ny = { phi1 = 0, phi2 = 0 }",
                         '[nominal.spin]\ny = { phi1 = "k*t", phi2 = "sin(2*t)" }')
@@ -260,7 +311,11 @@ MISTAKES = [
     ("axis of wrong type", 'axis = "z"\nposition', 'axis = 3\nposition',
      "expected one of x, y, z or a 3-vector, got the number 3", "axis = 3"),
     ("zero axis", 'axis = "z"\nposition', 'axis = [0, 0, 0]\nposition',
-     "must not be the zero vector", "axis = [0, 0, 0]"),
+     'body "link2" → joint → axis: the axis of joint "link2" must not be the zero vector',
+     "axis = [0, 0, 0]"),
+    ("axis zero at the default values", 'axis = "z"\nposition', 'axis = ["l1 - 1", 0, 0]\nposition',
+     'joint "link2" (body "link2"): the axis is the zero vector at the default parameter values',
+     "[bodies.link2.joint]"),
     ("unknown section", "[simulation]", "[simulations]",
      'unknown key "simulations" (did you mean "simulation"?)', "[simulations]"),
     ("unknown body key", 'mass = "m2"', 'mas = "m2"', 'unknown key "mas" (did you mean "mass"?)',

@@ -47,6 +47,7 @@ from ..model import (
     disc,
     rod,
 )
+from ..model.expressions import unit_axis
 from .expressions import RESERVED_NAMES, ExpressionError, _number, parse_expression
 from .toml_positions import Path, key_lines, line_of
 
@@ -343,15 +344,13 @@ class _Loader:
                 raise self.fail(path, f'expected one of x, y, z or a 3-vector, got "{value}"')
             return s
         if isinstance(value, list):
-            vec = self.vector(value, path, allowed, context)
-            if not any(e.free_symbols for e in vec):
-                norm = math.sqrt(sum(float(e) ** 2 for e in vec))
-                if norm == 0:
-                    raise self.fail(path, "the axis must not be the zero vector")
-                if abs(norm - 1) > 1e-12:
-                    # a direction is meant; make it a unit vector
-                    vec = tuple(e / se.sqrt(sum(x**2 for x in vec)) for e in vec)
-            return vec
+            # a direction: the same rule as the Python API (unit_axis), located in the file
+            u = unit_axis(self.vector(value, path, allowed, context))
+            if u is None:
+                jname = self.joint_of_body.get(path[1]) if path[:1] == ("bodies",) else None
+                which = f'the axis of joint "{jname}"' if jname else "the axis"
+                raise self.fail(path, f"{which} must not be the zero vector")
+            return u
         raise self.fail(path, f"expected one of x, y, z or a 3-vector, got {_type_name(value)}")
 
     def matrix3(self, value: object, path: Path, allowed: Container[str],
@@ -543,6 +542,17 @@ class _Loader:
                     raise self.fail((*path, b.name, "parent"), f"the parents form a cycle "
                                     f"({chain}); every chain of parents must end at \"world\"")
                 seen.append(nxt)
+        # the bodies keep the file's order (the rows of the equations follow it), so a child
+        # written before its parent is an error here as in the Python API
+        position = {name: k for k, name in enumerate(self.body_names)}
+        for k, b in enumerate(bodies):
+            if b.parent != WORLD and position[b.parent] > k:
+                line = line_of(self.lines, (*path, b.parent))
+                at = f", line {line}" if line else ""
+                raise self.fail((*path, b.name, "parent"),
+                                f'body "{b.name}" (position {k + 1}) comes before its parent '
+                                f'"{b.parent}" (position {position[b.parent] + 1}{at}): list '
+                                "parents before their children")
         return bodies
 
     def read_body(self, bname: str, spec: object) -> Body:

@@ -83,7 +83,12 @@ _AXES = {"x": (1, 0, 0), "y": (0, 1, 0), "z": (0, 0, 1)}
 
 
 def axis_vector(value: object, where: str) -> tuple[Expr, ...]:
-    """An axis given as 'x', 'y', 'z' (optionally with a sign) or a 3-vector of unit length."""
+    """A joint axis: ``'x'``, ``'y'``, ``'z'`` (optionally signed) or a 3-vector along it.
+
+    A vector gives the direction only and is made a unit vector by :func:`unit_axis`, so
+    ``(1, 1, 0)`` is the axis ``(√2/2, √2/2, 0)``; the zero vector is refused. ``where`` names
+    the joint or step for the error message.
+    """
     if isinstance(value, str):
         s = value.strip().lower()
         sign = -1 if s.startswith("-") else 1
@@ -93,15 +98,42 @@ def axis_vector(value: object, where: str) -> tuple[Expr, ...]:
                 f"{where}: expected one of x, y, z or a 3-vector, got {value!r}"
             )
         return tuple(se.Integer(sign * c) for c in _AXES[s])
-    vec = as_vector(value, where)
-    free = set().union(*(v.free_symbols for v in vec))
-    if not free:
-        norm2 = sum(float(v) ** 2 for v in vec)
-        if abs(norm2 - 1.0) > 1e-12:
-            if norm2 == 0.0:
-                raise ModelError(f"{where}: axis must not be the zero vector")
-            raise ModelError(f"{where}: axis {tuple(float(v) for v in vec)} is not a unit vector")
-    return vec
+    u = unit_axis(as_vector(value, where))
+    if u is None:
+        raise ModelError(f"{where} must not be the zero vector")
+    return u
+
+
+def unit_axis(vec: Sequence[Expr]) -> tuple[Expr, ...] | None:
+    """The unit vector u/|u| along the 3-vector ``vec``; None for the zero vector.
+
+    The one rule for joint axes, in the Python API and in model files alike. A constant vector
+    is divided by its length, exactly for integers and rationals (``(3, 4, 0)`` → ``(3/5, 4/5,
+    0)``), and kept as given when its length is 1 to rounding (1e-12). A vector with parameters
+    is kept as given when u·u simplifies to 1 (SymPy's ``simplify``: ``(sin(b), 0, cos(b))``),
+    and divided by its symbolic length √(u·u) otherwise, so it is a unit vector for every value
+    of the parameters where it is not zero (:class:`jourdain.System` checks that it is not zero
+    at the default values).
+    """
+    u = tuple(vec)
+    n2 = se.expand(sum((c * c for c in u), se.Integer(0)))
+    if not n2.free_symbols:
+        length2 = float(n2)
+        if length2 == 0.0:
+            return None
+        if abs(length2 - 1.0) <= 1e-12:
+            return u
+    elif n2 == 1 or _simplifies_to_one(n2):
+        return u
+    length = se.sqrt(n2)
+    return tuple(c / length for c in u)
+
+
+def _simplifies_to_one(e: Expr) -> bool:
+    # only for axes with parameters, so SymPy is not imported on the common path
+    import sympy
+
+    return sympy.simplify(sympy.sympify(e) - 1) == 0
 
 
 def as_matrix3(value: object, where: str) -> tuple[tuple[Expr, ...], ...]:

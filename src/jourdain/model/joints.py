@@ -2,13 +2,17 @@
 
 Every joint is a sequence of *elementary transformations* applied one after the other, starting
 at the joint frame on the parent (the parent's body frame moved by ``position`` and turned by
-``orientation``): a rotation :class:`Rot` about a unit axis by an angle, or a translation
+``orientation``): a rotation :class:`Rot` about an axis by an angle, or a translation
 :class:`Trans` by a vector, each an expression in the coordinates ``y``, the parameters and the
 time ``t``. The frame reached at the end is the child body's frame. Standard joints (revolute,
 prismatic, ...) are just named sequences; a :func:`General` joint takes any sequence, so prescribed
 (rheonomic) motions such as a disc turning at ``Omega*t`` are written the same way.
 
 Axes are given in the frame *before* the transformation (the current frame), as in Neweul-M².
+An axis is ``"x"``, ``"y"``, ``"z"`` (or ``"-x"``, ...) or a 3-vector that gives its direction:
+a vector is made a unit vector (``(1, 1, 0)`` is the axis ``(√2/2, √2/2, 0)``; see
+:func:`jourdain.model.expressions.unit_axis` for vectors with parameters) and the zero vector
+is refused, the same rule as in model files. Axes may depend on parameters only.
 """
 
 from __future__ import annotations
@@ -33,7 +37,11 @@ IDENTITY: Mat3 = (
 
 @dataclass(frozen=True)
 class Rot:
-    """Elementary rotation about the unit ``axis`` (current frame) by ``angle`` (rad)."""
+    """Elementary rotation about ``axis`` (current frame) by ``angle`` (rad).
+
+    ``axis`` is ``"x"``, ``"y"``, ``"z"`` (optionally signed) or a nonzero 3-vector, stored as
+    the unit vector along it.
+    """
 
     axis: Vec3
     angle: Expr
@@ -51,8 +59,9 @@ class Rot:
 class Trans:
     """Elementary translation by ``distance`` along ``axis``, or by a 3-vector ``vector``.
 
-    ``Trans("x", s)`` moves by ``s`` along the current x axis; ``Trans(vector=(a, b, c))`` by an
-    arbitrary vector in the current frame (each component may depend on y and t).
+    ``Trans("x", s)`` moves by ``s`` along the current x axis (a vector ``axis`` is made a unit
+    vector, so ``s`` is the distance); ``Trans(vector=(a, b, c))`` by an arbitrary vector in the
+    current frame (each component may depend on y and t).
     """
 
     axis: Vec3 | None
@@ -157,32 +166,38 @@ def _coords(name: str, cs: Sequence[object], n: int) -> tuple[se.Symbol, ...]:
 
 def Revolute(name: str, coordinate: object, axis: object = "z", *, position: object = None,
              orientation: object = None) -> Joint:
-    """Revolute (hinge) joint: rotation by ``coordinate`` about ``axis`` of the joint frame."""
+    """Revolute (hinge) joint: rotation by ``coordinate`` about ``axis`` of the joint frame
+    (``"x"``, ``"y"``, ``"z"`` or a nonzero 3-vector, normalized)."""
     q = _coord(name, coordinate)
+    u = axis_vector(axis, f'joint "{name}" axis')
     pos, ori = _frame(name, position, orientation)
-    return Joint(name, "revolute", (q,), (Rot(axis, q),), pos, ori)
+    return Joint(name, "revolute", (q,), (Rot(u, q),), pos, ori)
 
 
 def Prismatic(name: str, coordinate: object, axis: object = "x", *, position: object = None,
               orientation: object = None) -> Joint:
-    """Prismatic (slider) joint: translation by ``coordinate`` along ``axis``."""
+    """Prismatic (slider) joint: translation by ``coordinate`` along ``axis`` (``"x"``, ``"y"``,
+    ``"z"`` or a nonzero 3-vector, normalized, so ``coordinate`` is the distance)."""
     q = _coord(name, coordinate)
+    u = axis_vector(axis, f'joint "{name}" axis')
     pos, ori = _frame(name, position, orientation)
-    return Joint(name, "prismatic", (q,), (Trans(axis, q),), pos, ori)
+    return Joint(name, "prismatic", (q,), (Trans(u, q),), pos, ori)
 
 
 def Cylindrical(name: str, coordinates: Sequence[object], axis: object = "z", *,
                 position: object = None, orientation: object = None) -> Joint:
     """Cylindrical joint: rotation ``coordinates[0]`` about and translation ``coordinates[1]``
-    along the same ``axis``."""
+    along the same ``axis`` (normalized, as for :func:`Revolute`)."""
     phi, s = _coords(name, coordinates, 2)
+    u = axis_vector(axis, f'joint "{name}" axis')
     pos, ori = _frame(name, position, orientation)
-    return Joint(name, "cylindrical", (phi, s), (Trans(axis, s), Rot(axis, phi)), pos, ori)
+    return Joint(name, "cylindrical", (phi, s), (Trans(u, s), Rot(u, phi)), pos, ori)
 
 
 def Universal(name: str, coordinates: Sequence[object], axes: Sequence[object] = ("x", "y"), *,
               position: object = None, orientation: object = None) -> Joint:
-    """Universal (Cardan) joint: rotation about ``axes[0]``, then about the turned ``axes[1]``."""
+    """Universal (Cardan) joint: rotation about ``axes[0]``, then about the turned ``axes[1]``
+    (each normalized, as for :func:`Revolute`)."""
     a, b = _coords(name, coordinates, 2)
     if len(axes) != 2:
         raise ModelError(f'joint "{name}": a universal joint needs two axes')

@@ -58,7 +58,11 @@ class System:
     coordinates : sequence of symbols or names
         The generalized coordinates ``y`` (f of them). Their rates are named ``<name>_d``.
     bodies : sequence of Body
-        Each hangs from ``"world"`` or from another body through its joint.
+        Each hangs from ``"world"`` or from another body through its joint. The order is kept:
+        it is the order of :attr:`bodies`, of the body rows of M̄, J̄, q̄^c, q̄^e and of the
+        joints in the reactions g. Every parent must come before its children (any such order
+        is valid for the method); a child listed before its parent raises a ModelError naming
+        both and their positions.
     forces : sequence of force elements
         Gravity, Force, Torque, SpringDamper, GeneralizedForce (RotationalSpringDamper).
     parameters : mapping name -> default value
@@ -111,7 +115,7 @@ class System:
         for f in forces:
             if not isinstance(f, Gravity | Force | Torque | SpringDamper | GeneralizedForce):
                 raise ModelError(f"forces: expected force elements, got {type(f).__name__} {f!r}")
-        set_(self, "bodies", _tree_order(bodies))
+        set_(self, "bodies", _parents_first(bodies))
         set_(self, "forces", tuple(forces))
         _validate(self)
 
@@ -236,31 +240,43 @@ class System:
                 f"inputs={self.input_names})")
 
 
-def _tree_order(bodies: list[Body]) -> tuple[Body, ...]:
-    """Bodies ordered so that every parent comes before its children (stable otherwise)."""
-    names: dict[str, Body] = {}
-    for b in bodies:
-        if b.name in names:
+def _parents_first(bodies: list[Body]) -> tuple[Body, ...]:
+    """The bodies in the order given, checked to list every parent before its children.
+
+    The rows of M̄, J̄, q̄^c, q̄^e and the joints of g follow this order. Any order with parents
+    first is valid for the method, so the user's is kept; one with a child before its parent is
+    refused instead of being rearranged behind the user's back.
+    """
+    position: dict[str, int] = {}
+    for k, b in enumerate(bodies):
+        if b.name in position:
             raise ModelError(f'duplicate body name "{b.name}"')
-        names[b.name] = b
+        position[b.name] = k
     for b in bodies:
-        if b.parent != WORLD and b.parent not in names:
+        if b.parent != WORLD and b.parent not in position:
             raise ModelError(
                 f'body "{b.name}": unknown parent "{b.parent}" (not a body and not "world")'
             )
-    order: list[Body] = []
-    placed: set[str] = set()
-    remaining = list(bodies)
-    while remaining:
-        progress = [b for b in remaining if b.parent == WORLD or b.parent in placed]
-        if not progress:
-            cyc = ", ".join(f'"{b.name}"' for b in remaining)
-            raise ModelError(f"bodies {cyc} are not connected to the inertial frame (a cycle of parents)")
-        for b in progress:
-            order.append(b)
-            placed.add(b.name)
-        remaining = [b for b in remaining if b.name not in placed]
-    return tuple(order)
+    # with every parent listed first the parents cannot form a cycle; where one is listed
+    # later, a cycle is reported as such rather than as a matter of order
+    parent = {b.name: b.parent for b in bodies}
+    for k, b in enumerate(bodies):
+        if b.parent == WORLD or position[b.parent] < k:
+            continue
+        chain = [b.name]
+        while parent[chain[-1]] != WORLD and parent[chain[-1]] not in chain:
+            chain.append(parent[chain[-1]])
+        if parent[chain[-1]] != WORLD:
+            cycle = " → ".join([*chain[chain.index(parent[chain[-1]]):], parent[chain[-1]]])
+            raise ModelError(
+                f'body "{b.name}" is not connected to the inertial frame (a cycle of parents: '
+                f'{cycle}); every chain of parents must end at "{WORLD}"'
+            )
+        raise ModelError(
+            f'body "{b.name}" (position {k + 1}) comes before its parent "{b.parent}" '
+            f"(position {position[b.parent] + 1}): list parents before their children"
+        )
+    return tuple(bodies)
 
 
 def _validate(sys: System) -> None:
@@ -313,6 +329,7 @@ def _validate(sys: System) -> None:
                 "depend on coordinates, parameters and t only"
             )
         used_coords |= names & set(y_names)
+        _check_axes(sys, b)
         # mass data
         mass_names = free_names([b.mass, *b.com, *(x for row in b.inertia for x in row)])
         bad = mass_names - set(p_names)
@@ -358,6 +375,31 @@ def _validate(sys: System) -> None:
         bad = free_names(exprs) - allowed_force - extra
         if bad:
             raise ModelError(f"{w}: undeclared symbol(s) {sorted(bad)}")
+
+
+def _check_axes(sys: System, b: Body) -> None:
+    """Axes of the joint's steps: constant in the frame before the step (parameters only, as
+    the kinematics takes u̇ = 0) and, for axes with parameters, not zero at the default values
+    (:func:`jourdain.model.expressions.unit_axis` divides them by their symbolic length)."""
+    j = b.joint
+    p_names = {k for k, _ in sys.parameters}
+    subs = {se.Symbol(k): v for k, v in sys.parameters}
+    for k, step in enumerate(j.steps):
+        u = step.axis
+        names = free_names(u) if u is not None else set()
+        if not names:
+            continue
+        axis = "the axis" if len({s.axis for s in j.steps}) == 1 else f"the axis of step {k}"
+        where = f'joint "{j.name}" (body "{b.name}"): {axis}'
+        bad = names - p_names
+        if bad:
+            raise ModelError(f"{where} uses {sorted(bad)}; axes may depend on parameters only")
+        try:
+            vals = [float(v) for v in se.DenseMatrix(3, 1, list(u)).subs(subs)]
+        except (RuntimeError, TypeError, ValueError):
+            vals = [math.nan]
+        if not all(math.isfinite(v) for v in vals):
+            raise ModelError(f"{where} is the zero vector at the default parameter values")
 
 
 def _check_mass(sys: System, b: Body) -> None:
