@@ -588,6 +588,30 @@ def _inverse(A: list[list[se.Basic]]) -> list[list[se.Basic]]:
     return [[c[j][i] / d for j in range(3)] for i in range(3)]
 
 
+@lru_cache(maxsize=32)
+def joint_directions(system: System) -> tuple[JointReactions, ...]:
+    """The constrained directions of every joint, in body order, with the names and columns of
+    their components of g (no Q̄ yet: that needs the kinematics)."""
+    params = system.parameter_values
+    joints: list[JointReactions] = []
+    start = 0
+    for body in system.bodies:
+        dirs = constrained_directions(body.joint, system.coordinates, params)
+        joints.append(JointReactions(
+            body.joint, body.name, body.parent,
+            tuple(f"{body.joint.name}.{suffix}" for suffix, _ in dirs),
+            tuple(w for _, w in dirs), tuple(range(start, start + len(dirs)))))
+        start += len(dirs)
+    return tuple(joints)
+
+
+@lru_cache(maxsize=32)
+def _checked_joints(system: System) -> dict[str, str]:
+    """:func:`check_joints` of :func:`joint_directions` (ModelError for a direction that does
+    work), once per system."""
+    return check_joints(system, joint_directions(system))
+
+
 def reactions(ne: NewtonEuler) -> Reactions:
     """Q̄ from the joints and N̂, k̂, q̂ (METHOD.md §4); checks ``J̄ᵀQ̄ = 0``.
 
@@ -612,24 +636,21 @@ def reactions(ne: NewtonEuler) -> Reactions:
     bodies = system.bodies
     p = len(bodies)
     row = _body_rows(system)
-    params = system.parameter_values
+    joints = joint_directions(system)
+    names = [n for jr in joints for n in jr.names]
     # columns of Q̄, sparse: per column {row: expression}
     cols: list[dict[int, se.Basic]] = []
     # per column, its force on each body in that body's own frame (for N̂: SᵀS = E is then
     # never left for the simplifier to find)
     local: list[dict[int, Vec3]] = []
-    names: list[str] = []
-    joints: list[JointReactions] = []
-    for body, bk in zip(bodies, kin.bodies, strict=True):
+    for body, bk, jr in zip(bodies, kin.bodies, joints, strict=True):
         j = body.joint
-        dirs = constrained_directions(j, system.coordinates, params)
         S = bk.S.rows
         R_pc, o_pc = joint_transform(j)
         c_c = body.com
         i = row[body.name]
         parent = None if body.parent == WORLD else system.body(body.parent)
-        start = len(cols)
-        for suffix, w in dirs:
+        for w in jr.wrenches:
             F, T = w[:3], w[3:]
             col: dict[int, se.Basic] = {}
             SF = _mv(S, F)
@@ -647,10 +668,6 @@ def reactions(ne: NewtonEuler) -> Reactions:
                     col[3 * p + 3 * k + a] = -rot_p[a]
             cols.append({r: e for r, e in col.items() if e != 0})
             local.append({i: F} if parent is None else {i: F, row[parent.name]: _scale(RF, -1)})
-            names.append(f"{j.name}.{suffix}")
-        joints.append(JointReactions(j, body.name, body.parent, tuple(n for n in names[start:]),
-                                     tuple(w for _, w in dirs),
-                                     tuple(range(start, len(cols)))))
     q = len(cols)
     n6 = 6 * p
     Q_rows = [[ZERO] * q for _ in range(n6)]
@@ -658,7 +675,7 @@ def reactions(ne: NewtonEuler) -> Reactions:
         for r, e in col.items():
             Q_rows[r][c] = e
     Q_bar = SymMatrix.from_rows(Q_rows)
-    verified = check_joints(system, joints)
+    verified = _checked_joints(system)
     singular, inv = _singular_rows(system)
     # N̂, k̂, q̂ body by body over the regular rows (M̄ block diagonal)
     N = [[[] for _ in range(q)] for _ in range(q)]
@@ -786,10 +803,12 @@ def check_joints(system: System, joints: Sequence[JointReactions], samples: int 
 
 
 def check_orthogonality(r: Reactions, samples: int = 3, seed: int = 7, fn: Any = None) -> float:
-    """The orthogonality relation ``J̄ᵀ·Q̄ = 0`` of the assembled matrices, checked with the
-    compiled J̄ and Q̄ (``fn``: a compiled function giving ``J_bar`` and ``Q_bar``, compiled
-    here when not given) at random states (coordinates in (−π, π), t in (0, 2), parameters within
-    10 % of their defaults), and that ``[J̄, Q̄]`` is square and regular (no reaction missing).
+    """The orthogonality relation ``J̄ᵀ·Q̄ = 0`` of the assembled symbolic matrices of ``r``,
+    checked with J̄ and Q̄ compiled (``fn``: a compiled function giving ``J_bar`` and ``Q_bar``,
+    compiled here from ``r`` when not given) at random states (coordinates in (−π, π), t in
+    (0, 2), parameters within 10 % of their defaults), and that ``[J̄, Q̄]`` is square and
+    regular (no reaction missing). :meth:`jourdain.System.evaluate` checks its own numeric Q̄
+    the same way before it gives reaction forces.
 
     Returns the largest relative residual ``|J̄ᵀQ̄| / (|J̄|ᵀ|Q̄|)`` over the columns; raises
     :class:`ModelError` naming the joint and the direction of a column that does work.
@@ -799,15 +818,21 @@ def check_orthogonality(r: Reactions, samples: int = 3, seed: int = 7, fn: Any =
         from .numeric import lambdify
 
         fn = lambdify(system, {"J_bar": r.newton_euler.J_bar, "Q_bar": r.Q_bar})
+    lay = ReactionLayout(r.joints, r.g_names, r.singular_rows, ())
+    return _check_assembled(system, lay, fn, samples, seed)
+
+
+def _check_assembled(system: System, lay: ReactionLayout, fn: Any, samples: int = 3,
+                     seed: int = 7) -> float:
     rng = np.random.default_rng(seed)
     pv = np.array(list(system.parameter_values.values()), dtype=float)
     worst = 0.0
-    n6 = r.Q_bar.shape[0]
     for _ in range(samples):
         y = rng.uniform(-math.pi, math.pi, system.f)
         out = fn(y, np.zeros(system.f), float(rng.uniform(0, 2)), pv * rng.uniform(0.9, 1.1, pv.size),
                  np.zeros(len(system.inputs)))
         J, Q = out["J_bar"], out["Q_bar"]
+        n6 = J.shape[0]
         JQ = J.T @ Q
         scale = (np.abs(J).T @ np.abs(Q)).max(axis=0) + 1e-300
         rel = np.abs(JQ).max(axis=0) / scale
@@ -815,7 +840,7 @@ def check_orthogonality(r: Reactions, samples: int = 3, seed: int = 7, fn: Any =
         bad = np.nonzero(rel > 1e-9)[0]
         if bad.size:
             c = int(bad[0])
-            jr = next(j for j in r.joints if c in j.columns)
+            jr = next(j for j in lay.joints if c in j.columns)
             raise ModelError(
                 f'joint "{jr.joint.name}" (body "{jr.child}"): its constrained direction '
                 f'"{jr.names[jr.columns.index(c)]}" does work in an admissible motion (relative '
@@ -920,21 +945,73 @@ def _project(jr: JointReactions, W: Wrench) -> list[se.Basic]:
 
 
 # --- numbers -------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class ReactionLayout:
+    """What the numeric reactions need besides the compiled matrices: the joints with their
+    constrained directions, the names of g, the rows of M̄ without inertia, and per body the
+    columns of Q̄ that touch it (its joint's and its children's joints' directions)."""
+
+    joints: tuple[JointReactions, ...]
+    g_names: tuple[str, ...]
+    singular_rows: tuple[int, ...]
+    touching: tuple[tuple[int, ...], ...]
+
+
 @lru_cache(maxsize=32)
-def _compiled(system: System) -> tuple[Reactions, Any]:
-    from .numeric import lambdify
+def _reactions_function(system: System) -> tuple[ReactionLayout, Any]:
+    """The compiled Newton–Euler matrices with Q̄ (:func:`jourdain.numeric.recursive`), after
+    the joint-by-joint check and the check of the assembled J̄ᵀ·Q̄ = 0; ModelError when the
+    model's reactions cannot be formed."""
+    from .numeric import _eom_function
 
-    r = reactions(system.newton_euler())
-    return r, lambdify(system, {"Q_bar": r.Q_bar, "N_hat": r.N_hat, "k_hat": r.k_hat,
-                                "q_hat": r.q_hat, "J_bar": r.newton_euler.J_bar})
+    joints = joint_directions(system)
+    _checked_joints(system)
+    fn = _eom_function(system)
+    index = _body_rows(system)
+    touching: list[list[int]] = [list(jr.columns) for jr in joints]
+    for b, jr in zip(system.bodies, joints, strict=True):
+        if b.parent != WORLD:
+            touching[index[b.parent]].extend(jr.columns)
+    lay = ReactionLayout(joints, tuple(n for jr in joints for n in jr.names),
+                         _singular_rows(system)[0], tuple(tuple(sorted(t)) for t in touching))
+    _check_assembled(system, lay, fn)
+    return lay, fn
 
 
-@lru_cache(maxsize=32)
-def _reactions_function(system: System) -> tuple[Reactions, Any]:
-    """Compiled reactions of ``system``, after the check of the assembled J̄ᵀ·Q̄ = 0."""
-    r, fn = _compiled(system)
-    check_orthogonality(r, fn=fn)
-    return r, fn
+def projected_reactions(lay: ReactionLayout, M_bar: np.ndarray, Q_bar: np.ndarray,
+                        q_c: np.ndarray, q_e: np.ndarray
+                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``N̂ = Q̄_rᵀM̄_r⁻¹Q̄_r``, ``k̂ = Q̄_rᵀM̄_r⁻¹q̄^c_r``, ``q̂ = Q̄_rᵀM̄_r⁻¹q̄^e_r`` in numbers over
+    the regular rows r of M̄ (METHOD.md §4), for one state or a batch (leading axes).
+
+    M̄ is block diagonal, so the products are formed body by body from the few columns of Q̄
+    that touch each body (O(p) small products, never a 6p×6p solve); with the Cholesky factor
+    C of each block, ``N̂ += (C⁻¹Q̄_b)ᵀ(C⁻¹Q̄_b)``, so N̂ is exactly symmetric.
+    """
+    lead = Q_bar.shape[:-2]
+    n6, q = Q_bar.shape[-2:]
+    p = n6 // 6
+    singular = set(lay.singular_rows)
+    N = np.zeros((*lead, q, q))
+    kh = np.zeros((*lead, q))
+    qh = np.zeros((*lead, q))
+    for i in range(p):
+        cols = list(lay.touching[i])
+        if not cols:
+            continue
+        for base in (3 * i, 3 * p + 3 * i):
+            rows = [base + a for a in range(3) if base + a not in singular]
+            if not rows:
+                continue
+            Mb = M_bar[..., rows, :][..., :, rows]
+            C = np.linalg.cholesky(Mb)
+            B = np.linalg.solve(C, Q_bar[..., rows, :][..., :, cols])
+            bc = np.linalg.solve(C, q_c[..., rows, None])[..., 0]
+            be = np.linalg.solve(C, q_e[..., rows, None])[..., 0]
+            N[..., np.ix_(cols, cols)[0], np.ix_(cols, cols)[1]] += np.swapaxes(B, -1, -2) @ B
+            kh[..., cols] += np.einsum("...rc,...r->...c", B, bc)
+            qh[..., cols] += np.einsum("...rc,...r->...c", B, be)
+    return 0.5 * (N + np.swapaxes(N, -1, -2)), kh, qh
 
 
 def solve_g(Q_bar: np.ndarray, N_hat: np.ndarray, k_hat: np.ndarray, q_hat: np.ndarray,
@@ -988,23 +1065,16 @@ def evaluate_reactions(system: System, y: Any, yd: Any, t: float = 0.0,
     :func:`jourdain.numeric.evaluate` at the same state, if already at hand.
     """
     from .numeric import evaluate as evaluate_eom
-    from .numeric import state_vectors
 
-    args = state_vectors(system, y, yd, t, parameters, inputs)
-    r, fn = _reactions_function(system)
-    out = fn(*args)
-    Q = out["Q_bar"]
-    N = out["N_hat"]
-    kh, qh = out["k_hat"].reshape(-1), out["q_hat"].reshape(-1)
-    if r.singular_rows:
-        if eom is None:
-            eom = evaluate_eom(system, y, yd, t=t, parameters=parameters, inputs=inputs)
-        qc, qe = np.asarray(eom["q_c"]).reshape(-1), np.asarray(eom["q_e"]).reshape(-1)
-    else:
-        qc = qe = np.zeros(Q.shape[0])
-    g, und = solve_g(Q, N, kh, qh, qc, qe, r.singular_rows, r.g_names)
+    lay, _ = _reactions_function(system)
+    if eom is None or "Q_bar" not in eom:
+        eom = evaluate_eom(system, y, yd, t=t, parameters=parameters, inputs=inputs)
+    Q = np.asarray(eom["Q_bar"])
+    qc, qe = np.asarray(eom["q_c"]).reshape(-1), np.asarray(eom["q_e"]).reshape(-1)
+    N, kh, qh = projected_reactions(lay, np.asarray(eom["M_bar"]), Q, qc, qe)
+    g, und = solve_g(Q, N, kh, qh, qc, qe, lay.singular_rows, lay.g_names)
     return {"Q_bar": Q, "N_hat": N, "k_hat": kh, "q_hat": qh, "g": g,
-            "g_names": list(r.g_names), "g_undetermined": und}
+            "g_names": list(lay.g_names), "g_undetermined": und}
 
 
 @lru_cache(maxsize=64)

@@ -249,32 +249,27 @@ class Results:
 
     def _reactions(self) -> None:
         system = self._need_system("the reaction forces")
-        from .numeric import _eom_function
-        from .reactions import _reactions_function, solve_g
+        from .reactions import _reactions_function, projected_reactions, solve_g
 
-        r, fn = _reactions_function(system)
+        lay, fn = _reactions_function(system)
         p = np.array([self.parameters[k] for k, _ in system.parameters])
         U = self.u if self.u.shape[1] else None
         out = fn.batch(self.y, self.yd, self.t, p, U)
-        if r.singular_rows:
-            eo = _eom_function(system).batch(self.y, self.yd, self.t, p, U)
-            qc, qe = eo["q_c"][:, :, 0], eo["q_e"][:, :, 0]
-        else:
-            qc = qe = np.zeros((len(self.t), out["Q_bar"].shape[1]))
+        qc, qe = out["q_c"][:, :, 0], out["q_e"][:, :, 0]
+        N, kh, qh = projected_reactions(lay, out["M_bar"], out["Q_bar"], qc, qe)
         g = None
-        if not r.singular_rows:  # N̂ g = k̂ − q̂ for all states in one batched solve
+        if not lay.singular_rows:  # N̂ g = k̂ − q̂ for all states in one batched solve
             try:
-                g = np.linalg.solve(out["N_hat"], out["k_hat"] - out["q_hat"])[:, :, 0]
+                g = np.linalg.solve(N, (kh - qh)[:, :, None])[:, :, 0]
             except np.linalg.LinAlgError:
                 g = None
         if g is None:  # bodies without inertia or redundant directions: state by state
-            g = np.empty((len(self.t), out["N_hat"].shape[1]))
+            g = np.empty((len(self.t), N.shape[1]))
             for i in range(len(self.t)):
-                g[i], _ = solve_g(out["Q_bar"][i], out["N_hat"][i], out["k_hat"][i, :, 0],
-                                  out["q_hat"][i, :, 0], qc[i], qe[i], r.singular_rows,
-                                  r.g_names)
+                g[i], _ = solve_g(out["Q_bar"][i], N[i], kh[i], qh[i], qc[i], qe[i],
+                                  lay.singular_rows, lay.g_names)
         self._energies["g"] = g
-        self._energies["g_names"] = list(r.g_names)
+        self._energies["g_names"] = list(lay.g_names)
 
     def positions(self, body: str, point: str = "origin") -> np.ndarray:
         """Inertial position of a body's frame origin (``point="origin"``) or centre of mass

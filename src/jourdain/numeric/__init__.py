@@ -25,7 +25,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import symengine as se
 
-from ..errors import EvaluationError
+from ..errors import EvaluationError, JourdainError
+from ..reactions import joint_directions
 from ..symbolic import SymMatrix
 from .ccode import HEADER, argument_names, function_source
 from .recursive import recursive_source
@@ -263,7 +264,8 @@ def _interpreted(system: System, names: tuple[str, ...], shapes: tuple[tuple[int
                                len(system.inputs), fn)
 
 
-def _recursive(system: System, full: bool, extra_source: str = "") -> CompiledFunction:
+def _recursive(system: System, full: bool, extra_source: str = "",
+               directions: tuple | None = None) -> CompiledFunction:
     """Compile :func:`.recursive.recursive_source` (no symbolic M is formed)."""
     f, p = system.f, len(system.bodies)
     names: tuple[str, ...] = ("M", "k", "q")
@@ -271,6 +273,9 @@ def _recursive(system: System, full: bool, extra_source: str = "") -> CompiledFu
     if full:
         names = ("M_bar", "J_bar", "q_c", "q_e", *names)
         shapes = ((6 * p, 6 * p), (6 * p, f), (6 * p, 1), (6 * p, 1), *shapes)
+    if directions is not None:
+        names = (*names, "Q_bar")
+        shapes = (*shapes, (6 * p, sum(len(w) for w in directions)))
     try:
         compiler()
     except CompilerError:
@@ -279,8 +284,12 @@ def _recursive(system: System, full: bool, extra_source: str = "") -> CompiledFu
         if full:
             ne = eom.newton_euler
             mats = {"M_bar": ne.M_bar, "J_bar": ne.J_bar, "q_c": ne.q_c, "q_e": ne.q_e, **mats}
+        if directions is not None:
+            from ..reactions import reactions
+
+            mats["Q_bar"] = reactions(eom.newton_euler).Q_bar
         return lambdify(system, mats, extra_source)
-    source = HEADER + recursive_source(system, full) + extra_source
+    source = HEADER + recursive_source(system, full, directions) + extra_source
     key = content_key(_GENERATOR_VERSION, source)
     lib = build(key, source)
     vp = ctypes.c_void_p
@@ -295,7 +304,13 @@ def _recursive(system: System, full: bool, extra_source: str = "") -> CompiledFu
 
 @lru_cache(maxsize=32)
 def _eom_function(system: System) -> CompiledFunction:
-    return _recursive(system, full=True)
+    """M̄, J̄, q̄^c, q̄^e, M, k, q and, where the joints' constrained directions can be formed,
+    Q̄ (:func:`jourdain.reactions.joint_directions`), compiled by the recursion."""
+    try:
+        directions = tuple(jr.wrenches for jr in joint_directions(system))
+    except JourdainError:  # the equations of motion exist; the reactions report the reason
+        directions = None
+    return _recursive(system, full=True, directions=directions)
 
 
 #: largest f for which the integrator's jd_accel is compiled (its work arrays live on the stack)

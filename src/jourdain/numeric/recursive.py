@@ -61,14 +61,18 @@ class RecursiveLayout:
     parent: tuple[int, ...]
     columns: tuple[tuple[int, ...], ...]
     exprs: tuple[se.Basic, ...]
+    #: number of constrained directions of each joint (their wrenches follow the columns)
+    directions: tuple[int, ...] = ()
 
     @property
     def n_columns(self) -> int:
         return sum(len(c) for c in self.columns)
 
 
-def layout(system: System) -> RecursiveLayout:
-    """The local expressions of every joint and body, in the order of the C arrays."""
+def layout(system: System, directions: tuple | None = None) -> RecursiveLayout:
+    """The local expressions of every joint and body, in the order of the C arrays;
+    ``directions``: per body the unit wrenches of its joint's constrained directions
+    (:func:`jourdain.reactions.joint_directions`), for Q̄."""
     from ..kinematics import kinematics
     from ..newton_euler import applied_forces
 
@@ -95,7 +99,9 @@ def layout(system: System) -> RecursiveLayout:
             col_exprs.extend((*jm.J_R.get(j, z3), *jm.J_T.get(j, z3)))
         cols.append(js)
     parent = tuple(-1 if b.parent == "world" else index[b.parent] for b in system.bodies)
-    return RecursiveLayout(parent, tuple(cols), tuple(exprs + col_exprs))
+    dir_exprs = [x for ws in (directions or ()) for w in ws for x in w]
+    return RecursiveLayout(parent, tuple(cols), tuple(exprs + col_exprs + dir_exprs),
+                           tuple(len(ws) for ws in directions) if directions else ())
 
 
 def _table(name: str, values: list[int]) -> str:
@@ -103,11 +109,13 @@ def _table(name: str, values: list[int]) -> str:
     return f"static const int {name}[{max(len(values), 1)}] = {{{body}}};\n"
 
 
-def recursive_source(system: System, full: bool = False) -> str:
+def recursive_source(system: System, full: bool = False, directions: tuple | None = None
+                     ) -> str:
     """C source of ``jd_fn(y, yd, t, p, u, out)`` with ``out = [M (f×f), k (f), q (f)]``, and
     with ``full`` ``out = [M_bar, J_bar, q_c, q_e, M, k, q]`` (the layout of
-    :func:`jourdain.numeric.evaluate`); plus ``jd_fn_batch``."""
-    lay = layout(system)
+    :func:`jourdain.numeric.evaluate`), followed by ``Q_bar`` (6p×q) when ``directions`` (per
+    body, the unit wrenches of its joint) are given; plus ``jd_fn_batch``."""
+    lay = layout(system, directions)
     p = len(lay.parent)
     f = system.f
     names = argument_names(system.y, system.yd, system.t, system.parameter_symbols,
@@ -118,13 +126,21 @@ def recursive_source(system: System, full: bool = False) -> str:
     for c in lay.columns:
         col_coord.extend(c)
         col_start.append(col_start[-1] + len(c))
-    size = (36 * p * p + 6 * p * f + 12 * p if full else 0) + f * f + 2 * f
+    n_q = sum(lay.directions)
+    dir_start = [0]
+    for nd in lay.directions:
+        dir_start.append(dir_start[-1] + nd)
+    size = ((36 * p * p + 6 * p * f + 12 * p if full else 0) + f * f + 2 * f
+            + (6 * p * n_q if lay.directions else 0))
     head = (f"#define JD_P {p}\n#define JD_F {f}\n#define JD_NC {max(len(col_coord), 1)}\n"
             f"#define JD_NL {len(lay.exprs)}\n#define JD_COLS {p * BODY_BLOCK}\n"
+            f"#define JD_DIRS {p * BODY_BLOCK + COLUMN_BLOCK * len(col_coord)}\n"
             f"#define JD_SIZE {size}\n#define JD_FULL {1 if full else 0}\n"
+            f"#define JD_Q {n_q}\n#define JD_QBAR {1 if lay.directions else 0}\n"
             + _table("jd_parent", list(lay.parent))
             + _table("jd_col_start", col_start)
-            + _table("jd_col_coord", col_coord))
+            + _table("jd_col_coord", col_coord)
+            + _table("jd_dir_start", dir_start if lay.directions else [0]))
     return local + head + ENGINE
 
 
@@ -341,6 +357,40 @@ static void jd_newton_euler(const double *L, const jd_work *W, double *out) {
 }
 #endif
 
+#if JD_QBAR
+/* Q̄ (6p×q): each constrained direction (F, T), given in the child frame at its origin, acts
+   on the child and, reversed, on the parent; rows as in M̄ (translational inertial, rotational
+   in each body's frame about its centre of mass) */
+static void jd_distribution(const double *L, const jd_work *W, double *Q) {
+    const long n = 6 * JD_P;
+    for (long a = 0; a < n * JD_Q; ++a) Q[a] = 0.0;
+    for (int i = 0; i < JD_P; ++i) {
+        const double *b = L + i * 40, *A = b, *d = b + 9, *com = b + 25, *R = W->fr[i].R;
+        int lam = jd_parent[i];
+        for (int k = jd_dir_start[i]; k < jd_dir_start[i + 1]; ++k) {
+            const double *F = L + JD_DIRS + 6 * k, *T = F + 3;
+            double SF[3], cF[3], AF[3], AT[3], arm[3], aF[3];
+            jd_mv(R, F, SF);
+            jd_cross(com, F, cF);
+            for (int a = 0; a < 3; ++a) {
+                Q[(3 * i + a) * JD_Q + k] = SF[a];
+                Q[(3 * JD_P + 3 * i + a) * JD_Q + k] = T[a] - cF[a];
+            }
+            if (lam < 0) continue;
+            const double *comp = L + lam * 40 + 25;
+            jd_mv(A, F, AF);
+            jd_mv(A, T, AT);
+            for (int a = 0; a < 3; ++a) arm[a] = d[a] - comp[a];
+            jd_cross(arm, AF, aF);
+            for (int a = 0; a < 3; ++a) {
+                Q[(3 * lam + a) * JD_Q + k] = -SF[a];
+                Q[(3 * JD_P + 3 * lam + a) * JD_Q + k] = -(AT[a] + aF[a]);
+            }
+        }
+    }
+}
+#endif
+
 void jd_fn(const double *y, const double *yd, double t, const double *p, const double *u,
            double *out) {
     double L[JD_NL > 0 ? JD_NL : 1];
@@ -355,6 +405,9 @@ void jd_fn(const double *y, const double *yd, double t, const double *p, const d
     double *M = out;
 #endif
     jd_project(W, M, M + JD_F * JD_F, M + JD_F * JD_F + JD_F);
+#if JD_QBAR
+    jd_distribution(L, W, M + JD_F * JD_F + 2 * JD_F);
+#endif
     free(W);
 }
 
