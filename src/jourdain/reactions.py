@@ -1022,14 +1022,13 @@ def solve_g(Q_bar: np.ndarray, N_hat: np.ndarray, k_hat: np.ndarray, q_hat: np.n
 
     Returns ``g`` (NaN where undetermined) and the names of the undetermined components.
     """
-    import scipy.linalg as sla
-
     q = N_hat.shape[0]
     rhs = k_hat - q_hat
     s = list(singular_rows)
     if not s:
         try:
-            return sla.cho_solve(sla.cho_factor(N_hat), rhs), []
+            C = np.linalg.cholesky(N_hat)
+            return np.linalg.solve(C.T, np.linalg.solve(C, rhs)), []
         except np.linalg.LinAlgError:
             pass  # not positive definite: redundant directions; the general path says which
     Qs = Q_bar[s, :]

@@ -29,7 +29,7 @@ from ..errors import EvaluationError, JourdainError
 from ..reactions import joint_directions
 from ..symbolic import SymMatrix
 from .ccode import HEADER, argument_names, function_source
-from .recursive import recursive_source
+from .recursive import recursive_units
 from .toolchain import CompilerError, build, cache_dir, compiler, content_key
 
 if TYPE_CHECKING:
@@ -289,9 +289,9 @@ def _recursive(system: System, full: bool, extra_source: str = "",
 
             mats["Q_bar"] = reactions(eom.newton_euler).Q_bar
         return lambdify(system, mats, extra_source)
-    source = HEADER + recursive_source(system, full, directions) + extra_source
-    key = content_key(_GENERATOR_VERSION, source)
-    lib = build(key, source)
+    units = recursive_units(system, full, directions, extra_source)
+    key = content_key(_GENERATOR_VERSION, *units)
+    lib = build(key, units)
     vp = ctypes.c_void_p
     lib.jd_fn.restype = None
     lib.jd_fn.argtypes = [vp, vp, ctypes.c_double, vp, vp, vp]

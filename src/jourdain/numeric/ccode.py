@@ -121,10 +121,12 @@ def argument_names(y: Sequence[se.Symbol], yd: Sequence[se.Symbol], t: se.Symbol
 #: above this many temporaries, the body is split into functions of PART statements that share
 #: the temporaries in an array: C compilers take time superlinear in the size of one function
 #: (a 450 kB function of 12 spatial bodies: 35 s in one piece, a few seconds in parts)
-SPLIT_ABOVE = 600
+#: (measured for the per-joint code of spatial_chain(24), 900 temporaries: one function 1.8 s at
+#: -O2, parts of 200 statements 0.55 s)
+SPLIT_ABOVE = 200
 #: sin/cos of coordinates and of their sums and differences by the addition theorems
 TRIG_SUMS = True
-PART = 250
+PART = 200
 
 
 def function_source(name: str, exprs: Sequence[se.Basic], names: Mapping[str, str]) -> str:

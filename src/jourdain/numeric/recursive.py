@@ -42,7 +42,7 @@ from typing import TYPE_CHECKING
 import symengine as se
 
 from ..kinematics import joint_motions
-from .ccode import argument_names, function_source
+from .ccode import HEADER, argument_names, function_source
 
 if TYPE_CHECKING:
     from ..model.system import System
@@ -109,6 +109,17 @@ def _table(name: str, values: list[int]) -> str:
     return f"static const int {name}[{max(len(values), 1)}] = {{{body}}};\n"
 
 
+def recursive_units(system: System, full: bool = False, directions: tuple | None = None,
+                    extra_source: str = "") -> tuple[str, str]:
+    """:func:`recursive_source` as two translation units, compiled in parallel: the generated
+    per-joint code, and the engine with ``extra_source`` (which may call ``jd_fn``)."""
+    src = recursive_source(system, full, directions)
+    local, engine = src.split("\n/* ---- engine ---- */\n")
+    decl = ("void jd_local(const double *y, const double *yd, double t, const double *p,\n"
+            "              const double *u, double *out);\n")
+    return HEADER + local, HEADER + decl + engine + extra_source
+
+
 def recursive_source(system: System, full: bool = False, directions: tuple | None = None
                      ) -> str:
     """C source of ``jd_fn(y, yd, t, p, u, out)`` with ``out = [M (f×f), k (f), q (f)]``, and
@@ -141,7 +152,7 @@ def recursive_source(system: System, full: bool = False, directions: tuple | Non
             + _table("jd_col_start", col_start)
             + _table("jd_col_coord", col_coord)
             + _table("jd_dir_start", dir_start if lay.directions else [0]))
-    return local + head + ENGINE
+    return local + "\n/* ---- engine ---- */\n" + head + ENGINE
 
 
 # The engine: generic in the tables above. Spatial vectors about the inertial origin in inertial

@@ -16,6 +16,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+from collections.abc import Sequence
 from pathlib import Path
 
 from ..errors import JourdainError
@@ -76,11 +77,16 @@ def cached_library(key: str) -> ctypes.CDLL | None:
     return lib
 
 
-def build(key: str, source: str) -> ctypes.CDLL:
-    """Compile ``source`` to ``<cache>/<key>.so`` (unless there) and load it."""
+def build(key: str, source: str | Sequence[str]) -> ctypes.CDLL:
+    """Compile ``source`` to ``<cache>/<key>.so`` (unless there) and load it.
+
+    ``source`` may be several translation units: they are compiled in parallel (one compiler
+    process each) and linked into one library; ``<key>.c`` keeps them one after the other.
+    """
     lib = cached_library(key)
     if lib is not None:
         return lib
+    units = [source] if isinstance(source, str) else list(source)
     d = cache_dir()
     d.mkdir(parents=True, exist_ok=True)
     so = d / f"{key}.so"
@@ -89,18 +95,38 @@ def build(key: str, source: str) -> ctypes.CDLL:
     # (another process) never sees a half-written source or library
     fd, tmp = tempfile.mkstemp(suffix=".so", dir=d)
     os.close(fd)
-    fd, tmp_c = tempfile.mkstemp(suffix=".c", dir=d)
-    with os.fdopen(fd, "w") as fh:
-        fh.write(source)
+    tmp_units: list[str] = []
+    objects: list[str] = []
     try:
-        proc = subprocess.run([compiler(), *CFLAGS, "-o", tmp, tmp_c, "-lm"],
-                              capture_output=True, text=True)
-        os.replace(tmp_c, src)  # kept for reading, also when the compiler fails
-        if proc.returncode != 0:
-            raise CompilerError(f"compiling {src} failed:\n{proc.stderr[-4000:]}")
+        for text in units:
+            fd, tmp_c = tempfile.mkstemp(suffix=".c", dir=d)
+            with os.fdopen(fd, "w") as fh:
+                fh.write(text)
+            tmp_units.append(tmp_c)
+        if len(units) == 1:
+            procs = [subprocess.Popen([compiler(), *CFLAGS, "-o", tmp, tmp_units[0], "-lm"],
+                                      stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)]
+        else:
+            objects = [u[:-2] + ".o" for u in tmp_units]
+            flags = [f for f in CFLAGS if f != "-shared"]
+            procs = [subprocess.Popen([compiler(), *flags, "-c", "-o", o, u],
+                                      stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                     for u, o in zip(tmp_units, objects, strict=True)]
+        errors = [p.communicate()[1] for p in procs]
+        failed = [e for p, e in zip(procs, errors, strict=True) if p.returncode != 0]
+        if not failed and objects:
+            link = subprocess.run([compiler(), "-shared", "-o", tmp, *objects, "-lm"],
+                                  capture_output=True, text=True)
+            if link.returncode != 0:
+                failed.append(link.stderr)
+        # kept for reading, also when the compiler fails
+        with open(src, "w") as fh:
+            fh.write("\n".join(units))
+        if failed:
+            raise CompilerError(f"compiling {src} failed:\n{failed[0][-4000:]}")
         os.replace(tmp, so)
     finally:
-        for leftover in (tmp, tmp_c):
+        for leftover in (tmp, *tmp_units, *objects):
             if os.path.exists(leftover):
                 os.unlink(leftover)
     lib = ctypes.CDLL(str(so))
