@@ -155,3 +155,30 @@ def test_every_joint_and_force_newton_euler_residual(rng):
         res = (out["M_bar"] @ out["J_bar"] @ ydd + out["q_c"] - out["q_e"]
                - out["Q_bar"] @ out["g"])
         assert np.abs(res).max() <= newton_euler_tol(out, ydd)
+
+
+def test_joint_wrenches_equal_reaction_components(rng):
+    """CompiledFunction.dynamics gives each joint's wrench from the sub-tree's Newton–Euler
+    equations (the ÿ route); the reaction components g of N̂·g = k̂ − q̂ (METHOD.md §4, no ÿ)
+    along the joint's constrained directions w_k must compose the same wrench, Σ g_k·w_k."""
+    from jourdain.reactions import graph_values, joint_directions
+    from tests.tolerance import subtree_tol, tree_extent, ydd_tol
+
+    system = every_joint_and_force()
+    fn = mkq_function(system)
+    pv = np.array(list(system.parameter_values.values()))
+    for _ in range(3):
+        y, yd = rng.uniform(-1.5, 1.5, system.f), rng.uniform(-1, 1, system.f)
+        t, u = float(rng.uniform(0, 2)), [float(rng.uniform(-1, 1))]
+        out = system.evaluate(y, yd, t=t, inputs=u)
+        ydd, W = fn.dynamics(y[None], yd[None], t, pv, u)
+        tol = subtree_tol(out, ydd[0], tree_extent(system, y, t))
+        assert np.abs(ydd[0] - ydd_of(out)).max() <= ydd_tol(out, ydd[0])
+        vals = {**dict(zip(system.parameter_symbols, pv, strict=True)),
+                **dict(zip(system.y, y, strict=True)), system.t: t}
+        for b, jr in enumerate(joint_directions(system)):
+            if not jr.names:
+                continue  # a free joint transmits nothing
+            w = np.array(graph_values([x for wr in jr.wrenches for x in wr], vals), dtype=float)
+            ours = out["g"][list(jr.columns)] @ w.reshape(len(jr.names), 6)
+            assert np.abs(ours - W[0, b]).max() <= tol, jr.joint.name

@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import symengine as se
 
-from ..errors import EvaluationError, JourdainError
+from ..errors import EvaluationError, JourdainError, SingularMassMatrix
 from ..reactions import joint_directions
 from ..symbolic import SymMatrix
 from .ccode import HEADER, argument_names, function_source
@@ -65,6 +65,8 @@ class CompiledFunction:
     n_u: int
     lib: Any = field(repr=False)
     symbol: str = "jd_fn"
+    #: number of bodies (the joint wrenches of :meth:`dynamics`); 0 where not compiled with them
+    n_bodies: int = 0
 
     @property
     def size(self) -> int:
@@ -140,6 +142,42 @@ class CompiledFunction:
             raise EvaluationError(f"batch: out must be a C-contiguous float array {(n, self.size)}")
         self._batch(n, Y, YD, T, P, ps, U, us, out)
         return self.split(out)
+
+    def dynamics(self, y: Any, yd: Any, t: Any = 0.0, p: Any = None, u: Any = None
+                 ) -> tuple[np.ndarray, np.ndarray]:
+        """Forward dynamics and joint wrenches of ``n`` states in one call (the loop runs in C).
+
+        ``ÿ = M⁻¹(q − k)`` (LDLᵀ), then for every body the wrench its parent transmits to the
+        sub-tree it carries (the Newton–Euler equations of the sub-tree summed, as RNEA does),
+        as ``(F_x, F_y, F_z, T_x, T_y, T_z)`` in the body's frame at its origin (the joint
+        point). Arguments as for :meth:`batch`. Returns ``ydd`` (n, f) and ``wrenches``
+        (n, p, 6); raises :class:`SingularMassMatrix` naming the first state where M is not
+        positive definite.
+        """
+        fn = getattr(self.lib, "jd_dynamics_batch", None)
+        if fn is None or not self.n_bodies:
+            raise EvaluationError("this compiled function has no joint wrenches")
+        Y = np.ascontiguousarray(y, dtype=float)
+        YD = np.ascontiguousarray(yd, dtype=float)
+        if Y.ndim != 2 or Y.shape[1] != self.f or YD.shape != Y.shape:
+            raise EvaluationError(f"dynamics: y and yd must have shape (n, {self.f}), got "
+                                  f"{Y.shape} and {YD.shape}")
+        n = Y.shape[0]
+        T = np.ascontiguousarray(np.broadcast_to(np.asarray(t, dtype=float), (n,)))
+        P, ps = _shared_or_per_state(p, n, self.n_p, "parameters")
+        U, us = _shared_or_per_state(u, n, self.n_u, "inputs")
+        ydd = np.empty((n, self.f))
+        W = np.empty((n, self.n_bodies, 6))
+        vp = ctypes.c_void_p
+        fn.restype = ctypes.c_long
+        fn.argtypes = [ctypes.c_long, ctypes.c_long, vp, vp, vp, vp, ctypes.c_long, vp,
+                       ctypes.c_long, vp, vp]
+        bad = fn(n, self.f, Y.ctypes.data, YD.ctypes.data, T.ctypes.data, P.ctypes.data, ps,
+                 U.ctypes.data, us, ydd.ctypes.data, W.ctypes.data)
+        if bad >= 0:
+            raise SingularMassMatrix(f"M is not positive definite (or not finite) at state {bad}: "
+                                     f"t = {T[bad]}, y = {Y[bad].tolist()}")
+        return ydd, W
 
     def _batch(self, n: int, Y: np.ndarray, YD: np.ndarray, T: np.ndarray, P: np.ndarray,
                ps: int, U: np.ndarray, us: int, out: np.ndarray) -> None:
@@ -299,7 +337,7 @@ def _recursive(system: System, full: bool, extra_source: str = "",
     lib.jd_fn_batch.argtypes = [ctypes.c_long, ctypes.c_long, vp, vp, vp, vp, ctypes.c_long, vp,
                                 ctypes.c_long, vp]
     return CompiledFunction(names, shapes, arguments(system), key, f, len(system.parameters),
-                            len(system.inputs), lib)
+                            len(system.inputs), lib, n_bodies=p)
 
 
 @lru_cache(maxsize=32)

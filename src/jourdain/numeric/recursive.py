@@ -427,4 +427,100 @@ void jd_fn_batch(long n, long f, const double *y, const double *yd, const double
     for (long i = 0; i < n; ++i)
         jd_fn(y + i * f, yd + i * f, t[i], p + i * p_stride, u + i * u_stride, out + i * JD_SIZE);
 }
+
+/* Joint wrenches for given ÿ (the sub-tree's Newton–Euler equations summed, as RNEA does):
+   the wrench the parent transmits to the sub-tree of body b, about the inertial origin,
+       T_b = Σ_(i below b) (q̄^c_i + M̄_i a_i(ÿ) − q̄^e_i)
+           = B^c_b − W^c_b + I^c_b·P_λ(b) + Σ_(a below b) I^c_a·Z_a,
+   with Z_a = Σ_(columns of joint a) V·ÿ and P_b = P_λ(b) + Z_b; written in the child frame
+   at the joint point (the child's origin) as (F, T). */
+static void jd_wrenches_of(const double *ydd, jd_work *W, double *out) {
+    double P[6 * JD_P], Y[6 * JD_P];
+    for (int i = 0; i < JD_P; ++i) {
+        double Z[6] = {0, 0, 0, 0, 0, 0};
+        for (int c = jd_col_start[i]; c < jd_col_start[i + 1]; ++c)
+            for (int a = 0; a < 6; ++a) Z[a] += W->V[6 * c + a] * ydd[jd_col_coord[c]];
+        int lam = jd_parent[i];
+        double Pl[6] = {0, 0, 0, 0, 0, 0};
+        if (lam >= 0) for (int a = 0; a < 6; ++a) Pl[a] = P[6 * lam + a];
+        for (int a = 0; a < 6; ++a) P[6 * i + a] = Pl[a] + Z[a];
+        jd_inertia_twist(W->Ic + 13 * i, Z, Y + 6 * i);
+        /* start T_b with B^c − W^c + I^c P_λ; the Y of the sub-tree is added below */
+        double IP[6], *T = out + 6 * i;
+        jd_inertia_twist(W->Ic + 13 * i, Pl, IP);
+        for (int a = 0; a < 6; ++a) T[a] = W->Bc[6 * i + a] - W->Wc[6 * i + a] + IP[a];
+    }
+    for (int i = JD_P - 1; i >= 0; --i) {
+        int lam = jd_parent[i];
+        for (int a = 0; a < 6; ++a) out[6 * i + a] += Y[6 * i + a];
+        if (lam >= 0) for (int a = 0; a < 6; ++a) Y[6 * lam + a] += Y[6 * i + a];
+    }
+    for (int i = 0; i < JD_P; ++i) {
+        double *T = out + 6 * i, m[3], oF[3], Fc[3], mc[3];
+        const double *R = W->fr[i].R, *o = W->fr[i].o;
+        jd_cross(o, T + 3, oF);
+        for (int a = 0; a < 3; ++a) m[a] = T[a] - oF[a];
+        jd_mtv(R, T + 3, Fc);
+        jd_mtv(R, m, mc);
+        for (int a = 0; a < 3; ++a) { T[a] = Fc[a]; T[3 + a] = mc[a]; }
+    }
+}
+
+/* ÿ = M⁻¹(q − k) by LDLᵀ of the projected M; 0, 1 (M not positive definite) or 2 (NaN) */
+static int jd_solve_mkq(const double *M, const double *k, const double *q, double *ydd,
+                        double *L /* f×f work */) {
+    double D[JD_F], Dinv[JD_F], E[JD_F], dmax = 0.0;
+    for (int i = 0; i < JD_F; ++i) { ydd[i] = q[i] - k[i]; dmax = fmax(dmax, fabs(M[i * JD_F + i])); }
+    for (int j = 0; j < JD_F; ++j) {
+        double d = M[j * JD_F + j];
+        for (int m = 0; m < j; ++m) { E[m] = L[j * JD_F + m] * D[m]; d -= L[j * JD_F + m] * E[m]; }
+        if (!(d > 1e-13 * dmax)) return isfinite(d) ? 1 : 2;
+        D[j] = d; Dinv[j] = 1.0 / d;
+        for (int i = j + 1; i < JD_F; ++i) {
+            double s = M[i * JD_F + j];
+            for (int m = 0; m < j; ++m) s -= L[i * JD_F + m] * E[m];
+            L[i * JD_F + j] = s * Dinv[j];
+        }
+    }
+    for (int i = 0; i < JD_F; ++i) {
+        double s = ydd[i];
+        for (int m = 0; m < i; ++m) s -= L[i * JD_F + m] * ydd[m];
+        ydd[i] = s;
+    }
+    for (int i = JD_F - 1; i >= 0; --i) {
+        double s = ydd[i] * Dinv[i];
+        for (int m = i + 1; m < JD_F; ++m) s -= L[m * JD_F + i] * ydd[m];
+        ydd[i] = s;
+    }
+    for (int i = 0; i < JD_F; ++i) if (!isfinite(ydd[i])) return 2;
+    return 0;
+}
+
+/* per state: ÿ (f) and the joint wrenches (6p) of the forward dynamics; returns the status of
+   the solve (0 ok, 1 M not positive definite, 2 NaN) */
+int jd_dynamics(const double *y, const double *yd, double t, const double *p, const double *u,
+                double *ydd, double *wrench) {
+    double L[JD_NL > 0 ? JD_NL : 1];
+    /* one block on the heap: the work of the recursion, M, k, q and the factor of M */
+    char *mem = (char *)malloc(sizeof(jd_work) + sizeof(double) * (2 * JD_F * JD_F + 2 * JD_F));
+    if (!mem) return 2;
+    jd_work *W = (jd_work *)mem;
+    double *Mkq = (double *)(mem + sizeof(jd_work)), *Lf = Mkq + JD_F * JD_F + 2 * JD_F;
+    jd_local(y, yd, t, p, u, L);
+    jd_recursion(L, yd, W);
+    jd_project(W, Mkq, Mkq + JD_F * JD_F, Mkq + JD_F * JD_F + JD_F);
+    int status = jd_solve_mkq(Mkq, Mkq + JD_F * JD_F, Mkq + JD_F * JD_F + JD_F, ydd, Lf);
+    if (status == 0) jd_wrenches_of(ydd, W, wrench);
+    free(mem);
+    return status;
+}
+
+long jd_dynamics_batch(long n, long f, const double *y, const double *yd, const double *t,
+                       const double *p, long p_stride, const double *u, long u_stride,
+                       double *ydd, double *wrench) {
+    for (long i = 0; i < n; ++i)
+        if (jd_dynamics(y + i * f, yd + i * f, t[i], p + i * p_stride, u + i * u_stride,
+                        ydd + i * JD_F, wrench + i * 6 * JD_P) != 0) return i;
+    return -1;
+}
 """
