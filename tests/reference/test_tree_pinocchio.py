@@ -6,26 +6,23 @@ RNEA at that ÿ (zero: no actuators), and every joint's reaction wrench ``Σ g_k
 RNEA's ``data.f`` (see test_reactions_pinocchio.py); M symmetric positive definite. Tolerances
 come from tests/tolerance.py (tests/reference/tree_crosscheck.py, :func:`judge`).
 
-* Each joint kind alone (revolute, prismatic, universal about random axes; spherical in all
-  twelve rotation sequences; free joints), in this process: the conventions of the Pinocchio
+* Each joint kind alone (revolute, prismatic, universal about random axes; spherical joints
+  in all twelve rotation sequences; free joints), in this process: the conventions of the Pinocchio
   twin (tree_model's docstring) hold joint by joint.
 * Mixed trees of :data:`SIZES`, each in three fresh processes with different
   ``PYTHONHASHSEED`` and private, empty ``JOURDAIN_CACHE`` directories: besides the checks, the
   generated C sources and M and g at every state must be identical bit for bit (jourdain once
   returned a wrong, indefinite M at f = 48 that depended on the process's memory history).
 
-Cost of one fresh process (derivation, code generation and C compilation of the equations of
-motion and of the reactions, 5 states), measured on 2 cores: small (f = 14) 3 s, medium
-(f = 30) 7.5 s, large (f = 66) 26 s with the code generation of commit 3b80ffa, where the
-reactions still compile their symbolic N̂; the three processes of a size run side by side and
-take 9 s, 20 s and 100 s. With the recursive reactions of issue 13 (in progress) the same are
-1.5, 2.2 and 5 s per process, 3, 5 and 23 s for three. The large case runs with
-``JOURDAIN_LARGE=1`` until then.
+Cost of one fresh process (derivation, code generation and C compilation, 5 states), measured
+on 2 cores with the recursive code generation of issue 13 (commits 3b80ffa, 2516a8e, ebe142d):
+small (f = 14) 0.9 s, medium (f = 30) 1.2 s, large (f = 66) 3.8 s; the three processes of a
+size run side by side in 3, 4 and 14 s. (Before 2516a8e, with the symbolic N̂ of the reactions,
+the large case took 26 s per process and 100 s for three.)
 """
 
 from __future__ import annotations
 
-import os
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
@@ -42,8 +39,6 @@ from tests.tolerance import EPS, eval_tol, norm
 #: appears, and the data's breadth-first order is not depth-first
 SIZES = {"small": (6, 2, 14), "medium": (14, 2, 30), "large": (35, 0, 66)}
 HASHSEEDS = ("0", "1", "12345")
-LARGE = pytest.mark.skipif(os.environ.get("JOURDAIN_LARGE") != "1",
-                           reason="enabled once issue 13's code generation lands")
 ALL_SEQUENCES = (*CARDAN, "zxz", "xyx", "xzx", "yxy", "yzy", "zyz")
 
 #: one kind of joint per tree (plus the default mix in creation order), in this process
@@ -51,15 +46,23 @@ KINDS = {
     "revolute": dict(n_bodies=4, joints=("revolute",)),
     "prismatic": dict(n_bodies=4, joints=("prismatic",)),
     "universal": dict(n_bodies=4, joints=("universal",)),
-    "spherical": dict(n_bodies=4, joints=("spherical",), sequences=ALL_SEQUENCES),
+    "spherical": dict(n_bodies=len(ALL_SEQUENCES), joints=("spherical",)),  # one each
     "free": dict(n_bodies=3, joints=("free",), free_at=(0, 1, 2), sequences=ALL_SEQUENCES),
     "mixed-creation-order": dict(n_bodies=5, order="creation"),
 }
 
 
 def _tree(spec: dict, seed: int) -> tuple:
+    """``(system, Pinocchio model, TreeIndex)``; a spherical-only tree has every sequence."""
+    from benchmarks.pinocchio_models import tree_model
+    from jourdain.models import tree_from_data
+
     opts = dict(spec)
-    return build("tree", opts.pop("n_bodies"), seed, **opts)
+    data = random_tree_data(opts.pop("n_bodies"), seed, **opts)
+    if opts.get("joints") == ("spherical",):
+        data = [{**d, "sequence": ALL_SEQUENCES[i % len(ALL_SEQUENCES)]}
+                for i, d in enumerate(data)]
+    return (tree_from_data(data), *tree_model(data))
 
 
 def _check(c: dict, what: str) -> None:
@@ -121,8 +124,7 @@ def test_joint_conventions_match_pinocchio(kind, rng):
         _check(compare(system, model, index, y, yd), kind)
 
 
-@pytest.mark.parametrize("size", [
-    "small", "medium", pytest.param("large", marks=LARGE)])
+@pytest.mark.parametrize("size", list(SIZES))
 def test_fresh_processes_agree_with_pinocchio_and_each_other(size, tmp_path):
     n, seed, f = SIZES[size]
     spec = {"kind": "tree", "n": n, "seed": seed, "states": 4}
