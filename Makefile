@@ -1,6 +1,7 @@
 # Two entry points for a fresh machine (Python 3.11+, a C compiler):
 #   make run   - create .venv, install jourdain, run the main job on the default example
 #   make test  - create .venv, install jourdain with test extras, run ruff and the test suite
+#                (twice: PYTHONHASHSEED=0 with OPENBLAS_NUM_THREADS=1, and PYTHONHASHSEED=12345)
 PYTHON ?= python3
 VENV   ?= .venv
 BIN    := $(VENV)/bin
@@ -29,8 +30,11 @@ browser:
 	      >/dev/null 2>&1 || echo "chromium could not be installed: the browser test will be skipped"; \
 	  else echo "chromium not found and not root: the report's browser test will be skipped"; fi; }
 
+# the suite twice, with different hash seeds (set and dict order) and BLAS threading, so that a
+# result that depends on either fails here rather than on another machine (tests/README.md)
 test: lint browser
-	$(BIN)/python -m pytest -q
+	PYTHONHASHSEED=0 OPENBLAS_NUM_THREADS=1 $(BIN)/python -m pytest -q
+	PYTHONHASHSEED=12345 $(BIN)/python -m pytest -q
 
 clean:
 	rm -rf $(VENV) .pytest_cache .ruff_cache

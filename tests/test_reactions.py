@@ -9,6 +9,17 @@ import sympy
 import jourdain as jd
 from jourdain.models import double_pendulum, n_link_pendulum_on_cart, spatial_chain
 from jourdain.reactions import check_orthogonality, graph_values
+from tests.tolerance import (
+    eom_terms,
+    eval_tol,
+    newton_euler_tol,
+    reactions_tol,
+    solve_scale,
+    solve_tol,
+    subtree_tol,
+    tree_extent,
+    ydd_of,
+)
 
 
 def _pendulum(inertia: str):
@@ -23,14 +34,15 @@ def _pendulum(inertia: str):
                      parameters={"m": 1.3, "l": 0.8, "g": 9.81})
 
 
-def _ydd(out):
-    return np.linalg.solve(np.atleast_2d(out["M"]), out["q"] - out["k"])
+_ydd = ydd_of
 
 
 def _residual(out):
-    """M̄·J̄·ÿ + q̄^c − q̄^e − Q̄·g, and the scale it is measured against."""
-    lhs = out["M_bar"] @ (out["J_bar"] @ _ydd(out)) + out["q_c"] - out["q_e"]
-    return lhs - out["Q_bar"] @ out["g"], max(np.abs(lhs).max(), 1.0)
+    """M̄·J̄·ÿ + q̄^c − q̄^e − Q̄·g, and its tolerance (tests/tolerance.py: the errors of the
+    solves for ÿ and g mapped to forces, and the rounding of the summed terms)."""
+    ydd = _ydd(out)
+    lhs = out["M_bar"] @ (out["J_bar"] @ ydd) + out["q_c"] - out["q_e"]
+    return lhs - out["Q_bar"] @ out["g"], newton_euler_tol(out, ydd)
 
 
 def test_pendulum_rod_force_closed_form():
@@ -51,7 +63,7 @@ def test_pendulum_rod_force_closed_form():
         y, yd = rng.uniform(-np.pi, np.pi, 1), rng.uniform(-3, 3, 1)
         out = s.evaluate(y, yd)
         want = [0, 1.3 * 0.8 * yd[0] ** 2 + 1.3 * 9.81 * np.cos(y[0]), 0, 0, 0]
-        np.testing.assert_allclose(out["g"], want, rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(out["g"], want, rtol=0, atol=reactions_tol(out))
         assert out["g_undetermined"] == []
 
 
@@ -67,7 +79,7 @@ def test_rod_pendulum_tangential_force():
         y, yd = rng.uniform(-np.pi, np.pi, 1), rng.uniform(-3, 3, 1)
         out = s.evaluate(y, yd)
         want = [m * g * np.sin(y[0]) / 4, m * l / 2 * yd[0] ** 2 + m * g * np.cos(y[0]), 0, 0, 0]
-        np.testing.assert_allclose(out["g"], want, rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(out["g"], want, rtol=0, atol=reactions_tol(out))
 
 
 def _rotor(driven: bool):
@@ -109,12 +121,14 @@ def test_rotor_bearing_forces_steady_spin():
     p = s.parameter_values
     for phi, Om in [(0.3, 40.0), (-2.0, 12.0)]:
         out = s.evaluate([phi], [Om])
-        assert abs(_ydd(out)[0]) < 1e-12  # spin about a fixed axis, no axial torque
+        # spin about a fixed axis, no axial torque: q − k cancels to rounding of its terms
+        ydd = _ydd(out)
+        assert abs(ydd[0]) <= solve_tol(out["M"], solve_scale(out["M"], ydd, eom_terms(out)))
         F, T = _rotor_hand(p, Om, 0.0)
         g = dict(zip(out["g_names"], out["g"], strict=True))
         np.testing.assert_allclose([g["bearing.F_x"], g["bearing.F_y"], g["bearing.F_z"],
                                     g["bearing.T_x"], g["bearing.T_y"]],
-                                   [*F, T[0], T[1]], rtol=1e-12, atol=1e-12)
+                                   [*F, T[0], T[1]], rtol=0, atol=reactions_tol(out))
 
 
 def test_rotor_on_driven_shaft_rheonomic():
@@ -128,16 +142,18 @@ def test_rotor_on_driven_shaft_rheonomic():
     for t in (0.0, 0.7, 1.9):
         out = s.evaluate([0.2], [0.5], t=t)
         F, T = _rotor_hand(p, p["Omega"] + p["alpha"] * t, p["alpha"])
-        np.testing.assert_allclose(out["g"][:6], [*F, *T], rtol=1e-12, atol=1e-12)
-        res, scale = _residual(out)
-        assert np.abs(res).max() <= 1e-12 * scale
+        np.testing.assert_allclose(out["g"][:6], [*F, *T], rtol=0, atol=reactions_tol(out))
+        res, tol = _residual(out)
+        assert np.abs(res).max() <= tol
 
 
 @pytest.mark.parametrize("make", [lambda: spatial_chain(6), lambda: n_link_pendulum_on_cart(4)],
                          ids=["spatial_chain-6", "cart-pendulum-4"])
 def test_newton_euler_residual(make, rng):
     """M̄·J̄·ÿ + q̄^c − q̄^e − Q̄·g = 0 at random states, ÿ from the equations of motion; the
-    single-joint path (sub-tree residual) gives the same components."""
+    single-joint path (sub-tree residual) gives the same components. Both to the rounding the
+    solves for ÿ and g allow at the state (cond(M) reaches 1e7..1e9 at some states of the
+    chain)."""
     s = make()
     joints = [b.joint.name for b in s.bodies]
     for _ in range(4):
@@ -145,12 +161,13 @@ def test_newton_euler_residual(make, rng):
         yd = rng.uniform(-3, 3, s.f)
         kw = {"inputs": {"F": rng.uniform(-5, 5)}} if s.inputs else {}
         out = s.evaluate(y, yd, **kw)
-        res, scale = _residual(out)
-        assert np.abs(res).max() <= 1e-10 * scale
+        res, tol = _residual(out)
+        assert np.abs(res).max() <= tol
         assert out["g_undetermined"] == []
         one = jd.joint_reactions(s, joints, y, yd, **kw)
         g1 = np.array([one[n] for n in out["g_names"]])
-        assert np.abs(g1 - out["g"]).max() <= 1e-10 * np.abs(out["g"]).max()
+        tol1 = subtree_tol(out, _ydd(out), tree_extent(s, y))
+        assert np.abs(g1 - out["g"]).max() <= tol1
         if not s.reactions().singular_rows:  # N̂ symmetric positive definite
             N = out["N_hat"]
             assert np.abs(N - N.T).max() == 0.0
@@ -164,9 +181,10 @@ def test_point_masses_are_statics_of_massless_links():
     rng = np.random.default_rng(5)
     out = s.evaluate(rng.uniform(-2, 2, s.f), rng.uniform(-2, 2, s.f), inputs={"F": 1.0})
     g = dict(zip(out["g_names"], out["g"], strict=True))
+    tol = reactions_tol(out)
     for i in (1, 2, 3):
-        assert abs(g[f"hinge{i}.F_x"]) < 1e-10 * abs(g[f"hinge{i}.F_y"])
-        assert abs(g[f"hinge{i}.T_x"]) < 1e-10 and abs(g[f"hinge{i}.T_y"]) < 1e-10
+        assert abs(g[f"hinge{i}.F_x"]) <= tol and abs(g[f"hinge{i}.F_y"]) > 1e3 * tol
+        assert abs(g[f"hinge{i}.T_x"]) <= tol and abs(g[f"hinge{i}.T_y"]) <= tol
 
 
 def test_massless_link_and_weld():
@@ -182,13 +200,14 @@ def test_massless_link_and_weld():
     out = s.evaluate([0.4], [2.0])
     g_ = dict(zip(out["g_names"], out["g"], strict=True))
     radial = 0.7 * 1.1 * 4.0 + 0.7 * 9.81 * np.cos(0.4)
+    tol = reactions_tol(out)
     for j in ("hinge", "weld"):
-        assert g_[f"{j}.F_y"] == pytest.approx(radial, rel=1e-12)
-        assert abs(g_[f"{j}.F_x"]) < 1e-12
+        assert g_[f"{j}.F_y"] == pytest.approx(radial, rel=0, abs=tol)
+        assert abs(g_[f"{j}.F_x"]) <= tol
     for c in "xyz":
-        assert abs(g_[f"weld.T_{c}"]) < 1e-12
-    res, scale = _residual(out)
-    assert np.abs(res).max() <= 1e-12 * scale
+        assert abs(g_[f"weld.T_{c}"]) <= tol
+    res, tol = _residual(out)
+    assert np.abs(res).max() <= tol
 
 
 def _zoo():
@@ -235,11 +254,12 @@ def test_every_joint_type(rng):
         y = rng.uniform(-np.pi, np.pi, s.f)
         yd = rng.uniform(-2, 2, s.f)
         out = s.evaluate(y, yd)
-        res, scale = _residual(out)
-        assert np.abs(res).max() <= 1e-10 * scale
+        res, tol = _residual(out)
+        assert np.abs(res).max() <= tol
         one = jd.joint_reactions(s, ["cardan", "plane"], y, yd)
+        tol1 = subtree_tol(out, _ydd(out), tree_extent(s, y))
         for k, v in one.items():
-            assert v == pytest.approx(out["g"][out["g_names"].index(k)], rel=1e-9, abs=1e-9)
+            assert v == pytest.approx(out["g"][out["g_names"].index(k)], rel=0, abs=tol1), k
 
 
 def test_joint_moved_by_another_joints_coordinate_is_rejected():
@@ -270,8 +290,9 @@ def test_general_joint_derives_the_revolute_directions(rng):
     s2 = jd.System(s.coordinates, bodies, s.forces, parameters=dict(s.parameters))
     assert s2.reactions().g_names == s.reactions().g_names
     y, yd = rng.uniform(-2, 2, 2), rng.uniform(-2, 2, 2)
-    np.testing.assert_allclose(s2.evaluate(y, yd)["g"], s.evaluate(y, yd)["g"], rtol=1e-13,
-                               atol=1e-13)
+    out = s.evaluate(y, yd)  # two solves, one on each side
+    np.testing.assert_allclose(s2.evaluate(y, yd)["g"], out["g"], rtol=0,
+                               atol=2 * reactions_tol(out))
 
 
 def test_symbolic_single_joint_matches_numbers(rng):
@@ -287,7 +308,8 @@ def test_symbolic_single_joint_matches_numbers(rng):
             **{jd.symbols(k): v for k, v in s.parameter_values.items()}}
     got = np.array(graph_values(expr.entries(), vals), dtype=float)
     cols = list(r.joint("hinge1").columns)
-    np.testing.assert_allclose(got, out["g"][cols], rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(got, out["g"][cols], rtol=0,
+                               atol=subtree_tol(out, ydd, tree_extent(s, y)))
 
 
 def test_user_directions_violating_orthogonality_are_rejected():
@@ -330,12 +352,14 @@ def test_redundant_directions_are_undetermined():
     assert sorted(out["g_undetermined"]) == ["hinge.F_x", "hinge.F_x2"]
     g_ = dict(zip(out["g_names"], out["g"], strict=True))
     assert np.isnan(g_["hinge.F_x"]) and np.isnan(g_["hinge.F_x2"])
-    assert g_["hinge.F_y"] == pytest.approx(2.0 * 1.0 + 2.0 * 9.81, rel=1e-12)
+    tol = reactions_tol(out)  # minimum-norm solve: condition number over its rank
+    assert g_["hinge.F_y"] == pytest.approx(2.0 * 1.0 + 2.0 * 9.81, rel=0, abs=tol)
     with pytest.raises(jd.JourdainError, match="undetermined"):
         s.reactions().g()
     one = jd.joint_reactions(s, "hinge", [0.0], [1.0])
     assert np.isnan(one["hinge.F_x"]) and np.isnan(one["hinge.F_x2"])
-    assert one["hinge.F_y"] == pytest.approx(g_["hinge.F_y"], rel=1e-12)
+    assert one["hinge.F_y"] == pytest.approx(g_["hinge.F_y"], rel=0,
+                                             abs=subtree_tol(out, _ydd(out), tree_extent(s, [0.0])))
 
 
 def test_unknown_joint_is_named():
@@ -351,7 +375,8 @@ def test_unknown_joint_is_named():
 def test_assembled_orthogonality(make):
     """J̄ᵀ·Q̄ = 0 for the assembled matrices (not only joint by joint)."""
     r = make().reactions()
-    assert check_orthogonality(r, samples=4) < 1e-13
+    # relative to |J̄|ᵀ|Q̄|: the rounding of a sum of 6p products
+    assert check_orthogonality(r, samples=4) <= eval_tol(r.Q_bar.shape[0], 1.0)
 
 
 def test_assembly_error_is_caught_by_orthogonality():
@@ -392,9 +417,10 @@ def test_heavy_top_axial_pivot_force_closed_form(rng):
     # and the numeric path (Cholesky of N̂) gives the same numbers
     y, yd = rng.uniform(-3, 3, 3), rng.uniform(-3, 3, 3)
     p = s.parameter_values
-    num = s.evaluate(y, yd)["g"]
+    out = s.evaluate(y, yd)
     closed = sympy.lambdify(args, G, "numpy")(*y, *yd, p["m"], p["L"], p["A"], p["C"], p["g"])
-    np.testing.assert_allclose(num, np.asarray(closed, float).ravel(), rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(out["g"], np.asarray(closed, float).ravel(), rtol=0,
+                               atol=reactions_tol(out))
 
 
 def test_benchmark_script_tiny_case():
@@ -403,6 +429,8 @@ def test_benchmark_script_tiny_case():
     from benchmarks import reactions as bench
 
     (row,) = bench.run([3], states=5, repeat=1)
+    # the benchmark's five fixed states are well-conditioned (cond(M) < 300, cond(N̂) < 900):
+    # a fixed bound, about 700 times the difference measured there
     assert row["q"] == 12 and row["max_rel_diff"] < 1e-12
     assert row["jourdain_g"] > 0 and row["pinocchio"] > 0
 
