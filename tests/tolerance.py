@@ -65,7 +65,10 @@ def cond(A: object, rank_revealing: bool = False) -> float:
     ``rank_revealing``: ``σ_max/σ_r`` over the singular values above ``RANK_RTOL·σ_max``, the
     condition number of a minimum-norm (truncated SVD) solve of a rank-deficient system.
     """
-    sv = np.linalg.svd(np.atleast_2d(np.asarray(A, dtype=float)), compute_uv=False)
+    a = np.atleast_2d(np.asarray(A, dtype=float))
+    if a.size == 0:
+        return 1.0  # no equations (a model without constrained directions): nothing amplified
+    sv = np.linalg.svd(a, compute_uv=False)
     if rank_revealing:
         sv = sv[sv > RANK_RTOL * sv[0]]
     return float(sv[0] / sv[-1]) if sv[-1] > 0 else float("inf")

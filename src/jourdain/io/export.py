@@ -13,7 +13,6 @@ import re
 import time
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
-from functools import lru_cache
 from typing import TYPE_CHECKING, Any
 
 import symengine as se
@@ -28,8 +27,9 @@ if TYPE_CHECKING:
 MAX_DISPLAY_OPS = 600
 #: Matrices with more rows are summarized in text output (a 36×36 M̄ helps nobody on a terminal).
 MAX_TEXT_ROWS = 18
-#: Entries up to this many operations are simplified for display (trigonometric identities).
-SIMPLIFY_OPS = 500
+#: Entries up to this many operations are simplified for display (trigonometric identities);
+#: SymPy's trigsimp of one larger entry can take seconds and cannot be interrupted.
+SIMPLIFY_OPS = 150
 #: Time budget (seconds) for simplifying the entries of one matrix for display.
 SIMPLIFY_SECONDS = 3.0
 
@@ -121,21 +121,34 @@ def too_large(m: SymMatrix, max_ops: int = MAX_DISPLAY_OPS) -> bool:
     return display_ops(m) > max_ops
 
 
-def to_sympy_matrix(m: SymMatrix, simplify: bool = True) -> Any:
+def to_sympy_matrix(m: SymMatrix, simplify: bool = True, deadline: float | None = None) -> Any:
     """The matrix as SymPy, each entry lightly simplified (trigonometric identities) when small.
 
-    Simplification is for reading only; it stops after :data:`SIMPLIFY_SECONDS` per matrix
-    (the remaining entries are shown as derived) and its result is memoized per matrix.
+    Simplification is for reading only; it stops at ``deadline`` (a ``time.perf_counter()``
+    value; default :data:`SIMPLIFY_SECONDS` from now), after which the remaining entries are
+    shown as derived, and its result is memoized per matrix (a later call reuses it, whatever
+    its deadline).
     """
-    return _sympy_matrix(m, simplify)
+    key = (m, simplify)
+    hit = _SIMPLIFIED.get(key)
+    if hit is None:
+        if deadline is None:
+            deadline = time.perf_counter() + SIMPLIFY_SECONDS
+        hit = _sympy_matrix(m, simplify, deadline)
+        if len(_SIMPLIFIED) >= 64:
+            _SIMPLIFIED.pop(next(iter(_SIMPLIFIED)))
+        _SIMPLIFIED[key] = hit
+    return hit
 
 
-@lru_cache(maxsize=64)
-def _sympy_matrix(m: SymMatrix, simplify: bool) -> Any:
+#: memo of :func:`to_sympy_matrix` (matrices are immutable and compared by content)
+_SIMPLIFIED: dict[tuple[SymMatrix, bool], Any] = {}
+
+
+def _sympy_matrix(m: SymMatrix, simplify: bool, deadline: float) -> Any:
     import sympy
 
     memo: dict = {}
-    deadline = time.perf_counter() + SIMPLIFY_SECONDS
     rows = []
     for r in m.rows:
         row = []
@@ -161,14 +174,15 @@ def latex_symbol_names(system: System) -> dict[Any, str]:
     return {sympy.Symbol(n): d.latex() for n, d in display_names(system).items()}
 
 
-def matrix_latex(m: SymMatrix, system: System, max_ops: int = MAX_DISPLAY_OPS) -> str:
+def matrix_latex(m: SymMatrix, system: System, max_ops: int = MAX_DISPLAY_OPS,
+                 deadline: float | None = None) -> str:
     """LaTeX of ``m`` (a ``pmatrix``), or a summary ``\\text{6×2 matrix, 153 operations}``."""
     import sympy
 
     if too_large(m, max_ops):
         n, k = m.shape
         return f"\\text{{{n}×{k} matrix, {display_ops(m)} operations after CSE}}"
-    return sympy.latex(to_sympy_matrix(m), symbol_names=latex_symbol_names(system),
+    return sympy.latex(to_sympy_matrix(m, deadline=deadline), symbol_names=latex_symbol_names(system),
                        mat_str="pmatrix", mat_delim="")
 
 
@@ -222,13 +236,14 @@ def expr_mathml(expr: Any, system: System) -> str:
     return _printer(system).doprint(expr)
 
 
-def matrix_mathml(m: SymMatrix, system: System, max_ops: int = MAX_DISPLAY_OPS) -> str:
+def matrix_mathml(m: SymMatrix, system: System, max_ops: int = MAX_DISPLAY_OPS,
+                  deadline: float | None = None) -> str:
     """Presentation MathML of ``m`` (inner content), or a summary text for large matrices."""
     if too_large(m, max_ops):
         n, k = m.shape
         return (f"<mtext>{n}×{k} matrix, {display_ops(m)} operations after CSE (too large to "
                 "print)</mtext>")
-    return expr_mathml(to_sympy_matrix(m), system)
+    return expr_mathml(to_sympy_matrix(m, deadline=deadline), system)
 
 
 def symbol_mathml(text: str, bar: bool = False, hat: bool = False, tilde: bool = False,

@@ -387,14 +387,19 @@ def _prescribed_joints(system: Any) -> list[str]:
     return out
 
 
-def _display_matrix(name: str, m: Any, system: Any, max_ops: int) -> str:
+#: seconds for simplifying all matrices of one report for display (entries left as derived after)
+REPORT_SIMPLIFY_SECONDS = 0.5
+
+
+def _display_matrix(name: str, m: Any, system: Any, max_ops: int,
+                    deadline: float | None = None) -> str:
     rows, cols = m.shape
     if rows > MAX_DISPLAY_ROWS:
         ops = export.display_ops(m)
         inner = (f"<mtext>{rows}×{cols} matrix, {ops} operations after CSE (shown in "
                  "equations.json / equations.tex)</mtext>")
     else:
-        inner = export.matrix_mathml(m, system, max_ops)
+        inner = export.matrix_mathml(m, system, max_ops, deadline)
     return f'<div class="eq">{_math(f"<mrow>{_SYM[name]}<mo>=</mo>{inner}</mrow>")}</div>'
 
 
@@ -411,6 +416,8 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
     from ..cli import EVAL_FORMAT, _json_array, evaluate_all, has_capability, summary
 
     t_start = time.perf_counter()
+    # one budget for simplifying every displayed matrix: the report must not wait on SymPy
+    deadline = t_start + REPORT_SIMPLIFY_SECONDS
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     system = model.system
@@ -469,11 +476,11 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
          "rotational rows in each body frame about its centre of mass):</p>",
          f'<div class="eq">{_headline_ne()}</div>']
     for k in ("M_bar", "J_bar", "q_c", "q_e"):
-        s.append(_display_matrix(k, mats[k], system, max_ops))
+        s.append(_display_matrix(k, mats[k], system, max_ops, deadline))
     s.append("<p>Projection with J̄ᵀ eliminates the reaction forces (J̄ᵀQ̄ = 0):</p>")
     s.append(f'<div class="eq">{_headline_eom()}</div>')
     for k in ("M", "k", "q"):
-        s.append(_display_matrix(k, mats[k], system, max_ops))
+        s.append(_display_matrix(k, mats[k], system, max_ops, deadline))
     if has_capability("reactions"):
         try:
             react = system.reactions()
@@ -483,7 +490,7 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
                      + (", …" if q_count > 12 else "") + "); N̂·g = k̂ − q̂ gives g "
                      "without ÿ:</p>")
             s.append(f'<div class="eq">{_headline_reactions()}</div>')
-            s.append(_display_matrix("Q_bar", react.Q_bar, system, max_ops))
+            s.append(_display_matrix("Q_bar", react.Q_bar, system, max_ops, deadline))
             mats_json_extra = {"Q_bar": react.Q_bar}
         except JourdainError as exc:
             s.append(_note(f"the reaction forces could not be formed: {exc}"))
@@ -497,7 +504,7 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
     latex_names = {"M_bar": r"\bar{M}", "J_bar": r"\bar{J}", "q_c": r"\bar{q}^{c}",
                    "q_e": r"\bar{q}^{e}", "M": "M", "k": "k", "q": "q"}
     for k, m in mats.items():
-        tex.append(f"{latex_names[k]} = {export.matrix_latex(m, system, max_ops)}\n")
+        tex.append(f"{latex_names[k]} = {export.matrix_latex(m, system, max_ops, deadline)}\n")
     (out / "equations.tex").write_text("\n".join(tex) + "\n", encoding="utf-8")
     eqj = {"format": "jourdain-eom/1", "model": system.name,
            "coordinates": system.coordinate_names,
