@@ -6,14 +6,17 @@ of order 5 for stiff problems (Hairer & Wanner, *Solving ODEs II*, §IV.8: simpl
 iterations in the eigenbasis of the Runge–Kutta matrix, a forward-difference Jacobian, the
 embedded error estimate and Gustafsson's step-size predictor), their continuous extensions for
 output at requested times and for locating events, and a Cholesky factorization of ``M`` in
-every right-hand-side evaluation. The coefficient tables are read from SciPy, which tabulates
-the same published coefficients, and written into the source as constants.
+every right-hand-side evaluation. The coefficient tables are the published constants, written
+out once in ``rk_tables.h`` (no run-time dependency on SciPy's private modules).
 
 The state is ``x = [y, ẏ, W]`` with ``W`` the work of the generalized applied forces
 ``q`` (``Ẇ = ẏᵀq``), integrated to the same tolerance, for the energy balance.
 """
 
 from __future__ import annotations
+
+import re
+from importlib import resources
 
 import numpy as np
 
@@ -24,35 +27,19 @@ def _arr(name: str, a: np.ndarray) -> str:
 
 
 def tables() -> str:
-    """C constants of the two methods' coefficients."""
-    from scipy.integrate._ivp import dop853_coefficients as d8
-    from scipy.integrate._ivp import radau as rd
-    from scipy.integrate._ivp.rk import RK45
+    """C constants of the methods' coefficients (``rk_tables.h`` beside this module: the
+    published tables written out once; tests check them against the order conditions and
+    against SciPy's tabulation)."""
+    return (resources.files(__package__) / "rk_tables.h").read_text()
 
-    out = ["/* Dormand-Prince 5(4): 6 stages + FSAL stage */\n"]
-    A5 = np.zeros((7, 7))
-    A5[:6, :5] = RK45.A
-    out.append(_arr("RK5_A", A5))
-    out.append(_arr("RK5_B", RK45.B))
-    out.append(_arr("RK5_C", RK45.C))
-    out.append(_arr("RK5_E", RK45.E))
-    out.append(_arr("RK5_P", RK45.P))  # 7 x 4: dense output polynomial in theta
-    out.append("/* Dormand-Prince 8(5,3): 12 stages + FSAL + 3 stages for dense output */\n")
-    out.append(_arr("RK8_A", d8.A))  # 16 x 16
-    out.append(_arr("RK8_B", d8.B))
-    out.append(_arr("RK8_C", d8.C))
-    out.append(_arr("RK8_E3", d8.E3))
-    out.append(_arr("RK8_E5", d8.E5))
-    out.append(_arr("RK8_D", d8.D))  # 4 x 16
-    out.append("/* Radau IIA order 5: nodes, transformation to the eigenbasis, error weights */\n")
-    out.append(_arr("RADAU_C", rd.C))
-    out.append(_arr("RADAU_T", rd.T))
-    out.append(_arr("RADAU_TI", rd.TI))
-    out.append(_arr("RADAU_E", rd.E))
-    out.append(_arr("RADAU_P", rd.P))
-    out.append(f"static const double RADAU_MU_REAL = {float(rd.MU_REAL)!r};\n")
-    out.append(_arr("RADAU_MU_CPLX", np.array([rd.MU_COMPLEX.real, rd.MU_COMPLEX.imag])))
-    return "".join(out)
+
+def table_values(text: str | None = None) -> dict[str, np.ndarray]:
+    """The arrays of :func:`tables` by name (for the tests of the coefficients)."""
+    out: dict[str, np.ndarray] = {}
+    for m in re.finditer(r"static const double (\w+)(\[\d+\])? = \{?([^};]*)\}?;",
+                         tables() if text is None else text):
+        out[m.group(1)] = np.array([float(v) for v in m.group(3).split(",")])
+    return out
 
 
 SOURCE = r"""
