@@ -208,6 +208,22 @@ def cse(exprs: Sequence[Expr], prefix: str = "x") -> CSE:
     return CSE(tuple(temps), outputs)
 
 
+def count_nodes(exprs: Sequence[Expr], cap: int) -> int:
+    """Number of distinct non-atomic nodes of the expressions' graph (by identity), counted up
+    to ``cap + 1``: a cheap test of whether a graph is small, whatever its full size."""
+    ids = NodeIds()
+    seen: set[int] = set()
+    stack = [e for e in exprs if not _is_atom(e)]
+    while stack and len(seen) <= cap:
+        e = stack.pop()
+        k = ids(e)
+        if k in seen:
+            continue
+        seen.add(k)
+        stack.extend(a for a in e.args if not _is_atom(a))
+    return len(seen)
+
+
 def node_ops(n: Expr) -> int:
     """Operations of one node: n-ary + and * count n-1, a function call or power one."""
     a = n.args
