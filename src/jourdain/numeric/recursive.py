@@ -148,6 +148,8 @@ def recursive_source(system: System, full: bool = False, directions: tuple | Non
             f"#define JD_DIRS {p * BODY_BLOCK + COLUMN_BLOCK * len(col_coord)}\n"
             f"#define JD_SIZE {size}\n#define JD_FULL {1 if full else 0}\n"
             f"#define JD_Q {n_q}\n#define JD_QBAR {1 if lay.directions else 0}\n"
+            # the work of the recursion on the stack when small (no malloc per evaluation)
+            f"#define JD_WORK_STACK {1 if 8 * (58 * p + 6 * len(col_coord)) <= 65536 else 0}\n"
             + _table("jd_parent", list(lay.parent))
             + _table("jd_col_start", col_start)
             + _table("jd_col_coord", col_coord)
@@ -405,8 +407,12 @@ static void jd_distribution(const double *L, const jd_work *W, double *Q) {
 void jd_fn(const double *y, const double *yd, double t, const double *p, const double *u,
            double *out) {
     double L[JD_NL > 0 ? JD_NL : 1];
+#if JD_WORK_STACK
+    jd_work work, *W = &work;
+#else
     jd_work *W = (jd_work *)malloc(sizeof(jd_work));
     if (!W) { for (long a = 0; a < JD_SIZE; ++a) out[a] = NAN; return; }
+#endif
     jd_local(y, yd, t, p, u, L);
     jd_recursion(L, yd, W);
 #if JD_FULL
@@ -419,7 +425,9 @@ void jd_fn(const double *y, const double *yd, double t, const double *p, const d
 #if JD_QBAR
     jd_distribution(L, W, M + JD_F * JD_F + 2 * JD_F);
 #endif
+#if !JD_WORK_STACK
     free(W);
+#endif
 }
 
 void jd_fn_batch(long n, long f, const double *y, const double *yd, const double *t,
