@@ -171,21 +171,29 @@ def test_every_joint_and_force_newton_euler_residual(rng):
         assert np.abs(res).max() <= newton_euler_tol(out, ydd)
 
 
-def test_joint_wrenches_equal_reaction_components(rng):
-    """CompiledFunction.dynamics gives each joint's wrench from the sub-tree's Newton–Euler
-    equations (the ÿ route); the reaction components g of N̂·g = k̂ − q̂ (METHOD.md §4, no ÿ)
-    along the joint's constrained directions w_k must compose the same wrench, Σ g_k·w_k."""
+@pytest.mark.parametrize("make", [every_joint_and_force, lambda: models.random_tree(12, seed=3),
+                                  models.heavy_top],
+                         ids=["shared coordinate: LDLᵀ and sub-tree sums",
+                              "tree: articulated bodies", "top: articulated bodies"])
+def test_joint_wrenches_equal_reaction_components(make, rng):
+    """CompiledFunction.dynamics gives ÿ and each joint's wrench by the ÿ route (the
+    articulated-body recursion where every coordinate belongs to one joint, else LDLᵀ of M and
+    the sub-tree's Newton–Euler sums); ÿ must solve M·ÿ = q − k, and the reaction components g
+    of N̂·g = k̂ − q̂ (METHOD.md §4, no ÿ) along the joint's constrained directions w_k must
+    compose the same wrench, Σ g_k·w_k."""
     from jourdain.reactions import graph_values, joint_directions
     from tests.tolerance import subtree_tol, tree_extent, ydd_tol
 
-    system = every_joint_and_force()
+    system = make()
     fn = dynamics_function(system)
     pv = np.array(list(system.parameter_values.values()))
     for _ in range(3):
         y, yd = rng.uniform(-1.5, 1.5, system.f), rng.uniform(-1, 1, system.f)
-        t, u = float(rng.uniform(0, 2)), [float(rng.uniform(-1, 1))]
+        t = float(rng.uniform(0, 2))
+        u = [float(rng.uniform(-1, 1)) for _ in system.inputs] or None
         out = system.evaluate(y, yd, t=t, inputs=u)
         ydd, W = fn.dynamics(y[None], yd[None], t, pv, u)
+        assert "g" in out, out.get("reactions_error")
         tol = subtree_tol(out, ydd[0], tree_extent(system, y, t))
         assert np.abs(ydd[0] - ydd_of(out)).max() <= ydd_tol(out, ydd[0])
         vals = {**dict(zip(system.parameter_symbols, pv, strict=True)),

@@ -104,6 +104,12 @@ def layout(system: System, directions: tuple | None = None) -> RecursiveLayout:
                            tuple(len(ws) for ws in directions) if directions else ())
 
 
+def _disjoint(columns: tuple[tuple[int, ...], ...]) -> bool:
+    """Every coordinate belongs to one joint (the articulated-body recursion applies)."""
+    flat = [j for c in columns for j in c]
+    return len(flat) == len(set(flat))
+
+
 def _table(name: str, values: list[int]) -> str:
     body = ", ".join(str(v) for v in values) if values else "0"
     return f"static const int {name}[{max(len(values), 1)}] = {{{body}}};\n"
@@ -148,6 +154,7 @@ def recursive_source(system: System, full: bool = False, directions: tuple | Non
             f"#define JD_DIRS {p * BODY_BLOCK + COLUMN_BLOCK * len(col_coord)}\n"
             f"#define JD_SIZE {size}\n#define JD_FULL {1 if full else 0}\n"
             f"#define JD_Q {n_q}\n#define JD_QBAR {1 if lay.directions else 0}\n"
+            f"#define JD_ABA {1 if _disjoint(lay.columns) else 0}\n"
             # the work of the recursion on the stack when small (no malloc per evaluation)
             f"#define JD_WORK_STACK {1 if 8 * (58 * p + 6 * len(col_coord)) <= 65536 else 0}\n"
             + _table("jd_parent", list(lay.parent))
@@ -199,6 +206,9 @@ typedef struct {
     double V[6 * JD_NC];
     double Ic[13 * JD_P], Bc[6 * JD_P], Wc[6 * JD_P];
     double c[3 * JD_P], qc[6 * JD_P];
+#if JD_ABA
+    double Ib[13 * JD_P], Bb[6 * JD_P], Wb[6 * JD_P];  /* each body's own, before the sums */
+#endif
 } jd_work;
 
 static void jd_recursion(const double *L, const double *yd, jd_work *W) {
@@ -291,6 +301,10 @@ static void jd_recursion(const double *L, const double *yd, jd_work *W) {
         for (int a = 0; a < 3; ++a) Ic[9 + a] = m * cc[a];
         Ic[12] = m;
     }
+#if JD_ABA
+    for (int a = 0; a < 13 * JD_P; ++a) W->Ib[a] = W->Ic[a];
+    for (int a = 0; a < 6 * JD_P; ++a) { W->Bb[a] = W->Bc[a]; W->Wb[a] = W->Wc[a]; }
+#endif
     /* composite bodies: sums over each sub-tree, children before parents */
     for (int i = JD_P - 1; i >= 0; --i) {
         int lam = jd_parent[i];
@@ -436,6 +450,7 @@ void jd_fn_batch(long n, long f, const double *y, const double *yd, const double
         jd_fn(y + i * f, yd + i * f, t[i], p + i * p_stride, u + i * u_stride, out + i * JD_SIZE);
 }
 
+#if !JD_ABA
 /* Joint wrenches for given ÿ (the sub-tree's Newton–Euler equations summed, as RNEA does):
    the wrench the parent transmits to the sub-tree of body b, about the inertial origin,
        T_b = Σ_(i below b) (q̄^c_i + M̄_i a_i(ÿ) − q̄^e_i)
@@ -462,15 +477,6 @@ static void jd_wrenches_of(const double *ydd, jd_work *W, double *out) {
         int lam = jd_parent[i];
         for (int a = 0; a < 6; ++a) out[6 * i + a] += Y[6 * i + a];
         if (lam >= 0) for (int a = 0; a < 6; ++a) Y[6 * lam + a] += Y[6 * i + a];
-    }
-    for (int i = 0; i < JD_P; ++i) {
-        double *T = out + 6 * i, m[3], oF[3], Fc[3], mc[3];
-        const double *R = W->fr[i].R, *o = W->fr[i].o;
-        jd_cross(o, T + 3, oF);
-        for (int a = 0; a < 3; ++a) m[a] = T[a] - oF[a];
-        jd_mtv(R, T + 3, Fc);
-        jd_mtv(R, m, mc);
-        for (int a = 0; a < 3; ++a) { T[a] = Fc[a]; T[3 + a] = mc[a]; }
     }
 }
 
@@ -503,12 +509,156 @@ static int jd_solve_mkq(const double *M, const double *k, const double *q, doubl
     for (int i = 0; i < JD_F; ++i) if (!isfinite(ydd[i])) return 2;
     return 0;
 }
+#endif
 
-/* per state: ÿ (f) and the joint wrenches (6p) of the forward dynamics; returns the status of
-   the solve (0 ok, 1 M not positive definite, 2 NaN) */
+#if JD_ABA
+/* inverse of a small symmetric positive definite matrix (n ≤ 6) by Cholesky; 0 or 1 (not
+   positive definite) */
+static int jd_spd_inverse(int n, const double *D, double *Dinv, double scale) {
+    double Lc[36], Y[36];
+    for (int j = 0; j < n; ++j) {
+        double d = D[j * n + j];
+        for (int m = 0; m < j; ++m) d -= Lc[j * n + m] * Lc[j * n + m];
+        if (!(d > 1e-13 * scale)) return 1;
+        Lc[j * n + j] = sqrt(d);
+        for (int i = j + 1; i < n; ++i) {
+            double t = D[i * n + j];
+            for (int m = 0; m < j; ++m) t -= Lc[i * n + m] * Lc[j * n + m];
+            Lc[i * n + j] = t / Lc[j * n + j];
+        }
+    }
+    for (int c = 0; c < n; ++c) {  /* columns of L⁻¹, then Dinv = L⁻ᵀ L⁻¹ */
+        for (int i = 0; i < n; ++i) {
+            double t = i == c ? 1.0 : 0.0;
+            for (int m = 0; m < i; ++m) t -= Lc[i * n + m] * Y[m * n + c];
+            Y[i * n + c] = i < c ? 0.0 : t / Lc[i * n + i];
+        }
+    }
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+            double t = 0.0;
+            for (int m = 0; m < n; ++m) t += Y[m * n + i] * Y[m * n + j];
+            Dinv[i * n + j] = t;
+        }
+    return 0;
+}
+
+/* The articulated-body recursion (Featherstone), about the inertial origin in inertial
+   components, for trees whose coordinates each belong to one joint. With X_i = Σ_(a above or
+   at i) S_a·ÿ_a, the wrench a joint transmits is f_i = I^A_i·X_i + p^A_i; its free directions
+   carry none (S_iᵀ·f_i = 0), which gives ÿ_i = −D_i⁻¹(U_iᵀ·X_λ + S_iᵀ·p^A_i), D = SᵀI^A S,
+   U = I^A S, and the parent gains I^A − U D⁻¹ Uᵀ and p^A − U D⁻¹ Sᵀp^A. Body wrenches start
+   from q̄^c − q̄^e at ÿ = 0 (B − W). O(f) per state; ÿ and every joint wrench. */
+typedef struct { double IA[36 * JD_P], pA[6 * JD_P], U[36 * JD_P], Dinv[36 * JD_P],
+                 u[6 * JD_P], X[6 * JD_P]; } jd_aba_work;
+
+static int jd_aba(const jd_work *W, jd_aba_work *A, double *ydd, double *wrench) {
+    double scale = 0.0;
+    for (int i = 0; i < JD_P; ++i) {
+        const double *Ib = W->Ib + 13 * i, *h = Ib + 9;
+        double *IA = A->IA + 36 * i;
+        /* [[Ī, h̃], [−h̃, m E]]: twist (w, u) -> wrench (moment, force) */
+        double H[9] = {0, -h[2], h[1], h[2], 0, -h[0], -h[1], h[0], 0};
+        for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 3; ++c) {
+                IA[6 * r + c] = Ib[3 * r + c];
+                IA[6 * r + 3 + c] = H[3 * r + c];
+                IA[6 * (3 + r) + c] = -H[3 * r + c];
+                IA[6 * (3 + r) + 3 + c] = r == c ? Ib[12] : 0.0;
+            }
+        for (int a = 0; a < 6; ++a) A->pA[6 * i + a] = W->Bb[6 * i + a] - W->Wb[6 * i + a];
+        scale = fmax(scale, fmax(Ib[12], fmax(Ib[0], fmax(Ib[4], Ib[8]))));
+    }
+    for (int i = JD_P - 1; i >= 0; --i) {
+        int c0 = jd_col_start[i], n = jd_col_start[i + 1] - c0, lam = jd_parent[i];
+        const double *S = W->V + 6 * c0;  /* column k at S + 6k */
+        double *IA = A->IA + 36 * i, *pA = A->pA + 6 * i, *U = A->U + 36 * i;
+        double *Dinv = A->Dinv + 36 * i, *u = A->u + 6 * i, D[36];
+        for (int k = 0; k < n; ++k)
+            for (int r = 0; r < 6; ++r) {
+                double t = 0.0;
+                for (int c = 0; c < 6; ++c) t += IA[6 * r + c] * S[6 * k + c];
+                U[6 * k + r] = t;
+            }
+        for (int k = 0; k < n; ++k) {
+            u[k] = jd_dot6(S + 6 * k, pA);
+            for (int l = 0; l < n; ++l) D[k * n + l] = jd_dot6(S + 6 * k, U + 6 * l);
+        }
+        if (n && jd_spd_inverse(n, D, Dinv, scale)) return 1;
+        if (lam < 0) continue;
+        double *IAp = A->IA + 36 * lam, *pAp = A->pA + 6 * lam, Du[6];
+        for (int k = 0; k < n; ++k) {
+            Du[k] = 0.0;
+            for (int l = 0; l < n; ++l) Du[k] += Dinv[k * n + l] * u[l];
+        }
+        for (int r = 0; r < 6; ++r) {
+            double t = pA[r];
+            for (int k = 0; k < n; ++k) t -= U[6 * k + r] * Du[k];
+            pAp[r] += t;
+            for (int c = 0; c < 6; ++c) {
+                double s = IA[6 * r + c];
+                for (int k = 0; k < n; ++k)
+                    for (int l = 0; l < n; ++l) s -= U[6 * k + r] * Dinv[k * n + l] * U[6 * l + c];
+                IAp[6 * r + c] += s;
+            }
+        }
+    }
+    for (int i = 0; i < JD_P; ++i) {
+        int c0 = jd_col_start[i], n = jd_col_start[i + 1] - c0, lam = jd_parent[i];
+        const double *S = W->V + 6 * c0, *U = A->U + 36 * i, *Dinv = A->Dinv + 36 * i;
+        const double *u = A->u + 6 * i;
+        double *X = A->X + 6 * i, r[6];
+        for (int a = 0; a < 6; ++a) X[a] = lam < 0 ? 0.0 : A->X[6 * lam + a];
+        for (int k = 0; k < n; ++k) r[k] = jd_dot6(U + 6 * k, X) + u[k];
+        for (int k = 0; k < n; ++k) {
+            double t = 0.0;
+            for (int l = 0; l < n; ++l) t -= Dinv[k * n + l] * r[l];
+            ydd[jd_col_coord[c0 + k]] = t;
+        }
+        for (int k = 0; k < n; ++k)
+            for (int a = 0; a < 6; ++a) X[a] += S[6 * k + a] * ydd[jd_col_coord[c0 + k]];
+        if (wrench) {
+            const double *IA = A->IA + 36 * i;
+            for (int a = 0; a < 6; ++a) {
+                double t = A->pA[6 * i + a];
+                for (int c = 0; c < 6; ++c) t += IA[6 * a + c] * X[c];
+                wrench[6 * i + a] = t;
+            }
+        }
+    }
+    for (int i = 0; i < JD_F; ++i) if (!isfinite(ydd[i])) return 2;
+    return 0;
+}
+#endif
+
+/* a wrench about the inertial origin (moment, force) in body i's frame at its origin (F, T) */
+static void jd_to_joint_frames(const jd_work *W, double *wrench) {
+    for (int i = 0; i < JD_P; ++i) {
+        double *T = wrench + 6 * i, m[3], oF[3], Fc[3], mc[3];
+        const double *R = W->fr[i].R, *o = W->fr[i].o;
+        jd_cross(o, T + 3, oF);
+        for (int a = 0; a < 3; ++a) m[a] = T[a] - oF[a];
+        jd_mtv(R, T + 3, Fc);
+        jd_mtv(R, m, mc);
+        for (int a = 0; a < 3; ++a) { T[a] = Fc[a]; T[3 + a] = mc[a]; }
+    }
+}
+
+/* per state: ÿ (f) and the joint wrenches (6p) of the forward dynamics (the articulated-body
+   recursion where every coordinate belongs to one joint, else LDLᵀ of the projected M and the
+   sub-tree sums); returns 0, 1 (M not positive definite) or 2 (NaN) */
 int jd_dynamics(const double *y, const double *yd, double t, const double *p, const double *u,
                 double *ydd, double *wrench) {
     double L[JD_NL > 0 ? JD_NL : 1];
+#if JD_ABA
+    char *mem = (char *)malloc(sizeof(jd_work) + sizeof(jd_aba_work));
+    if (!mem) return 2;
+    jd_work *W = (jd_work *)mem;
+    jd_local(y, yd, t, p, u, L);
+    jd_recursion(L, yd, W);
+    int status = jd_aba(W, (jd_aba_work *)(mem + sizeof(jd_work)), ydd, wrench);
+    if (status == 0) jd_to_joint_frames(W, wrench);
+#else
     /* one block on the heap: the work of the recursion, M, k, q and the factor of M */
     char *mem = (char *)malloc(sizeof(jd_work) + sizeof(double) * (2 * JD_F * JD_F + 2 * JD_F));
     if (!mem) return 2;
@@ -518,7 +668,11 @@ int jd_dynamics(const double *y, const double *yd, double t, const double *p, co
     jd_recursion(L, yd, W);
     jd_project(W, Mkq, Mkq + JD_F * JD_F, Mkq + JD_F * JD_F + JD_F);
     int status = jd_solve_mkq(Mkq, Mkq + JD_F * JD_F, Mkq + JD_F * JD_F + JD_F, ydd, Lf);
-    if (status == 0) jd_wrenches_of(ydd, W, wrench);
+    if (status == 0) {
+        jd_wrenches_of(ydd, W, wrench);
+        jd_to_joint_frames(W, wrench);
+    }
+#endif
     free(mem);
     return status;
 }
