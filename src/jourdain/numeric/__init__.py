@@ -73,6 +73,11 @@ class CompiledFunction:
     def size(self) -> int:
         return sum(n * m for n, m in self.shapes)
 
+    def lib_source(self) -> str:
+        """The generated C source of this function (``<cache_dir>/<key>.c``; empty if gone)."""
+        path = cache_dir() / f"{self.key}.c"
+        return path.read_text() if path.exists() else ""
+
     @property
     def accel_address(self) -> int | None:
         """Address of ``int jd_accel(y, yd, t, p, u, ydd, power)`` when compiled with it."""
@@ -304,7 +309,7 @@ def _interpreted(system: System, names: tuple[str, ...], shapes: tuple[tuple[int
 
 
 def _recursive(system: System, full: bool, extra_source: str = "",
-               directions: tuple | None = None) -> CompiledFunction:
+               directions: tuple | None = None, accel: bool = False) -> CompiledFunction:
     """Compile :func:`.recursive.recursive_source` (no symbolic M is formed)."""
     f, p = system.f, len(system.bodies)
     names: tuple[str, ...] = ("M", "k", "q")
@@ -328,7 +333,8 @@ def _recursive(system: System, full: bool, extra_source: str = "",
 
             mats["Q_bar"] = reactions(eom.newton_euler).Q_bar
         return lambdify(system, mats, extra_source)
-    units = recursive_units(system, full, directions, extra_source)
+    template = ACCEL_TEMPLATE.replace("JD_F_VALUE", str(f)) if accel else None
+    units = recursive_units(system, full, directions, extra_source, template)
     key = content_key(_GENERATOR_VERSION, *units)
     lib = build(key, units)
     vp = ctypes.c_void_p
@@ -367,8 +373,9 @@ SYMBOLIC_MAX_F = 24
 @lru_cache(maxsize=32)
 def mkq_function(system: System) -> CompiledFunction:
     """Compiled ``M, k, q`` of the equations of motion for the integrator (memoized per system),
-    with ``jd_accel`` (ÿ = M⁻¹(q − k) by LDLᵀ) when f ≤ ACCEL_MAX_F: the symbolic projection's
-    code for small graphs (:data:`SYMBOLIC_NODES`), else the recursion."""
+    with ``jd_accel`` (ÿ = M⁻¹(q − k)) when f ≤ ACCEL_MAX_F: the symbolic projection's code
+    with LDLᵀ for small graphs (:data:`SYMBOLIC_NODES`), else the recursion (its
+    articulated-body ÿ where every coordinate belongs to one joint)."""
     extra = (ACCEL_TEMPLATE.replace("JD_F_VALUE", str(system.f))
              if system.f <= ACCEL_MAX_F else "")
     if system.f <= SYMBOLIC_MAX_F:
@@ -376,7 +383,8 @@ def mkq_function(system: System) -> CompiledFunction:
         exprs = [*eom.M.entries(), *eom.k.entries(), *eom.q.entries()]
         if count_nodes(exprs, SYMBOLIC_NODES) <= SYMBOLIC_NODES:
             return lambdify(system, {"M": eom.M, "k": eom.k, "q": eom.q}, extra_source=extra)
-    return _recursive(system, full=False, extra_source=extra)
+    # the recursion's jd_accel: articulated bodies where they apply (O(f)), else LDLᵀ of M
+    return _recursive(system, full=False, accel=system.f <= ACCEL_MAX_F)
 
 
 @lru_cache(maxsize=32)

@@ -116,13 +116,24 @@ def _table(name: str, values: list[int]) -> str:
 
 
 def recursive_units(system: System, full: bool = False, directions: tuple | None = None,
-                    extra_source: str = "") -> tuple[str, str]:
+                    extra_source: str = "", accel_template: str | None = None
+                    ) -> tuple[str, str]:
     """:func:`recursive_source` as two translation units, compiled in parallel: the generated
-    per-joint code, and the engine with ``extra_source`` (which may call ``jd_fn``)."""
+    per-joint code, and the engine with ``extra_source`` (which may call ``jd_fn``).
+
+    ``accel_template``: the integrator's ``jd_accel`` by LDLᵀ of M, used where the
+    articulated-body recursion does not apply; where it does, the engine's own ``jd_accel``
+    (O(f) per evaluation) is compiled instead.
+    """
     src = recursive_source(system, full, directions)
     local, engine = src.split("\n/* ---- engine ---- */\n")
     decl = ("void jd_local(const double *y, const double *yd, double t, const double *p,\n"
             "              const double *u, double *out);\n")
+    if accel_template is not None:
+        if "#define JD_ABA 1\n" in engine:
+            engine = "#define JD_ACCEL_ABA 1\n" + engine
+        else:
+            extra_source = accel_template + extra_source
     return HEADER + local, HEADER + decl + engine + extra_source
 
 
@@ -685,4 +696,26 @@ long jd_dynamics_batch(long n, long f, const double *y, const double *yd, const 
                         ydd + i * JD_F, wrench + i * 6 * JD_P) != 0) return i;
     return -1;
 }
+
+#if defined(JD_ACCEL_ABA) && JD_ABA
+/* the integrator's right-hand side by the articulated-body recursion: ÿ, and the power ẏᵀq of
+   the applied forces (q_j = Σ over the columns of coordinate j of V·(Σ q̄^e as a wrench)) */
+int jd_accel(const double *y, const double *yd, double t, const double *p, const double *u,
+             double *ydd, double *power) {
+    double L[JD_NL > 0 ? JD_NL : 1];
+    char *mem = (char *)malloc(sizeof(jd_work) + sizeof(jd_aba_work));
+    if (!mem) return 2;
+    jd_work *W = (jd_work *)mem;
+    jd_local(y, yd, t, p, u, L);
+    jd_recursion(L, yd, W);
+    double w = 0.0;
+    for (int b = 0; b < JD_P; ++b)
+        for (int c = jd_col_start[b]; c < jd_col_start[b + 1]; ++c)
+            w += yd[jd_col_coord[c]] * jd_dot6(W->V + 6 * c, W->Wc + 6 * b);
+    *power = w;
+    int status = jd_aba(W, (jd_aba_work *)(mem + sizeof(jd_work)), ydd, NULL);
+    free(mem);
+    return status;
+}
+#endif
 """
