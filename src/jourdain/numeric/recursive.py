@@ -74,11 +74,18 @@ def layout(system: System, directions: tuple | None = None) -> RecursiveLayout:
     ``directions``: per body the unit wrenches of its joint's constrained directions
     (:func:`jourdain.reactions.joint_directions`), for Q̄."""
     from ..kinematics import kinematics
+    from ..model.forces import Gravity
     from ..newton_euler import applied_forces
 
     motions = joint_motions(system)
     index = {b.name: i for i, b in enumerate(system.bodies)}
-    forces = applied_forces(kinematics(system)) if system.forces else None
+    # the symbolic kinematics of every body is needed only for loads that depend on it
+    forces = None
+    if any(not isinstance(fe, Gravity) for fe in system.forces):
+        forces = [(bf.f, bf.l) for bf in applied_forces(kinematics(system))]
+    elif system.forces:
+        g = [se.Add(*(fe.vector[a] for fe in system.forces)) for a in range(3)]
+        forces = [(tuple(b.mass * x for x in g), (se.Integer(0),) * 3) for b in system.bodies]
     zero = se.Integer(0)
     exprs: list[se.Basic] = []
     cols: list[tuple[int, ...]] = []
@@ -92,7 +99,7 @@ def layout(system: System, directions: tuple | None = None) -> RecursiveLayout:
         if forces is None:
             exprs.extend((zero,) * 6)
         else:
-            exprs.extend((*forces[i].f, *forces[i].l))
+            exprs.extend((*forces[i][0], *forces[i][1]))
         js = tuple(sorted(set(jm.J_T) | set(jm.J_R)))
         z3 = (zero, zero, zero)
         for j in js:
