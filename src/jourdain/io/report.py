@@ -156,7 +156,7 @@ def _svg(fig: Any) -> str:
     import matplotlib.pyplot as plt
 
     buf = io.StringIO()
-    fig.savefig(buf, format="svg", bbox_inches="tight")
+    fig.savefig(buf, format="svg")  # layout="constrained" fits the labels: one draw, not two
     plt.close(fig)
     text = buf.getvalue()
     return text[text.index("<svg"):]
@@ -169,7 +169,7 @@ def _time_plot(t: np.ndarray, series: Mapping[str, np.ndarray], ylabel: str,
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(7.5, 3.0))
+    fig, ax = plt.subplots(figsize=(7.5, 3.0), layout="constrained")
     for name, v in series.items():
         ax.plot(t, v, label=name, linewidth=1.2)
     ax.set_xlabel("t [s]")
@@ -187,7 +187,7 @@ def _eigen_plot(eigenvalues: np.ndarray, title: str) -> str:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(4.5, 3.2))
+    fig, ax = plt.subplots(figsize=(4.5, 3.2), layout="constrained")
     ax.axvline(0, color="0.5", linewidth=0.8)
     ax.axhline(0, color="0.5", linewidth=0.8)
     ax.plot(eigenvalues.real, eigenvalues.imag, "x", markersize=8, color="C3")
@@ -281,7 +281,7 @@ def _snapshot_strip(m: _Motion, view: str | None, frames: int = 8) -> str:
 
     proj, lo, hi = _frame_geometry(m, view)
     idx = np.linspace(0, len(m.t) - 1, frames).round().astype(int)
-    fig, axs = plt.subplots(1, frames, figsize=(1.6 * frames, 2.0))
+    fig, axs = plt.subplots(1, frames, figsize=(1.6 * frames, 2.0), layout="constrained")
     mmax = max(max(m.mass.values(), default=1.0), 1e-12)
     for ax, k in zip(np.atleast_1d(axs), idx, strict=True):
         for a, b in _segments(m, int(k)):
@@ -388,7 +388,7 @@ def _prescribed_joints(system: Any) -> list[str]:
 
 
 #: seconds for simplifying all matrices of one report for display (entries left as derived after)
-REPORT_SIMPLIFY_SECONDS = 0.5
+REPORT_SIMPLIFY_SECONDS = 0.3
 
 
 def _display_matrix(name: str, m: Any, system: Any, max_ops: int,
