@@ -183,6 +183,25 @@ def _step_exprs(step: Any) -> set[Any]:
     return out
 
 
+def _check_initial_state(model: Any) -> None:
+    """The equations of motion at the model's initial state (its [simulation] y0, yd0 and
+    inputs at t = 0, else zeros) must be finite numbers: a NaN there (a spring of zero length,
+    a square root of a negative number) is a model error naming its source."""
+    from .differentiate import evaluate_float
+
+    system, sim = model.system, model.simulation
+    y0 = list(sim.y0) or [0.0] * system.f
+    yd0 = list(sim.yd0) or [0.0] * system.f
+    given = dict(sim.inputs)
+    values = {**system.parameter_values, "t": 0.0}
+    try:
+        u = [evaluate_float([given[n]], values)[0] if n in given else 0.0
+             for n in system.input_names]
+        system.evaluate(y0, yd0, 0.0, inputs=u or None)
+    except JourdainError as exc:
+        raise model.error(f"at the initial state: {exc}") from None
+
+
 def cmd_check(args: argparse.Namespace) -> int:
     model = _load(args.model)
     if has_capability("reactions"):
@@ -191,6 +210,7 @@ def cmd_check(args: argparse.Namespace) -> int:
             model.system.reactions()
         except JourdainError as exc:
             raise model.error(str(exc)) from None
+    _check_initial_state(model)
     s = summary(model)
     if args.json:
         print(json.dumps(s, indent=2))

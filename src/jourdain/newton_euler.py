@@ -8,6 +8,7 @@ Rows are ordered as in the seed: the 3p translational rows of all bodies (inerti
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -161,11 +162,13 @@ class _Accumulator:
         return tuple(out)
 
 
-def applied_forces(kin: Kinematics) -> tuple[BodyForces, ...]:
-    """Resultant applied force and torque on every body from the model's force elements."""
+def applied_forces(kin: Kinematics, elements: Sequence[object] | None = None
+                   ) -> tuple[BodyForces, ...]:
+    """Resultant applied force and torque on every body from the model's force elements (or
+    from ``elements`` only, for example one element to trace a fault to it)."""
     acc = _Accumulator(kin)
     sys = kin.system
-    for fe in sys.forces:
+    for fe in sys.forces if elements is None else elements:
         if isinstance(fe, Gravity):
             acc.gravity = _add(acc.gravity, fe.vector)
         elif isinstance(fe, Force):

@@ -253,9 +253,18 @@ def _derived_directions(joint: Joint, coordinates: Sequence[se.Symbol],
                 normals += 1
                 candidates.append((f"T_n{normals}" if normals > 1 else "T_n", _wrench(T=n)))
     rng = np.random.default_rng(20240601)
-    samples = 3
-    values = _sample_values(cols + [c for _, w in candidates for c in w], coordinates,
-                            parameters, rng, samples)
+    # three states where the steps have real values (a square root of a coordinate has none
+    # for negative ones): drawn among more, the others dropped
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        values = _sample_values(cols + [c for _, w in candidates for c in w], coordinates,
+                                parameters, rng, 24)
+    values = values[:, np.isfinite(values).all(axis=0)][:, :3]
+    samples = values.shape[1]
+    if samples == 0:
+        raise ModelError(
+            f'joint "{joint.name}": its steps have no finite real value at any of 24 random '
+            "states, so its constrained directions cannot be derived; give them with "
+            "General(..., constrained=[...])")
     J = values[:len(cols)].reshape(len(ys), 6, samples) if ys else np.zeros((0, 6, samples))
     Wc = values[len(cols):].reshape(len(candidates), 6, samples)
     rank = max((np.linalg.matrix_rank(J[:, :, s].T, tol=1e-9) for s in range(samples)), default=0)
@@ -827,11 +836,17 @@ def _check_assembled(system: System, lay: ReactionLayout, fn: Any, samples: int 
     rng = np.random.default_rng(seed)
     pv = np.array(list(system.parameter_values.values()), dtype=float)
     worst = 0.0
-    for _ in range(samples):
+    checked = 0
+    for _ in range(8 * samples):  # states where the model has real values (sqrt(y) needs y ≥ 0)
+        if checked == samples:
+            break
         y = rng.uniform(-math.pi, math.pi, system.f)
         out = fn(y, np.zeros(system.f), float(rng.uniform(0, 2)), pv * rng.uniform(0.9, 1.1, pv.size),
                  np.zeros(len(system.inputs)))
         J, Q = out["J_bar"], out["Q_bar"]
+        if not (np.isfinite(J).all() and np.isfinite(Q).all()):
+            continue
+        checked += 1
         n6 = J.shape[0]
         JQ = J.T @ Q
         scale = (np.abs(J).T @ np.abs(Q)).max(axis=0) + 1e-300
@@ -855,6 +870,10 @@ def _check_assembled(system: System, lay: ReactionLayout, fn: Any, samples: int 
                 f"[J̄, Q̄] has rank {rank} < 6p = {n6}: the constrained directions of the "
                 "joints and the motions do not span all directions; a reaction is missing"
             )
+    if checked == 0:
+        raise ModelError("J̄ and Q̄ have no finite values at any of the random states tried: the "
+                         "orthogonality J̄ᵀ·Q̄ = 0 cannot be checked, so no reaction forces are "
+                         "given")
     return worst
 
 
@@ -1072,6 +1091,15 @@ def evaluate_reactions(system: System, y: Any, yd: Any, t: float = 0.0,
     qc, qe = np.asarray(eom["q_c"]).reshape(-1), np.asarray(eom["q_e"]).reshape(-1)
     N, kh, qh = projected_reactions(lay, np.asarray(eom["M_bar"]), Q, qc, qe)
     g, und = solve_g(Q, N, kh, qh, qc, qe, lay.singular_rows, lay.g_names)
+    # NaN marks undetermined components only; anything else not finite is an error
+    bad = [k for k, v in (("N_hat", N), ("k_hat", kh), ("q_hat", qh)) if not np.isfinite(v).all()]
+    determined = [i for i, n in enumerate(lay.g_names) if n not in und]
+    if not np.isfinite(g[determined]).all():
+        bad.append("g")
+    if bad:
+        raise EvaluationError(f"{', '.join(bad)} of {system.name!r} contain NaN or inf at this "
+                              "state (the reaction equations are not solvable in floating point "
+                              "here)")
     return {"Q_bar": Q, "N_hat": N, "k_hat": kh, "q_hat": qh, "g": g,
             "g_names": list(lay.g_names), "g_undetermined": und}
 

@@ -48,6 +48,7 @@ import symengine as se
 from .errors import EvaluationError, JourdainError, SingularMassMatrix
 from .model.expressions import as_expr
 from .numeric import CompiledFunction, lambdify, mkq_function, parameter_vector
+from .numeric.diagnose import nonfinite_sources
 from .numeric.integrator_c import source as integrator_source
 from .numeric.toolchain import build, content_key
 from .results import Results
@@ -299,8 +300,15 @@ def _error(code: int, setup: _Setup, fail: np.ndarray) -> JourdainError:
         return SingularMassMatrix(f"the mass matrix M of {sysm.name!r} is not positive definite "
                                   f"{where}")
     if code == _ENAN:
-        return IntegrationError(f"NaN or inf in the state or its derivative {where} (check the "
-                                "parameters and inputs)")
+        y, yd = fail[1:1 + f], fail[1 + f:1 + 2 * f]
+        try:
+            u = setup.inputs_at(np.array([t]), np.concatenate([y, yd])[None, :])[0]
+            sources = nonfinite_sources(sysm, y, yd, float(t), setup.p, np.asarray(u, float))
+        except Exception:  # noqa: BLE001 - the trace is a courtesy; the error stands
+            sources = []
+        cause = ("caused by " + "; ".join(sources)) if sources else \
+            "check the parameters and inputs"
+        return IntegrationError(f"NaN or inf in the state or its derivative {where} ({cause})")
     if code == _ESTEP:
         return IntegrationError(f"step size fell below the round-off limit {where}; the motion "
                                 "may be singular or very stiff (try method='Radau')")

@@ -30,6 +30,7 @@ from ..errors import EvaluationError, JourdainError, SingularMassMatrix
 from ..reactions import joint_directions
 from ..symbolic import SymMatrix
 from .ccode import HEADER, argument_names, function_source
+from .diagnose import nonfinite_message
 from .recursive import recursive_units
 from .toolchain import CompilerError, build, cache_dir, compiler, content_key
 
@@ -538,9 +539,17 @@ def _vector(x: Any, n: int, what: str, names: Sequence[str]) -> np.ndarray:
 def evaluate(system: System, y: Any, yd: Any, t: float = 0.0,
              parameters: Mapping[str, float] | None = None,
              inputs: Mapping[str, float] | Sequence[float] | None = None) -> dict[str, np.ndarray]:
-    """``M_bar, J_bar, q_c, q_e, M, k, q`` as NumPy arrays at one state (vectors 1-D)."""
+    """``M_bar, J_bar, q_c, q_e, M, k, q`` (and ``Q_bar`` where the joints give it) as NumPy
+    arrays at one state (vectors 1-D).
+
+    Raises :class:`EvaluationError` when any of them holds NaN or inf, naming the quantities,
+    the state and the joint, body or force element at fault (:mod:`.diagnose`).
+    """
     args = state_vectors(system, y, yd, t, parameters, inputs)
     out = _eom_function(system)(*args)
+    bad = [k for k, v in out.items() if not np.all(np.isfinite(v))]
+    if bad:
+        raise EvaluationError(nonfinite_message(system, bad, *args))
     # vectors (q_c, q_e, k, q) come back 1-D, matrices keep their shape even when 1x1
     return {k: (v.reshape(-1) if k in _VECTORS else v) for k, v in out.items()}
 
