@@ -315,3 +315,22 @@ def test_ctrl_c_during_the_c_loop_stops_between_chunks():
     assert sent and res.interrupted and "Ctrl-C" in res.message
     assert 0.7 < res.t[-1] < 3.0 and np.all(np.diff(res.t) > 0)
     assert signal.getsignal(signal.SIGINT) is before  # the handler is restored
+
+
+@pytest.mark.parametrize("method", ["DOP853", "RK45"])
+def test_steps_do_not_depend_on_how_the_run_is_split(method, monkeypatch):
+    """The C loop runs in calls of a few thousand steps (for Ctrl-C and progress); a run split
+    into calls of 7 steps takes the very same steps as one in large calls, bit for bit (the
+    step size, the FSAL stage and the rejection state are carried across calls). The number of
+    steps per call never depends on the wall clock (issue 17: a chain under load once failed
+    with a collapsed step)."""
+    import importlib
+
+    sim = importlib.import_module("jourdain.simulate")  # the package re-exports a function
+    s = spatial_chain(3)
+    rng = np.random.default_rng(3)
+    y0, yd0 = rng.uniform(-1, 1, s.f), rng.uniform(-1, 1, s.f)
+    big = s.simulate((0, 1.0), y0, yd0, method=method, rtol=1e-10, atol=1e-10)
+    monkeypatch.setattr(sim, "steps_per_call", lambda f: 7)
+    small = s.simulate((0, 1.0), y0, yd0, method=method, rtol=1e-10, atol=1e-10)
+    assert np.array_equal(big.t, small.t) and np.array_equal(big.y, small.y)

@@ -287,6 +287,14 @@ def _takes_state(fn: Callable[..., Any]) -> bool:
     return len(positional) >= 3 or any(p.kind == p.VAR_POSITIONAL for p in params)
 
 
+def steps_per_call(f: int) -> int:
+    """Steps per call of the C loop: about 0.1 s of work estimated from the model's size
+    (Ctrl-C and the progress report wait at most that long). Never from the wall clock: the
+    calls must not depend on the machine's load (an explicit method continues exactly across
+    calls, and the step sequence of the others depends on where the calls end)."""
+    return max(200, min(20000, 4_000_000 // (f * f + 50)))
+
+
 def _error(code: int, setup: _Setup, fail: np.ndarray) -> JourdainError:
     sysm = setup.system
     f = sysm.f
@@ -425,7 +433,7 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
     f = system.f
     n = 2 * f + 1
     nev = len(setup.events)
-    st = np.array([t0, 0.0])
+    st = np.array([t0, 0.0, 0.0])  # t, step size, last trial rejected (1.0)
     x = x0.copy()
     k0 = np.zeros(n)
     g_old = np.zeros(max(nev, 1))
@@ -463,9 +471,7 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
         chunks_x.append(out_x[:n_out[0]])
         chunks_dx.append(out_dx[:n_out[0], f:2 * f].copy())  # ÿ only: half the memory
         kept = id_chunk
-    # steps per call of the C loop, adapted so that a call takes about 0.2 s: Ctrl-C and the
-    # progress report wait at most that long, and short runs go in one call
-    max_steps = 20000
+    max_steps = steps_per_call(f)
     t_last_report = time.perf_counter()
     # Ctrl-C sets a flag that is looked at between calls of the C loop, so it never lands in
     # the middle of bookkeeping; a second Ctrl-C raises at once
@@ -488,7 +494,6 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
                 out_x = np.empty((cap, n))
                 out_dx = np.empty((cap, n))
                 n_out[0] = 0
-            t_call = time.perf_counter()
             id_chunk += 1
             code = lib.jd_integrate(
                 ctypes.byref(setup.problem), t1, st.ctypes.data, x.ctypes.data, k0.ctypes.data,
@@ -496,11 +501,6 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
                 i_eval.ctypes.data, out_t.ctypes.data, out_x.ctypes.data, out_dx.ctypes.data, cap,
                 n_out.ctypes.data, ev_t.ctypes.data, ev_x.ctypes.data, ev_i.ctypes.data, ev_cap,
                 n_ev.ctypes.data, max_steps, fail.ctypes.data)
-            took = time.perf_counter() - t_call
-            if took > 0.4:
-                max_steps = max(10, max_steps // 2)
-            elif took < 0.1 and max_steps < 10**6:
-                max_steps *= 2
             if te is None:
                 _keep_chunk()
                 if writer:

@@ -761,7 +761,8 @@ out:
 }
 
 /*
- * Advance from st[0] = t towards t_end. st[1] holds the step size (0: choose one).
+ * Advance from st[0] = t towards t_end. st[1] holds the step size (0: choose one), st[2]
+ * whether the last trial step was rejected (explicit methods).
  * x (n), k0 (n: derivative at x, valid when cnt[4] != 0), g_old (nev: events at x).
  * t_eval mode (n_eval > 0): dense output at t_eval[*i_eval ...] into out_t/out_x;
  * else every accepted step is written to out_t/out_x (capacity cap; JD_CONTINUE when full).
@@ -832,7 +833,8 @@ int jd_integrate(const jd_problem *P, double t_end, double *st, double *x, doubl
         status = radau_loop(&c, &s, &io, t_end, &t, &h, x, k0, cnt, max_steps);
         goto done;
     }
-    int rejected = 0;
+    /* carried between calls in st[2], so that a run split into calls steps exactly as one */
+    int rejected = st[2] != 0.0;
     while (1) {
         if (t >= t_end) { status = JD_DONE; break; }
         if (steps >= max_steps) { status = JD_CONTINUE; break; }
@@ -930,6 +932,7 @@ int jd_integrate(const jd_problem *P, double t_end, double *st, double *x, doubl
         rejected = 0;
         h *= factor;
     }
+    st[2] = rejected;
 done:
     st[0] = t; st[1] = h;
     cnt[0] += c.nfev;
