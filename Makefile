@@ -2,39 +2,65 @@
 #   make run   - create .venv, install jourdain, run the main job on the default example
 #   make test  - create .venv, install jourdain with test extras, run ruff and the test suite
 #                (twice: PYTHONHASHSEED=0 with OPENBLAS_NUM_THREADS=1, and PYTHONHASHSEED=12345)
+#   make bench - every benchmark script in its quick mode (not part of make test; the full runs
+#                and their options are in each script's docstring)
 PYTHON ?= python3
 VENV   ?= .venv
 BIN    := $(VENV)/bin
 
-.PHONY: run test lint clean browser
+.PHONY: run test lint clean browser bench
 
-$(BIN)/.installed: pyproject.toml
+$(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e ".[test]"
+
+# the main job needs jourdain only; the test tools (Pinocchio, PyDy, Cython: most of a 1 GB
+# environment) are installed by the test target
+$(BIN)/.installed-run: pyproject.toml | $(BIN)/python
+	$(BIN)/python -m pip install --quiet -e .
 	touch $@
 
-run: $(BIN)/.installed
+$(BIN)/.installed: pyproject.toml | $(BIN)/python
+	$(BIN)/python -m pip install --quiet -e ".[test]"
+	touch $@ $(BIN)/.installed-run
+
+run: $(BIN)/.installed-run
 	$(BIN)/jourdain run examples/double_pendulum.toml --out report/
 
 lint: $(BIN)/.installed
 	$(BIN)/ruff check src tests benchmarks
 
 # headless Chromium for the report's browser test: installed when missing and running as root
-# with apt-get; otherwise that one test is skipped with the reason
+# with apt-get (NO_BROWSER=1 skips the install); otherwise that one test is skipped with the reason
 browser:
-	@command -v chromium >/dev/null 2>&1 || command -v chromium-browser >/dev/null 2>&1 || \
+	@[ -n "$(NO_BROWSER)" ] && echo "NO_BROWSER set: the report's browser test will be skipped" || \
+	command -v chromium >/dev/null 2>&1 || command -v chromium-browser >/dev/null 2>&1 || \
 	{ if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
-	    echo "installing chromium (Debian package) for the report's browser test"; \
+	    echo "installing chromium (Debian package, apt-get) for the report's browser test;" \
+	         "NO_BROWSER=1 make test skips it"; \
 	    (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium) \
 	      >/dev/null 2>&1 || echo "chromium could not be installed: the browser test will be skipped"; \
 	  else echo "chromium not found and not root: the report's browser test will be skipped"; fi; }
 
 # the suite twice, with different hash seeds (set and dict order) and BLAS threading, so that a
 # result that depends on either fails here rather than on another machine (tests/README.md)
+# (the compiled libraries go to a cache in the project, shared by the two runs and removed by
+# make clean, never to the user's ~/.cache/jourdain)
 test: lint browser
-	PYTHONHASHSEED=0 OPENBLAS_NUM_THREADS=1 $(BIN)/python -m pytest -q
-	PYTHONHASHSEED=12345 $(BIN)/python -m pytest -q
+	PYTHONHASHSEED=0 OPENBLAS_NUM_THREADS=1 JOURDAIN_TEST_CACHE=$(CURDIR)/.jourdain-test-cache \
+	  $(BIN)/python -m pytest -q
+	PYTHONHASHSEED=12345 JOURDAIN_TEST_CACHE=$(CURDIR)/.jourdain-test-cache \
+	  $(BIN)/python -m pytest -q
+
+# quick modes only: a few minutes in all; timings from a quick run are not the reported numbers
+bench: $(BIN)/.installed
+	$(BIN)/python benchmarks/derivation.py --quick
+	$(BIN)/python benchmarks/linearization.py --quick
+	$(BIN)/python benchmarks/reactions.py --n 3 --states 50
+	$(BIN)/python benchmarks/simulation.py --quick --rounds 3
+	$(BIN)/python benchmarks/crosscheck.py --n 3 --tree 3 --states 1
+	$(BIN)/python benchmarks/scaling.py --quick
+	$(BIN)/python benchmarks/per_state.py --quick
 
 clean:
-	rm -rf $(VENV) .pytest_cache .ruff_cache
+	rm -rf $(VENV) .pytest_cache .ruff_cache .jourdain-test-cache

@@ -1,5 +1,22 @@
+"""Shared fixtures. The compiled libraries of the tests go to a temporary cache (or to
+``$JOURDAIN_TEST_CACHE``, as ``make test`` sets it), never to the user's ~/.cache/jourdain; child
+processes started by the tests inherit it."""
+
+import os
+import shutil
+import tempfile
+
 import numpy as np
 import pytest
+
+_given = os.environ.get("JOURDAIN_TEST_CACHE")
+_temporary = None if _given else tempfile.mkdtemp(prefix="jourdain-test-cache-")
+os.environ["JOURDAIN_CACHE"] = _given or _temporary
+
+
+def pytest_unconfigure(config: pytest.Config) -> None:
+    if _temporary:
+        shutil.rmtree(_temporary, ignore_errors=True)
 
 
 @pytest.fixture
