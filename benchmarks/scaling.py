@@ -23,8 +23,9 @@ memory history; :func:`benchmarks.crosscheck.spawn`) and measures, in this order
 * ``RSS MB``: the child's peak resident memory over everything, derivation included;
 * ``wall s``: the child's wall time, interpreter start-up and imports included.
 
-Each model runs in ``--trials`` fresh processes (default 3), and every time and memory column
-is the smallest over them: on a shared machine other work only ever adds to a measurement.
+Each model runs in ``--trials`` fresh processes (default 3; the trials of all models in turn),
+and every time and memory column is the smallest over them: on a shared machine other work only
+ever adds to a measurement.
 
 Below the table: the growth exponents, log-log slopes between the smallest and the largest f
 of each family, of the time to first number, the source size, the derivation and the per-state
@@ -255,17 +256,25 @@ def main(argv: list[str] | None = None) -> list[dict]:
     specs = ([{"kind": "chain", "n": n} for n in chains]
              + [{"kind": "tree", "n": n} for n in trees])
     print(f"each row: the smallest of {a.trials} fresh processes, each with an empty "
-          f"JOURDAIN_CACHE; per-state costs: batch of {a.states} states, best of {a.repeat}\n")
-    print(HEADER)
-    print(_rule(HEADER))
-    rows = []
+          f"JOURDAIN_CACHE, the trials of all rows in turn; per-state costs: batch of "
+          f"{a.states} states, best of {a.repeat}\n")
     t_all = time.perf_counter()
-    for spec in specs:
-        spec.update(seed=a.seed, states=a.states, repeat=a.repeat)
-        r = combine([spawn(spec, "0", timeout=a.timeout, module="benchmarks.scaling")
-                     for _ in range(a.trials)])
-        rows.append(r)
-        print(row(r), flush=True)
+    # trial after trial over all models, so that a busy spell of the machine hits one trial of
+    # several rows rather than every trial of one row
+    runs: list[list[dict]] = [[] for _ in specs]
+    for trial in range(a.trials):
+        for spec, done in zip(specs, runs, strict=True):
+            spec.update(seed=a.seed, states=a.states, repeat=a.repeat)
+            done.append(spawn(spec, "0", timeout=a.timeout, module="benchmarks.scaling"))
+            if trial == a.trials - 1:
+                if spec is specs[0]:
+                    print(HEADER)
+                    print(_rule(HEADER))
+                print(row(combine(done)), flush=True)
+            else:
+                print(f"trial {trial + 1}/{a.trials}: {spec['kind']} {spec['n']}, f = "
+                      f"{done[-1]['f']}: {done[-1]['wall_s']:.1f} s", file=sys.stderr, flush=True)
+    rows = [combine(done) for done in runs]
     print(f"\ntotal wall time {time.perf_counter() - t_all:.1f} s")
     worst = max((r["M_vs_evaluate"] for r in rows), default=0.0)
     print(f"M from fn.batch against System.evaluate at y = 0.1·1: max relative difference "
