@@ -47,6 +47,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import symengine as se
 
+from .differentiate import evaluate_float
 from .errors import EvaluationError, JourdainError, ModelError
 from .kinematics import Z3, _add, _cross, _dot, _mm, _mtv, _mv, _scale
 from .model.bodies import WORLD
@@ -554,13 +555,17 @@ def _singular_rows(system: System) -> tuple[tuple[int, ...], dict[str, tuple[lis
     """Rows where M̄ vanishes and, per body, its regular rotational axes with the inverse of the
     inertia tensor restricted to them."""
     p = len(system.bodies)
-    subs = {se.Symbol(k): v for k, v in system.parameters}
+    values = dict(system.parameters)
+
+    def num(x: se.Basic) -> float:  # the default value (only the symbols it has: O(1), not O(p))
+        return evaluate_float([x], values)[0]
+
     singular: list[int] = []
     inv: dict[str, tuple[list[int], Any]] = {}
     for i, b in enumerate(system.bodies):
         if b.mass == 0:
             singular.extend(range(3 * i, 3 * i + 3))
-        elif abs(float(b.mass.subs(subs))) == 0.0:
+        elif abs(num(b.mass)) == 0.0:
             raise ModelError(f'body "{b.name}": its mass is zero at the default parameters but '
                              "not identically zero; write mass=0 for a massless body")
         I = b.inertia
@@ -569,8 +574,8 @@ def _singular_rows(system: System) -> tuple[tuple[int, ...], dict[str, tuple[lis
         singular.extend(3 * p + 3 * i + a for a in range(3) if a not in regular)
         if regular:
             sub = [[I[a][c] for c in regular] for a in regular]
-            num = np.array([[float(x.subs(subs)) for x in r] for r in sub])
-            if abs(np.linalg.det(num)) <= 1e-12 * max(1.0, float(np.abs(num).max())) ** len(regular):
+            Ir = np.array([[num(x) for x in r] for r in sub])
+            if abs(np.linalg.det(Ir)) <= 1e-12 * max(1.0, float(np.abs(Ir).max())) ** len(regular):
                 raise ModelError(
                     f'body "{b.name}": its inertia tensor is singular, but not along body axes '
                     "(no row and column of zeros); give the inertia in a frame whose axes are "

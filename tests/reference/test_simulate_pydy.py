@@ -69,7 +69,10 @@ def test_benchmark_script_runs_on_a_tiny_case():
     report = main(["--quick", "--no-pinocchio", "--rounds", "1"])
     (entry,) = report["pendulum"]
     tools = entry["tools"]
-    assert set(tools) == {"jourdain DOP853 (C loop)", "PyDy lambdify/numpy + odeint"}
+    assert {"jourdain DOP853 (C loop)", "PyDy lambdify/numpy + odeint"} <= set(tools)
+    # besides, jourdain at the loosest tolerance as accurate as PyDy (equal accuracy)
+    assert all(k.startswith("jourdain DOP853, rtol=") for k in set(tools) - {
+        "jourdain DOP853 (C loop)", "PyDy lambdify/numpy + odeint"})
     for t in tools.values():
         assert t["final_state_error"] < 1e-5 and t["integrate"] > 0 and t["nfev"] > 100
     assert entry["reference_check"] < 1e-8  # the reference agrees with odeint at 1e-12

@@ -122,8 +122,9 @@ def argument_names(y: Sequence[se.Symbol], yd: Sequence[se.Symbol], t: se.Symbol
 #: the temporaries in an array: C compilers take time superlinear in the size of one function
 #: (a 450 kB function of 12 spatial bodies: 35 s in one piece, a few seconds in parts)
 #: (measured for the per-joint code of spatial_chain(24), 900 temporaries: one function 1.8 s at
-#: -O2, parts of 200 statements 0.55 s)
-SPLIT_ABOVE = 200
+#: -O2, parts of 200 statements 0.55 s; of spatial_chain(32), 167 temporaries and 2 000 outputs:
+#: 1.5 s in one function, 0.43 s in parts)
+SPLIT_ABOVE = 400
 #: sin/cos of coordinates and of their sums and differences by the addition theorems
 TRIG_SUMS = True
 PART = 200
@@ -139,8 +140,10 @@ def function_source(name: str, exprs: Sequence[se.Basic], names: Mapping[str, st
     """
     exprs = list(exprs)
     g = Graph(exprs)
+    # statements: one per shared node and one per output (the compiler's time grows with the
+    # size of one function, outputs included)
     n_shared = sum(1 for u in g.uses.values() if u > 1)
-    split = n_shared > SPLIT_ABOVE
+    split = n_shared + len(exprs) > SPLIT_ABOVE
     lines: list[str] = []
     n_tmp = 0
 
