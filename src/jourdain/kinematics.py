@@ -31,7 +31,7 @@ import symengine as se
 
 from .identity import IdentityMap
 from .model.forces import acceleration, rate
-from .model.joints import IDENTITY, Mat3, Rot, Trans, Vec3, rotation_matrix
+from .model.joints import IDENTITY, Joint, Mat3, Rot, Trans, Vec3, rotation_matrix
 from .symbolic import SymMatrix
 
 if TYPE_CHECKING:
@@ -315,6 +315,17 @@ def _translate(F: _Frame, d: Vec3, ctx: _Context) -> None:
         F.a_pieces = _append(F.a_pieces, F.tag, acc)
 
 
+def _joint_steps(F: _Frame, joint: Joint, ctx: _Context) -> None:
+    """Apply a joint's constant orientation and its elementary steps to the frame at the joint
+    point."""
+    _reorient(F, joint.orientation)
+    for step in joint.steps:
+        if isinstance(step, Rot):
+            _rotate(F, step.axis, step.angle, ctx)
+        elif isinstance(step, Trans):
+            _translate(F, step.vector, ctx)
+
+
 @dataclass(frozen=True)
 class BodyKinematics:
     """Kinematics of one body (fields named as in METHOD.md §1).
@@ -417,12 +428,7 @@ def kinematics(system: System) -> Kinematics:
         else:
             F = frames[body.parent].copy()
             _translate(F, j.position, ctx)
-        _reorient(F, j.orientation)
-        for step in j.steps:
-            if isinstance(step, Rot):
-                _rotate(F, step.axis, step.angle, ctx)
-            elif isinstance(step, Trans):
-                _translate(F, step.vector, ctx)
+        _joint_steps(F, j, ctx)
         frames[body.name] = F
         # centre of mass
         C = F.copy()
@@ -474,12 +480,7 @@ def joint_motions(system: System) -> tuple[JointMotion, ...]:
         j = body.joint
         F = _Frame()
         _translate(F, j.position, ctx)
-        _reorient(F, j.orientation)
-        for step in j.steps:
-            if isinstance(step, Rot):
-                _rotate(F, step.axis, step.angle, ctx)
-            elif isinstance(step, Trans):
-                _translate(F, step.vector, ctx)
+        _joint_steps(F, j, ctx)
         out.append(JointMotion(F.S, F.r, MappingProxyType(dict(F.JT)),
                                MappingProxyType(dict(F.JR)), F.v_bar, F.omega_bar, F.a_bar,
                                F.alpha_bar))

@@ -31,7 +31,7 @@ from ..reactions import joint_directions
 from ..symbolic import SymMatrix
 from .ccode import HEADER, argument_names, function_source
 from .diagnose import nonfinite_message
-from .recursive import recursive_units
+from .recursive import LDL_SOLVE, recursive_units
 from .toolchain import CompilerError, build, cache_dir, compiler, content_key
 
 if TYPE_CHECKING:
@@ -134,21 +134,27 @@ class CompiledFunction:
         -------
         dict name -> array (n, rows, cols)
         """
-        Y = np.ascontiguousarray(y, dtype=float)
-        YD = np.ascontiguousarray(yd, dtype=float)
-        if Y.ndim != 2 or Y.shape[1] != self.f or YD.shape != Y.shape:
-            raise EvaluationError(f"batch: y and yd must have shape (n, {self.f}), got "
-                                  f"{Y.shape} and {YD.shape}")
-        n = Y.shape[0]
-        T = np.ascontiguousarray(np.broadcast_to(np.asarray(t, dtype=float), (n,)))
-        P, ps = _shared_or_per_state(p, n, self.n_p, "parameters")
-        U, us = _shared_or_per_state(u, n, self.n_u, "inputs")
+        n, Y, YD, T, P, ps, U, us = self._states("batch", y, yd, t, p, u)
         if out is None:
             out = np.empty((n, self.size))
         elif out.shape != (n, self.size) or not out.flags.c_contiguous or out.dtype != float:
             raise EvaluationError(f"batch: out must be a C-contiguous float array {(n, self.size)}")
         self._batch(n, Y, YD, T, P, ps, U, us, out)
         return self.split(out)
+
+    def _states(self, what: str, y: Any, yd: Any, t: Any, p: Any, u: Any) -> tuple:
+        """Checked contiguous arrays of a batch of states: n, Y, YD, T, P, p_stride, U,
+        u_stride (a stride 0 shares one vector between all states)."""
+        Y = np.ascontiguousarray(y, dtype=float)
+        YD = np.ascontiguousarray(yd, dtype=float)
+        if Y.ndim != 2 or Y.shape[1] != self.f or YD.shape != Y.shape:
+            raise EvaluationError(f"{what}: y and yd must have shape (n, {self.f}), got "
+                                  f"{Y.shape} and {YD.shape}")
+        n = Y.shape[0]
+        T = np.ascontiguousarray(np.broadcast_to(np.asarray(t, dtype=float), (n,)))
+        P, ps = _shared_or_per_state(p, n, self.n_p, "parameters")
+        U, us = _shared_or_per_state(u, n, self.n_u, "inputs")
+        return n, Y, YD, T, P, ps, U, us
 
     def dynamics(self, y: Any, yd: Any, t: Any = 0.0, p: Any = None, u: Any = None
                  ) -> tuple[np.ndarray, np.ndarray]:
@@ -164,15 +170,7 @@ class CompiledFunction:
         fn = getattr(self.lib, "jd_dynamics_batch", None)
         if fn is None or not self.n_bodies:
             raise EvaluationError("this compiled function has no joint wrenches")
-        Y = np.ascontiguousarray(y, dtype=float)
-        YD = np.ascontiguousarray(yd, dtype=float)
-        if Y.ndim != 2 or Y.shape[1] != self.f or YD.shape != Y.shape:
-            raise EvaluationError(f"dynamics: y and yd must have shape (n, {self.f}), got "
-                                  f"{Y.shape} and {YD.shape}")
-        n = Y.shape[0]
-        T = np.ascontiguousarray(np.broadcast_to(np.asarray(t, dtype=float), (n,)))
-        P, ps = _shared_or_per_state(p, n, self.n_p, "parameters")
-        U, us = _shared_or_per_state(u, n, self.n_u, "inputs")
+        n, Y, YD, T, P, ps, U, us = self._states("dynamics", y, yd, t, p, u)
         ydd = np.empty((n, self.f))
         W = np.empty((n, self.n_bodies, 6))
         vp = ctypes.c_void_p
@@ -401,49 +399,16 @@ ACCEL_TEMPLATE = r"""
 #ifndef JD_F
 #define JD_F JD_F_VALUE
 #endif
+""" + LDL_SOLVE + r"""
 int jd_accel(const double *y, const double *yd, double t, const double *p, const double *u,
              double *ydd, double *power) {
     double buf[JD_F * JD_F + 2 * JD_F], L[JD_F * JD_F];
     jd_fn(y, yd, t, p, u, buf);
     const double *M = buf, *k = buf + JD_F * JD_F, *q = k + JD_F;
-    double w = 0.0, dmax = 0.0;
-    for (int i = 0; i < JD_F; ++i) {
-        ydd[i] = q[i] - k[i];
-        w += yd[i] * q[i];
-        dmax = fmax(dmax, fabs(M[i * JD_F + i]));
-    }
+    double w = 0.0;
+    for (int i = 0; i < JD_F; ++i) w += yd[i] * q[i];
     *power = w;
-    /* M = L D Lᵀ (L unit lower triangular): no square roots, one division per column; the
-       pivots D_j are those of the Cholesky factorization squared, so the same test applies */
-    double D[JD_F], Dinv[JD_F];
-    for (int j = 0; j < JD_F; ++j) {
-        double E[JD_F];  /* E[m] = L[j][m] D[m] */
-        double d = M[j * JD_F + j];
-        for (int m = 0; m < j; ++m) {
-            E[m] = L[j * JD_F + m] * D[m];
-            d -= L[j * JD_F + m] * E[m];
-        }
-        if (!(d > 1e-13 * dmax)) return isfinite(d) ? 1 : 2;
-        D[j] = d;
-        Dinv[j] = 1.0 / d;
-        for (int i = j + 1; i < JD_F; ++i) {
-            double s = M[i * JD_F + j];
-            for (int m = 0; m < j; ++m) s -= L[i * JD_F + m] * E[m];
-            L[i * JD_F + j] = s * Dinv[j];
-        }
-    }
-    for (int i = 0; i < JD_F; ++i) {
-        double s = ydd[i];
-        for (int m = 0; m < i; ++m) s -= L[i * JD_F + m] * ydd[m];
-        ydd[i] = s;
-    }
-    for (int i = JD_F - 1; i >= 0; --i) {
-        double s = ydd[i] * Dinv[i];
-        for (int m = i + 1; m < JD_F; ++m) s -= L[m * JD_F + i] * ydd[m];
-        ydd[i] = s;
-    }
-    for (int i = 0; i < JD_F; ++i) if (!isfinite(ydd[i])) return 2;
-    return 0;
+    return jd_solve_mkq(M, k, q, ydd, L);
 }
 """
 

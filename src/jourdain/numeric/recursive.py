@@ -179,7 +179,46 @@ def recursive_source(system: System, full: bool = False, directions: tuple | Non
             + _table("jd_col_start", col_start)
             + _table("jd_col_coord", col_coord)
             + _table("jd_dir_start", dir_start if lay.directions else [0]))
-    return local + "\n/* ---- engine ---- */\n" + head + ENGINE
+    return (local + "\n/* ---- engine ---- */\n" + head
+            + ENGINE.replace("/* LDL_SOLVE */\n", LDL_SOLVE))
+
+
+#: ÿ = M⁻¹(q − k) by LDLᵀ for f = JD_F (the integrator's jd_accel of the symbolic code and the
+#: recursion where the articulated-body recursion does not apply)
+LDL_SOLVE = r"""
+#ifndef JD_SOLVE_MKQ
+#define JD_SOLVE_MKQ
+/* ÿ = M⁻¹(q − k) by LDLᵀ of the projected M; 0, 1 (M not positive definite) or 2 (NaN) */
+static int jd_solve_mkq(const double *M, const double *k, const double *q, double *ydd,
+                        double *L /* f×f work */) {
+    double D[JD_F], Dinv[JD_F], E[JD_F], dmax = 0.0;
+    for (int i = 0; i < JD_F; ++i) { ydd[i] = q[i] - k[i]; dmax = fmax(dmax, fabs(M[i * JD_F + i])); }
+    for (int j = 0; j < JD_F; ++j) {
+        double d = M[j * JD_F + j];
+        for (int m = 0; m < j; ++m) { E[m] = L[j * JD_F + m] * D[m]; d -= L[j * JD_F + m] * E[m]; }
+        if (!(d > 1e-13 * dmax)) return isfinite(d) ? 1 : 2;
+        D[j] = d; Dinv[j] = 1.0 / d;
+        for (int i = j + 1; i < JD_F; ++i) {
+            double s = M[i * JD_F + j];
+            for (int m = 0; m < j; ++m) s -= L[i * JD_F + m] * E[m];
+            L[i * JD_F + j] = s * Dinv[j];
+        }
+    }
+    for (int i = 0; i < JD_F; ++i) {
+        double s = ydd[i];
+        for (int m = 0; m < i; ++m) s -= L[i * JD_F + m] * ydd[m];
+        ydd[i] = s;
+    }
+    for (int i = JD_F - 1; i >= 0; --i) {
+        double s = ydd[i] * Dinv[i];
+        for (int m = i + 1; m < JD_F; ++m) s -= L[m * JD_F + i] * ydd[m];
+        ydd[i] = s;
+    }
+    for (int i = 0; i < JD_F; ++i) if (!isfinite(ydd[i])) return 2;
+    return 0;
+}
+#endif
+"""
 
 
 # The engine: generic in the tables above. Spatial vectors about the inertial origin in inertial
@@ -498,35 +537,7 @@ static void jd_wrenches_of(const double *ydd, jd_work *W, double *out) {
     }
 }
 
-/* ÿ = M⁻¹(q − k) by LDLᵀ of the projected M; 0, 1 (M not positive definite) or 2 (NaN) */
-static int jd_solve_mkq(const double *M, const double *k, const double *q, double *ydd,
-                        double *L /* f×f work */) {
-    double D[JD_F], Dinv[JD_F], E[JD_F], dmax = 0.0;
-    for (int i = 0; i < JD_F; ++i) { ydd[i] = q[i] - k[i]; dmax = fmax(dmax, fabs(M[i * JD_F + i])); }
-    for (int j = 0; j < JD_F; ++j) {
-        double d = M[j * JD_F + j];
-        for (int m = 0; m < j; ++m) { E[m] = L[j * JD_F + m] * D[m]; d -= L[j * JD_F + m] * E[m]; }
-        if (!(d > 1e-13 * dmax)) return isfinite(d) ? 1 : 2;
-        D[j] = d; Dinv[j] = 1.0 / d;
-        for (int i = j + 1; i < JD_F; ++i) {
-            double s = M[i * JD_F + j];
-            for (int m = 0; m < j; ++m) s -= L[i * JD_F + m] * E[m];
-            L[i * JD_F + j] = s * Dinv[j];
-        }
-    }
-    for (int i = 0; i < JD_F; ++i) {
-        double s = ydd[i];
-        for (int m = 0; m < i; ++m) s -= L[i * JD_F + m] * ydd[m];
-        ydd[i] = s;
-    }
-    for (int i = JD_F - 1; i >= 0; --i) {
-        double s = ydd[i] * Dinv[i];
-        for (int m = i + 1; m < JD_F; ++m) s -= L[m * JD_F + i] * ydd[m];
-        ydd[i] = s;
-    }
-    for (int i = 0; i < JD_F; ++i) if (!isfinite(ydd[i])) return 2;
-    return 0;
-}
+/* LDL_SOLVE */
 #endif
 
 #if JD_ABA
@@ -665,25 +676,29 @@ static void jd_to_joint_frames(const jd_work *W, double *wrench) {
 /* per state: ÿ (f) and the joint wrenches (6p) of the forward dynamics (the articulated-body
    recursion where every coordinate belongs to one joint, else LDLᵀ of the projected M and the
    sub-tree sums); returns 0, 1 (M not positive definite) or 2 (NaN) */
+/* the work of the recursion at a state, on the heap with ``extra`` bytes after it (W + 1) */
+static jd_work *jd_at_state(const double *y, const double *yd, double t, const double *p,
+                            const double *u, size_t extra) {
+    double L[JD_NL > 0 ? JD_NL : 1];
+    jd_work *W = (jd_work *)malloc(sizeof(jd_work) + extra);
+    if (!W) return NULL;
+    jd_local(y, yd, t, p, u, L);
+    jd_recursion(L, yd, W);
+    return W;
+}
+
 int jd_dynamics(const double *y, const double *yd, double t, const double *p, const double *u,
                 double *ydd, double *wrench) {
-    double L[JD_NL > 0 ? JD_NL : 1];
 #if JD_ABA
-    char *mem = (char *)malloc(sizeof(jd_work) + sizeof(jd_aba_work));
-    if (!mem) return 2;
-    jd_work *W = (jd_work *)mem;
-    jd_local(y, yd, t, p, u, L);
-    jd_recursion(L, yd, W);
-    int status = jd_aba(W, (jd_aba_work *)(mem + sizeof(jd_work)), ydd, wrench);
+    jd_work *W = jd_at_state(y, yd, t, p, u, sizeof(jd_aba_work));
+    if (!W) return 2;
+    int status = jd_aba(W, (jd_aba_work *)(W + 1), ydd, wrench);
     if (status == 0) jd_to_joint_frames(W, wrench);
 #else
-    /* one block on the heap: the work of the recursion, M, k, q and the factor of M */
-    char *mem = (char *)malloc(sizeof(jd_work) + sizeof(double) * (2 * JD_F * JD_F + 2 * JD_F));
-    if (!mem) return 2;
-    jd_work *W = (jd_work *)mem;
-    double *Mkq = (double *)(mem + sizeof(jd_work)), *Lf = Mkq + JD_F * JD_F + 2 * JD_F;
-    jd_local(y, yd, t, p, u, L);
-    jd_recursion(L, yd, W);
+    /* after the work: M, k, q and the factor of M */
+    jd_work *W = jd_at_state(y, yd, t, p, u, sizeof(double) * (2 * JD_F * JD_F + 2 * JD_F));
+    if (!W) return 2;
+    double *Mkq = (double *)(W + 1), *Lf = Mkq + JD_F * JD_F + 2 * JD_F;
     jd_project(W, Mkq, Mkq + JD_F * JD_F, Mkq + JD_F * JD_F + JD_F);
     int status = jd_solve_mkq(Mkq, Mkq + JD_F * JD_F, Mkq + JD_F * JD_F + JD_F, ydd, Lf);
     if (status == 0) {
@@ -691,7 +706,7 @@ int jd_dynamics(const double *y, const double *yd, double t, const double *p, co
         jd_to_joint_frames(W, wrench);
     }
 #endif
-    free(mem);
+    free(W);
     return status;
 }
 
@@ -709,19 +724,15 @@ long jd_dynamics_batch(long n, long f, const double *y, const double *yd, const 
    the applied forces (q_j = Σ over the columns of coordinate j of V·(Σ q̄^e as a wrench)) */
 int jd_accel(const double *y, const double *yd, double t, const double *p, const double *u,
              double *ydd, double *power) {
-    double L[JD_NL > 0 ? JD_NL : 1];
-    char *mem = (char *)malloc(sizeof(jd_work) + sizeof(jd_aba_work));
-    if (!mem) return 2;
-    jd_work *W = (jd_work *)mem;
-    jd_local(y, yd, t, p, u, L);
-    jd_recursion(L, yd, W);
+    jd_work *W = jd_at_state(y, yd, t, p, u, sizeof(jd_aba_work));
+    if (!W) return 2;
     double w = 0.0;
     for (int b = 0; b < JD_P; ++b)
         for (int c = jd_col_start[b]; c < jd_col_start[b + 1]; ++c)
             w += yd[jd_col_coord[c]] * jd_dot6(W->V + 6 * c, W->Wc + 6 * b);
     *power = w;
-    int status = jd_aba(W, (jd_aba_work *)(mem + sizeof(jd_work)), ydd, NULL);
-    free(mem);
+    int status = jd_aba(W, (jd_aba_work *)(W + 1), ydd, NULL);
+    free(W);
     return status;
 }
 #endif
