@@ -163,3 +163,100 @@ def test_batched_reactions_equal_single_state_evaluation():
         ref = s.evaluate(res.y[i], res.yd[i], res.t[i])  # two solves of N̂·g = k̂ − q̂
         np.testing.assert_allclose(res.g[i], ref["g"], rtol=0, atol=2 * reactions_tol(ref))
     assert res.g_names == ref["g_names"]
+
+
+# --- sampling and the motion between the samples (issue 17, item 8) ---------------------------
+#: a plot resolves about a thousandth of its height
+PLOT_RESOLUTION = 1e-3
+
+
+def test_default_run_plots_smooth_curves():
+    """Without t_eval the results hold the integrator's steps (here about 0.2 s apart, a
+    tenth of the period: straight lines between them miss the curve by 4 % of the amplitude).
+    The plot draws the interpolated motion on PLOT_POINTS times plus the steps."""
+    from jourdain.results import PLOT_POINTS
+
+    s = pendulum()
+    res = s.simulate((0, 10), [1.0], [0.0])
+    period = 2 * np.pi * np.sqrt(0.8 / 9.81)  # small-amplitude period, slightly short at 1 rad
+    assert np.diff(res.t).max() > period / 20  # the steps alone are coarse
+    for what, col in (("y", "y"), ("yd", "yd")):
+        x, y = res.plot(what).get_lines()[0].get_data()
+        assert len(x) >= PLOT_POINTS and np.diff(x).max() <= 10.0 / (PLOT_POINTS - 1) * (1 + 1e-12)
+        assert len(x) * period / 10.0 >= 100  # points per period
+        assert set(res.t) <= set(x)
+        ref = s.simulate((0, 10), [1.0], [0.0], rtol=1e-12, atol=1e-12, t_eval=x)
+        dev = np.abs(y - getattr(ref, col)[:, 0]).max() / np.abs(getattr(ref, col)).max()
+        assert dev < PLOT_RESOLUTION, what
+    straight = np.interp(x, res.t, res.yd[:, 0])  # what the plot drew before
+    assert np.abs(straight - ref.yd[:, 0]).max() / np.abs(ref.yd).max() > PLOT_RESOLUTION
+    x, _ = res.plot_phase("phi").get_lines()[0].get_data()
+    assert len(x) >= PLOT_POINTS
+    x, _ = res.plot("energy").get_lines()[0].get_data()
+    assert len(x) >= PLOT_POINTS
+    x, _ = res.plot_path("bob", point="com").get_lines()[0].get_data()
+    assert len(x) >= PLOT_POINTS
+
+
+def test_interpolate_is_exact_at_the_samples_and_of_sixth_order_between():
+    s = pendulum()
+    res = s.simulate((0, 3), [1.0], [0.0], rtol=1e-10, atol=1e-12)
+    at = res.interpolate(res.t)
+    for k in ("y", "yd", "ydd"):
+        np.testing.assert_allclose(at[k], getattr(res, k), rtol=1e-13, atol=1e-13)
+    # halving the steps (t_eval on every step and midpoint gives them to the interpolation)
+    # divides the error between samples by about 2⁶
+    mid = 0.5 * (res.t[1:] + res.t[:-1])
+    fine = s.simulate((0, 3), [1.0], [0.0], rtol=1e-10, atol=1e-12,
+                      t_eval=np.sort(np.r_[res.t, mid]))
+    quarter = 0.5 * (res.t[1:] + mid)
+    ref = s.simulate((0, 3), [1.0], [0.0], rtol=1e-13, atol=1e-13, t_eval=quarter)
+    coarse_err = np.abs(res.interpolate(quarter)["y"] - ref.y).max()
+    fine_err = np.abs(fine.interpolate(quarter)["y"] - ref.y).max()
+    assert fine_err < coarse_err / 16
+    with pytest.raises(jd.EvaluationError, match="within the run"):
+        res.interpolate([3.5])
+
+
+# --- energy balance for every model, events (issue 17, item 10) -------------------------------
+def test_energy_balance_is_a_number_for_every_model(tmp_path):
+    damped = pendulum(damping=0.3).simulate((0, 5), [1.0], [0.0], rtol=1e-10, atol=1e-10)
+    assert damped.energy_drift is None  # the conservative special case only
+    assert isinstance(damped.energy_balance_error, float) and damped.energy_balance_error < 1e-8
+    assert "energy balance error" in damped.summary()
+    back = jd.Results.load(damped.save(tmp_path / "damped.h5"))  # T, V from the file
+    assert back.energy_balance_error == pytest.approx(damped.energy_balance_error, rel=1e-6)
+    conservative = pendulum().simulate((0, 2), [1.2], [0.5], rtol=1e-10, atol=1e-10)
+    assert conservative.energy_balance_error <= 2 * conservative.energy_drift + 1e-15
+    np.testing.assert_array_equal(conservative.work_drive, 0.0)
+
+
+def test_energy_balance_includes_the_work_of_a_prescribed_motion():
+    """A bead on a rod turned at Ω: T = ½m(ẋ² + Ω²x²), ẍ = Ω²x, so the drive does
+    W = mΩ²(x² − x0²). It used to be left out, and the 'balance error' was 0.5."""
+    x, m, W = jd.symbols("x m Omega")
+    rod = jd.Body("rod", "world", jd.General("drive", [jd.Rot("z", W * jd.t)], coordinates=[]),
+                  mass=0, inertia=jd.point_mass())
+    bead = jd.Body("bead", "rod", jd.Prismatic("slot", x, "x"), mass=m, inertia=jd.point_mass())
+    s = jd.System([x], [rod, bead], [], parameters={"m": 0.3, "Omega": 2.0})
+    r = s.simulate((0, 1.5), [0.1], [0.05], rtol=1e-11, atol=1e-12)
+    assert r.rheonomic and not r.conservative and r.energy_drift is None
+    exact = 0.3 * 4.0 * (r.y[:, 0] ** 2 - 0.1**2)
+    # three-point Gauss along the interpolated motion: error of the interpolation's order
+    np.testing.assert_allclose(r.work_drive, exact, rtol=1e-7, atol=1e-7 * exact.max())
+    assert r.energy_balance_error < 1e-7
+    assert "prescribed (rheonomic) motion's drive" in r.summary()
+    labels = [ln.get_label() for ln in r.plot("energy").get_lines()]
+    assert "W_drive (work of the prescribed motion)" in labels
+
+
+def test_events_hold_every_event_even_without_crossings():
+    s = pendulum()
+    phi = s.y[0]
+    res = s.simulate((0, 2), [1.0], [0.0], events=[
+        jd.Event(phi, direction=-1, name="down"), jd.Event(phi - 5, name="never")])
+    assert set(res.events) == {"down", "never"}
+    assert res.events["never"]["t"].shape == (0,) and res.events["never"]["y"].shape == (0, 1)
+    t_down = res.events["down"]["t"]
+    assert len(t_down) >= 1 and np.all(np.abs(res.interpolate(t_down)["y"][:, 0]) < 1e-5)
+    assert "events" in jd.Results.__doc__ and "terminal" in jd.Results.__doc__

@@ -124,7 +124,7 @@ def test_bead_on_a_rod_turned_at_constant_rate():
     np.testing.assert_allclose(r.kinetic_energy, 0.15 * (r.yd[:, 0] ** 2 + 4 * r.y[:, 0] ** 2),
                                rtol=1e-12)
     assert not r.conservative and r.rheonomic
-    assert r.energy_balance_error > 0.1  # the drive's work is not in the balance
+    assert r.energy_balance_error < 1e-7  # the drive's work is in the balance
     assert "rheonomic" in r.summary()
 
 

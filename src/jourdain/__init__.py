@@ -22,13 +22,21 @@ from .analysis import (
 )
 from .energy import Energy, energy
 from .equilibrium import Equilibrium, NoEquilibrium, find_equilibria, find_equilibrium
-from .errors import EvaluationError, JourdainError, ModelError, SingularMassMatrix
+from .errors import (
+    EvaluationError,
+    JourdainError,
+    JourdainWarning,
+    ModelError,
+    SingularMassMatrix,
+)
 from .io import ModelFile, ModelFileError, load_model
 from .kinematics import BodyKinematics, Kinematics, kinematics
 from .linearization import (
     CompiledLinearization,
     GeneralLinearization,
     Linearization,
+    NominalCheck,
+    NominalMotionWarning,
     NumericLinearization,
     TimeVariantError,
     linearization,
@@ -80,11 +88,12 @@ __version__ = "0.1.0"
 
 __all__ = [
     "atan2", "cos", "exp", "log", "pi", "sin", "sqrt", "tan",
-    "EvaluationError", "JourdainError", "ModelError", "SingularMassMatrix",
+    "EvaluationError", "JourdainError", "JourdainWarning", "ModelError", "SingularMassMatrix",
     "ModelFile", "ModelFileError", "load_model",
     "BodyKinematics", "Kinematics", "kinematics", "NewtonEuler", "newton_euler",
     "EquationsOfMotion", "projection", "SymMatrix",
-    "CompiledLinearization", "GeneralLinearization", "Linearization", "NumericLinearization",
+    "CompiledLinearization", "GeneralLinearization", "Linearization", "NominalCheck",
+    "NominalMotionWarning", "NumericLinearization",
     "TimeVariantError", "linearization", "linearization_general", "linearize_numeric",
     "FrequencyResponse", "Modes", "Stability", "StateSpace", "Sweep", "frequency_response",
     "modes", "stability", "stability_boundary", "state_space", "sweep",

@@ -268,10 +268,9 @@ def cmd_eom(args: argparse.Namespace) -> int:
     if args.format == "latex":
         names = {"M_bar": r"\bar{M}", "J_bar": r"\bar{J}", "q_c": r"\bar{q}^{c}",
                  "q_e": r"\bar{q}^{e}", "M": "M", "k": "k", "q": "q"}
-        print(f"% {system.name}: Newton–Euler equations and equations of motion (jourdain)")
-        for k, m in mats.items():
-            print(f"{names[k]} = {export.matrix_latex(m, system, args.max_ops)}")
-            print()
+        print(export.latex_fragment(
+            mats, names, system, f"{system.name}: Newton-Euler equations and equations of motion",
+            args.max_ops), end="")
         return EXIT_OK
     print(f"{system.name}: M̄·J̄·ÿ + q̄^c = q̄^e + Q̄·g  →  M·ÿ + k = q")
     for k, m in mats.items():
@@ -365,12 +364,16 @@ def cmd_eval(args: argparse.Namespace) -> int:
         }
         print(json.dumps(out, indent=1))
         return EXIT_OK
-    np.set_printoptions(precision=6, suppress=True, linewidth=120)
-    state = ", ".join(f"{c}={v:g}" for c, v in zip(system.coordinate_names, y, strict=True))
-    rates = ", ".join(f"{c}_d={v:g}" for c, v in zip(system.coordinate_names, yd, strict=True))
-    print(f"{system.name} at t={t:g}, {state}, {rates}")
+    from .io.export import ROUNDOFF_RTOL, format_array
+
+    print(f"{system.name} at {_state_text(system, y, yd, t, inputs)}")
+    if params:
+        print("  parameters set: " + ", ".join(f"{k}={v:g}" for k, v in params.items()))
+    print(f"  (round-off, below {ROUNDOFF_RTOL:g} of the largest entry of a matrix or vector, "
+          "is shown as 0; --json gives the numbers as computed)")
+    scales = _display_scales(values)
     for k, v in values.items():
-        print(f"\n{k} =\n{np.asarray(v)}")
+        print(f"\n{k} =\n{format_array(v, scales.get(k))}")
     if extra.get("g_names"):
         print("\ng components: " + ", ".join(extra["g_names"]))
     if missing:
@@ -393,11 +396,63 @@ def cmd_reactions(args: argparse.Namespace) -> int:
                           "g": _json_array(g),
                           "g_undetermined": list(values.get("g_undetermined", []))}, indent=1))
         return EXIT_OK
-    print(f"{system.name}: reaction forces g from N̂·g = k̂ − q̂ at t={t:g}")
-    print("  (components in the child body frame at the joint point)")
-    for lab, v in zip(labels, g, strict=False):
-        print(f"  {lab:<24} {v: .6g}" if np.isfinite(v) else f"  {lab:<24} undetermined")
+    from .io.export import ROUNDOFF_RTOL, chop
+
+    print(f"{system.name}: reaction forces g from N̂·g = k̂ − q̂ at "
+          f"{_state_text(system, y, yd, t, inputs)}")
+    if params:
+        print("  parameters set: " + ", ".join(f"{k}={v:g}" for k, v in params.items()))
+    print("  (components in the child body frame at the joint point; round-off, below "
+          f"{ROUNDOFF_RTOL:g} of the largest |g|, is shown as 0)")
+    force, torque = reaction_units(system)
+    shown = chop(g)
+    for lab, v in zip(labels, shown, strict=False):
+        unit = torque if lab.rsplit(".", 1)[-1].startswith("T") else force
+        print(f"  {lab:<24} {v: .6g} {unit}" if np.isfinite(v)
+              else f"  {lab:<24} undetermined")
     return EXIT_OK
+
+
+#: units of length and mass recognized in a model's units, for the units of forces and torques
+_LENGTHS = ("m", "mm", "cm", "km", "in", "ft")
+_MASSES = ("kg", "g", "t", "lb")
+
+
+def reaction_units(system: Any) -> tuple[str, str]:
+    """Units of the reaction forces and torques: N and N·m, or mass·length/s² and
+    mass·length²/s² where the model declares other units of length or mass (jourdain does not
+    convert units, so the numbers are in the model's own)."""
+    declared = [u.strip() for u in dict(system.units).values()]
+    length = next((u for u in declared if u in _LENGTHS), "m")
+    mass = next((u for u in declared if u in _MASSES), "kg")
+    if (mass, length) == ("kg", "m"):
+        return "N", "N·m"
+    return f"{mass}·{length}/s²", f"{mass}·{length}²/s²"
+
+
+def _state_text(system: Any, y: np.ndarray, yd: np.ndarray, t: float,
+                inputs: dict[str, float]) -> str:
+    """The state of a numeric evaluation, for the header of the text output."""
+    parts = [f"t={t:g}"]
+    parts += [f"{c}={v:g}" for c, v in zip(system.coordinate_names, y, strict=True)]
+    parts += [f"{c}_d={v:g}" for c, v in zip(system.coordinate_names, yd, strict=True)]
+    parts += [f"{n}={v:g}" for n, v in inputs.items()]
+    return ", ".join(parts)
+
+
+def _display_scales(values: dict[str, np.ndarray]) -> dict[str, Any]:
+    """What the round-off of each quantity is judged against: the symmetric and skew parts
+    against P and Q, the generalized forces k, q, h against the body forces and torques
+    projected (``max|J̄|·(max|q̄^c| + max|q̄^e|)``, which stays large where q itself cancels to
+    round-off, as for a pendulum standing upright); the others against themselves."""
+    out: dict[str, Any] = {"D": values.get("P"), "G": values.get("P"), "K": values.get("Q"),
+                           "N": values.get("Q")}
+    if all(k in values for k in ("J_bar", "q_c", "q_e")):
+        forces = [float(np.abs(values["J_bar"]).max(initial=0.0)
+                        * (np.abs(values["q_c"]).max(initial=0.0)
+                           + np.abs(values["q_e"]).max(initial=0.0)))]
+        out.update({k: forces for k in ("k", "q", "h")})
+    return out
 
 
 def cmd_linearize(args: argparse.Namespace) -> int:
@@ -411,7 +466,6 @@ def cmd_linearize(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(integration.jsonable(result), indent=1))
         return EXIT_OK
-    np.set_printoptions(precision=6, suppress=True, linewidth=120)
     print(integration.linear_text(result))
     return EXIT_OK
 

@@ -24,6 +24,12 @@ large systems).
 For a time-invariant result (M̃, P, Q, B free of t) the matrices split into damping ``D``,
 gyroscopic ``G``, stiffness ``K`` and circulatory ``N`` parts (§6):
 ``D = ½(P + Pᵀ)``, ``G = ½(P − Pᵀ)``, ``K = ½(Q + Qᵀ)``, ``N = ½(Q − Qᵀ)``.
+
+A nominal motion may set the inputs too (``u_s``: the motor torque that keeps a rotor turning
+against its damping, the force that holds an arm in its pose). Where an equilibrium or a steady
+motion (ÿ_s = 0) leaves ``h ≠ 0`` it is not a solution of the equations of motion: the
+linearization says so with a :class:`NominalMotionWarning` (:meth:`Linearization.check_nominal`,
+:class:`NominalCheck`), and so does the stability verdict built on it.
 """
 
 from __future__ import annotations
@@ -36,7 +42,7 @@ import numpy as np
 import symengine as se
 
 from .differentiate import Graph, evaluate_float, free_symbol_names, jet, jet_float
-from .errors import EvaluationError, JourdainError, ModelError
+from .errors import EvaluationError, JourdainError, JourdainWarning, ModelError, warn
 from .model.expressions import as_expr
 from .symbolic import SymMatrix
 
@@ -49,8 +55,116 @@ ZERO = se.Integer(0)
 HALF = se.Rational(1, 2)
 
 
+#: ``h`` counts as zero where ``|h_i| ≤ NOMINAL_RTOL·scale_i`` (:class:`NominalCheck`): far
+#: above the round-off of evaluating q − k − M·ÿ_s (a few eps of the forces summed), and below
+#: the error of a nominal value written with 8 significant digits (``phi = 3.1415927``).
+NOMINAL_RTOL = 1e-8
+
+
 class TimeVariantError(JourdainError):
     """An operation that needs a time-invariant linear system got a time-variant one."""
+
+
+class NominalMotionWarning(JourdainWarning):
+    """A claimed equilibrium or steady motion is not a solution of the equations of motion
+    (``h ≠ 0``): the linear system describes the motion near a point the system does not stay
+    at, so its eigenvalues and stability verdict are not those of the nominal motion."""
+
+
+@dataclass(frozen=True)
+class NominalCheck:
+    """Whether a nominal motion solves the equations of motion: the residual
+    ``h = q − k − M·ÿ_s`` at one time against the size of the forces at work there.
+
+    Attributes
+    ----------
+    h : (f,) array
+        The residual (METHOD.md §5).
+    scale : (f,) array
+        ``‖J̄_i‖·(‖q̄^c‖ + ‖q̄^e‖ + ‖M̄·J̄·ÿ_s‖) + |k_i| + |q_i|`` with ``J̄_i`` the column of
+        coordinate i: by Cauchy–Schwarz on ``q_i = J̄_iᵀ·q̄^e``, the largest generalized force the
+        body forces and torques at the nominal state could make on coordinate i. It stays large
+        where those forces balance (a pendulum standing upright, where ``q`` itself is round-off).
+        Zeros where h is exactly zero (not evaluated).
+    relative : float
+        ``max |h_i| / scale_i`` (inf where ``scale_i = 0 < |h_i|``).
+    kind : str
+        ``"equilibrium"`` (y_s constant), ``"steady motion"`` (ÿ_s = 0, constant rates) or
+        ``"nominal motion"``.
+    t : float
+    nominal : str
+        The nominal motion in words (for messages).
+    coordinate_names, input_names : tuple of str
+    u_s : (m,) array
+        The nominal inputs.
+    B : (f, m) array
+        The input matrix ``∂q/∂u`` at the nominal motion.
+    """
+
+    h: np.ndarray
+    scale: np.ndarray
+    relative: float
+    kind: str
+    t: float
+    nominal: str
+    coordinate_names: tuple[str, ...]
+    input_names: tuple[str, ...]
+    u_s: np.ndarray
+    B: np.ndarray
+
+    @property
+    def is_solution(self) -> bool:
+        """True when ``|h_i| ≤ NOMINAL_RTOL·scale_i`` for every coordinate."""
+        return self.relative <= NOMINAL_RTOL
+
+    @property
+    def holding_inputs(self) -> dict[str, float] | None:
+        """Input values that make h vanish, ``u_s − B⁺·h``, where such values exist (h in the
+        range of B); None otherwise or when the system has no inputs."""
+        if not self.input_names or self.is_solution:
+            return None
+        du = np.linalg.lstsq(self.B, -self.h, rcond=None)[0]
+        rest = self.h + self.B @ du
+        if np.any(np.abs(rest) > NOMINAL_RTOL * np.maximum(self.scale, np.abs(self.h))):
+            return None
+        return {n: float(v) for n, v in zip(self.input_names, self.u_s + du, strict=True)}
+
+    def message(self) -> str:
+        """Why the nominal motion is not a solution, and what would make it one."""
+        i = int(np.argmax(np.abs(self.h) / np.where(self.scale > 0, self.scale, 1.0)))
+        rel = (f"{abs(self.h[i]) / self.scale[i]:.2g} of the forces at work there"
+               if self.scale[i] > 0 else "where no force acts")
+        text = (f"the nominal {self.kind} {self.nominal} is not a solution of the equations of "
+                f"motion at t = {self.t:g}: h = q - k - M*ydd_s = "
+                f"{np.array2string(self.h, precision=4)} is not zero (|h| = {abs(self.h[i]):.4g} "
+                f'on "{self.coordinate_names[i]}", {rel}); the linear system describes motions '
+                "near a point the system does not stay at, so its eigenvalues and stability "
+                "verdict are not those of the nominal motion.")
+        hold = self.holding_inputs
+        if hold is not None:
+            vals = ", ".join(f'"{k}": {v:.6g}' for k, v in hold.items())
+            return (text + f" The inputs {{{vals}}} hold it: give them with the nominal motion "
+                    f"(system.linearize(nominal, inputs={{{vals}}}), or inputs = {{ ... }} in "
+                    "the model file's [nominal.<name>]).")
+        if self.input_names:
+            return (text + " Give the inputs that hold it with the nominal motion "
+                    "(system.linearize(nominal, inputs={...}), or inputs = { ... } in the model "
+                    "file's [nominal.<name>]), or correct y_s.")
+        return text + " Correct y_s (jourdain.find_equilibrium finds equilibria)."
+
+
+def _h_scale(J_bar: np.ndarray, q_c: np.ndarray, q_e: np.ndarray, M_bar: np.ndarray,
+             ydd_s: np.ndarray, k: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """The scale of :class:`NominalCheck` from the numbers at the nominal state."""
+    forces = (np.linalg.norm(q_c) + np.linalg.norm(q_e)
+              + np.linalg.norm(M_bar @ (J_bar @ ydd_s)))
+    return np.linalg.norm(J_bar, axis=0) * forces + np.abs(k) + np.abs(q)
+
+
+def _kind(y_s: list[se.Basic], yd_s: list[se.Basic], ydd_s: list[se.Basic]) -> str:
+    if not all(_is_zero(a) for a in ydd_s):
+        return "nominal motion"
+    return "equilibrium" if all(_is_zero(v) for v in yd_s) else "steady motion"
 
 
 @dataclass(frozen=True)
@@ -180,6 +294,45 @@ class Linearization:
                         return False
         return True
 
+    # --- does the nominal motion solve the equations of motion? -------------------------------
+    def check_nominal(self, t: float = 0.0,
+                      parameters: Mapping[str, float] | None = None) -> NominalCheck:
+        """``h`` at time ``t`` against the forces at work at the nominal state
+        (:class:`NominalCheck`; ``check.is_solution``, ``check.message()``)."""
+        from .numeric import parameter_vector, time_value
+
+        system = self.system
+        f, m = system.f, len(system.inputs)
+        tv = time_value(t)
+        p = parameter_vector(system, parameters)
+        values = {str(s): float(v) for s, v in zip(system.parameter_symbols, p, strict=True)}
+        values["t"] = tv
+        nums = np.array(evaluate_float(
+            [*self.y_s.entries(), *self.yd_s.entries(), *self.ydd_s.entries(),
+             *self.u_s.entries(), *self.h.entries(), *self.B.entries()], values))
+        ys, yds, ydds, us, h = (nums[:f], nums[f:2 * f], nums[2 * f:3 * f],
+                                nums[3 * f:3 * f + m], nums[3 * f + m:4 * f + m])
+        B = nums[4 * f + m:].reshape(f, m)
+        scale = np.zeros(f)
+        if np.any(h != 0):
+            eom = self.equations_of_motion
+            ne = eom.newton_euler
+            state = dict(values)
+            for syms, vals in ((system.y, ys), (system.yd, yds), (system.inputs, us)):
+                state.update({str(s): float(v) for s, v in zip(syms, vals, strict=True)})
+            mats = (ne.J_bar, ne.q_c, ne.q_e, ne.M_bar, eom.k, eom.q)
+            flat = np.array(evaluate_float([e for mat in mats for e in mat.entries()], state))
+            parts, i = [], 0
+            for mat in mats:
+                r, c = mat.shape
+                parts.append(flat[i:i + r * c].reshape(r, c))
+                i += r * c
+            Jb, qc, qe, Mb, k, q = parts
+            scale = _h_scale(Jb, qc[:, 0], qe[:, 0], Mb, ydds, k[:, 0], q[:, 0])
+        return _nominal_check(h, scale, _kind(self.y_s.entries(), self.yd_s.entries(),
+                                              self.ydd_s.entries()),
+                              tv, _describe_nominal(self), system, us, B)
+
     # --- numbers -----------------------------------------------------------------------------
     def evaluate(self, t: float = 0.0,
                  parameters: Mapping[str, float] | None = None) -> dict[str, np.ndarray]:
@@ -268,7 +421,30 @@ class CompiledLinearization:
         return self.linearization._finish(dict(out))
 
 
-def linearization(eom: EquationsOfMotion, nominal: Mapping[Any, Any] | Any) -> Linearization:
+def _nominal_check(h: np.ndarray, scale: np.ndarray, kind: str, t: float, nominal: str,
+                   system: System, u_s: np.ndarray, B: np.ndarray) -> NominalCheck:
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rel = np.where(h == 0, 0.0, np.abs(h) / scale)
+    return NominalCheck(h=h, scale=scale, relative=float(rel.max(initial=0.0)), kind=kind, t=t,
+                        nominal=nominal, coordinate_names=tuple(system.coordinate_names),
+                        input_names=tuple(system.input_names), u_s=np.asarray(u_s, float),
+                        B=np.asarray(B, float).reshape(system.f, len(system.inputs)))
+
+
+def _warn_if_not_solution(lin: Linearization) -> None:
+    """A :class:`NominalMotionWarning` when a claimed equilibrium or steady motion leaves
+    h ≠ 0 at t = 0 for the default parameter values (a reference trajectory with ÿ_s ≠ 0 is
+    not checked: h is its feed-forward)."""
+    try:
+        result = lin.check_nominal()
+    except JourdainError:  # no numbers at the default parameter values: evaluate() will say
+        return
+    if result.kind != "nominal motion" and not result.is_solution:
+        warn(result.message(), NominalMotionWarning)
+
+
+def linearization(eom: EquationsOfMotion, nominal: Mapping[Any, Any] | Any,
+                  inputs: Mapping[Any, Any] | None = None) -> Linearization:
     """Linearize ``M·ÿ + k = q`` about a nominal motion (METHOD.md §5).
 
     Parameters
@@ -281,6 +457,10 @@ def linearization(eom: EquationsOfMotion, nominal: Mapping[Any, Any] | Any) -> L
         ``Omega*t`` for a steady rotation, any ``y_s(t)`` for a reference trajectory. Inputs may
         be given too (``{"F": F_s}``); inputs not given are zero. An object with a ``nominal``
         attribute (e.g. :class:`jourdain.Equilibrium`) is accepted as well.
+    inputs : mapping, optional
+        Nominal inputs ``{input: u_s}`` (numbers or expressions in t and the parameters), e.g.
+        the motor torque that keeps the nominal motion going; the same as giving them in
+        ``nominal``.
 
     Returns
     -------
@@ -292,9 +472,15 @@ def linearization(eom: EquationsOfMotion, nominal: Mapping[Any, Any] | Any) -> L
     ModelError
         A coordinate without a nominal value, an unknown name, or a symbol in a nominal value
         that is neither ``t`` nor a parameter of the system.
+
+    Warns
+    -----
+    NominalMotionWarning
+        When the nominal motion is an equilibrium or a steady motion (ÿ_s = 0) and ``h ≠ 0`` at
+        t = 0 for the default parameter values (:meth:`Linearization.check_nominal`).
     """
     system = eom.system
-    y_s, u_s = _nominal(system, nominal)
+    y_s, u_s = _nominal(system, nominal, inputs)
     t = system.t
     f = system.f
     yd_s = [se.diff(e, t) for e in y_s]
@@ -354,26 +540,37 @@ def linearization(eom: EquationsOfMotion, nominal: Mapping[Any, Any] | Any) -> L
                 vals = iter(jet(flat, [], {t: ZERO}).values)
                 matrices[name] = [[next(vals) for _ in row] for row in rows]
         Mt, P, Q, B = (matrices[n] for n in ("M_tilde", "P", "Q", "B"))
-    return Linearization(
+    lin = Linearization(
         equations_of_motion=eom, time_dependence=dependence,
         y_s=SymMatrix.column(y_s), yd_s=SymMatrix.column(yd_s), ydd_s=SymMatrix.column(ydd_s),
         u_s=SymMatrix.column(u_s) if m else SymMatrix(()),
         M_tilde=SymMatrix.from_rows(Mt), P=SymMatrix.from_rows(P), Q=SymMatrix.from_rows(Q),
         h=SymMatrix.column(h), B=SymMatrix(tuple(tuple(row) for row in B)),
     )
+    _warn_if_not_solution(lin)
+    return lin
 
 
-def _nominal(system: System, nominal: Any) -> tuple[list[se.Basic], list[se.Basic]]:
-    """Check a nominal motion and return ``y_s`` (f) and ``u_s`` (m) as expressions."""
+def _nominal(system: System, nominal: Any, inputs: Mapping[Any, Any] | None = None
+             ) -> tuple[list[se.Basic], list[se.Basic]]:
+    """Check a nominal motion (and nominal inputs) and return ``y_s`` (f) and ``u_s`` (m) as
+    expressions."""
     if hasattr(nominal, "nominal") and not isinstance(nominal, Mapping):
         nominal = nominal.nominal
     if not isinstance(nominal, Mapping):
         raise ModelError(f"nominal motion: expected a mapping from coordinate names to values, "
                          f"got {type(nominal).__name__}")
+    if inputs is not None and not isinstance(inputs, Mapping):
+        raise ModelError(f"nominal inputs: expected a mapping from input names to values, got "
+                         f"{type(inputs).__name__}")
     y_names = system.coordinate_names
     u_names = system.input_names
+    not_inputs = [str(k) for k in (inputs or {}) if str(k) not in u_names]
+    if not_inputs:
+        raise ModelError(f"nominal inputs: {not_inputs} are not inputs of the system; inputs are "
+                         f"{u_names}")
     given: dict[str, se.Basic] = {}
-    for key, value in nominal.items():
+    for key, value in [*nominal.items(), *(inputs or {}).items()]:
         name = str(key)
         if name not in y_names and name not in u_names:
             raise ModelError(f'nominal motion: "{name}" is neither a coordinate ({y_names}) nor '
@@ -454,8 +651,11 @@ def _sym_part(A: SymMatrix, sign: int) -> SymMatrix:
 
 
 def _describe_nominal(lin: Linearization) -> str:
-    parts = [f"{n} = {lin.y_s[i]}" for i, n in enumerate(lin.system.coordinate_names)]
-    text = ", ".join(parts)
+    return _describe(lin.system, lin.y_s.entries())
+
+
+def _describe(system: System, y_s: list[se.Basic]) -> str:
+    text = ", ".join(f"{n} = {e}" for n, e in zip(system.coordinate_names, y_s, strict=True))
     return text if len(text) < 120 else text[:117] + "..."
 
 
@@ -478,6 +678,9 @@ class NumericLinearization:
     time_dependence : tuple of str
         Names of the matrices among M̃, P, Q, B that change with t (tested at three times where
         t appears at all).
+    nominal_check : NominalCheck or None
+        Whether the nominal motion solves the equations of motion at ``t``
+        (:meth:`check_nominal`).
     """
 
     system: System
@@ -489,10 +692,23 @@ class NumericLinearization:
     t: float
     parameters: dict[str, float]
     time_dependence: tuple[str, ...]
+    nominal_check: NominalCheck | None = None
 
     @property
     def is_time_invariant(self) -> bool:
         return not self.time_dependence
+
+    def check_nominal(self, t: float | None = None,
+                      parameters: Mapping[str, float] | None = None) -> NominalCheck:
+        """``h`` against the forces at work at the nominal state (:class:`NominalCheck`), at
+        the one time and parameter values of this result."""
+        if (t is not None and float(t) != self.t) or parameters:
+            raise EvaluationError("a NumericLinearization holds numbers for one t and one set "
+                                  "of parameters; call linearize_numeric again for others")
+        if self.nominal_check is None:
+            raise EvaluationError("this NumericLinearization was built without the check of its "
+                                  "nominal motion; linearize_numeric makes one with it")
+        return self.nominal_check
 
     def _split(self, what: str, A: np.ndarray, sign: int) -> np.ndarray:
         if self.time_dependence:
@@ -531,12 +747,14 @@ class NumericLinearization:
 
 def linearize_numeric(source: System | EquationsOfMotion, nominal: Mapping[Any, Any] | Any,
                       t: float = 0.0,
-                      parameters: Mapping[str, float] | None = None) -> NumericLinearization:
+                      parameters: Mapping[str, float] | None = None,
+                      inputs: Mapping[Any, Any] | None = None) -> NumericLinearization:
     """M̃, P, Q, h, B as numbers for given parameter values, by forward-mode differentiation in
     floating point over the graphs of k, q and J̄ (:func:`jourdain.differentiate.jet_float`),
     with ``M̃ = J̄ᵀ·M̄·J̄`` in numbers.
 
-    Same equations and nominal motions as :func:`linearization`, without forming symbolic
+    Same equations, nominal motions, nominal inputs and :class:`NominalMotionWarning` as
+    :func:`linearization` (here at ``t`` and for ``parameters``), without forming symbolic
     matrices: the way to eigenvalues of large systems (a spatial chain of 16 bodies in well
     under a second, derivation included).
     """
@@ -546,7 +764,7 @@ def linearize_numeric(source: System | EquationsOfMotion, nominal: Mapping[Any, 
     eom = source if isinstance(source, EquationsOfMotion) else source.equations_of_motion()
     system = eom.system
     tv = time_value(t)
-    y_s, u_s = _nominal(system, nominal)
+    y_s, u_s = _nominal(system, nominal, inputs)
     ts = system.t
     yd_s = [se.diff(e, ts) for e in y_s]
     ydd_s = [se.diff(e, ts) for e in yd_s]
@@ -563,8 +781,9 @@ def linearize_numeric(source: System | EquationsOfMotion, nominal: Mapping[Any, 
     n6 = ne.J_bar.shape[0]
     M_bar = evaluate_float(ne.M_bar.entries(), pars)  # raises if M̄ depended on more
     M_bar = np.array(M_bar).reshape(n6, n6)
-    exprs = [*eom.k.entries(), *eom.q.entries(), *J_bar]
-    mask = [True] * (2 * f) + [any(ydd_nonzero)] * len(J_bar)
+    # q̄^c and q̄^e (values only) give the scale of the forces for the check of h
+    exprs = [*eom.k.entries(), *eom.q.entries(), *J_bar, *ne.q_c.entries(), *ne.q_e.entries()]
+    mask = [True] * (2 * f) + [any(ydd_nonzero)] * len(J_bar) + [False] * (2 * n6)
     graph = Graph(exprs)
     variables = [*system.y, *system.yd, *system.inputs]
     nv = len(variables)
@@ -578,7 +797,8 @@ def linearize_numeric(source: System | EquationsOfMotion, nominal: Mapping[Any, 
         values.update({str(s): v for s, v in zip(system.yd, yds, strict=True)})
         values.update({str(s): v for s, v in zip(system.inputs, us, strict=True)})
         J = jet_float(graph, variables, values, mask)
-        Jb = J.values[2 * f:].reshape(n6, f)
+        nJ = 2 * f + n6 * f
+        Jb = J.values[2 * f:nJ].reshape(n6, f)
         MJ = M_bar @ Jb
         Mt = Jb.T @ MJ
         Mt = 0.5 * (Mt + Mt.T)
@@ -587,11 +807,14 @@ def linearize_numeric(source: System | EquationsOfMotion, nominal: Mapping[Any, 
         dr = J.jacobian[:f] - J.jacobian[f:2 * f]
         if np.any(ydds != 0.0):
             # ∂(J̄ᵀM̄J̄·ÿ_s)/∂y_v = (∂J̄/∂y_v)ᵀ·M̄J̄ÿ_s + J̄ᵀM̄·(∂J̄/∂y_v)·ÿ_s
-            dJ = J.jacobian[2 * f:].reshape(n6, f, nv)
+            dJ = J.jacobian[2 * f:nJ].reshape(n6, f, nv)
             dJa = np.einsum("rjv,j->rv", dJ, ydds)
             dr = dr + np.einsum("rjv,r->jv", dJ, MJ @ ydds) + MJ.T @ dJa
+        scale = _h_scale(Jb, J.values[nJ:nJ + n6], J.values[nJ + n6:], M_bar, ydds,
+                         J.values[:f], J.values[f:2 * f])
         return {"M_tilde": Mt, "Q": dr[:, :f], "P": dr[:, f:2 * f],
-                "B": -dr[:, 2 * f:2 * f + m], "h": -r}
+                "B": -dr[:, 2 * f:2 * f + m], "h": -r, "h_scale": scale,
+                "u_s": np.array(us, dtype=float)}
 
     out = at(tv)
     dependence: tuple[str, ...] = ()
@@ -604,9 +827,14 @@ def linearize_numeric(source: System | EquationsOfMotion, nominal: Mapping[Any, 
     for name, arr in out.items():
         if not np.all(np.isfinite(arr)):
             raise EvaluationError(f"the linearization has non-finite entries in {name}")
+    check = _nominal_check(out["h"], np.where(out["h"] == 0, 0.0, out["h_scale"]),
+                           _kind(y_s, yd_s, ydd_s), tv, _describe(system, y_s), system,
+                           out["u_s"], out["B"])
+    if check.kind != "nominal motion" and not check.is_solution:
+        warn(check.message(), NominalMotionWarning)
     return NumericLinearization(system=system, M_tilde=out["M_tilde"], P=out["P"], Q=out["Q"],
                                 h=out["h"], B=out["B"], t=tv, parameters=pars,
-                                time_dependence=dependence)
+                                time_dependence=dependence, nominal_check=check)
 
 
 @dataclass(frozen=True)

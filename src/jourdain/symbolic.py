@@ -3,10 +3,20 @@
 Expressions from the recursive kinematics share sub-expressions (a DAG); converting them to SymPy
 or counting their operations must visit each shared node once, which :func:`to_sympy` and
 :func:`count_ops` do.
+
+Display (``repr``, ``_repr_latex_`` in Jupyter, and the text and LaTeX exports of
+:mod:`jourdain.io.export`) shows each matrix simplified for reading by :func:`simplified_sympy`:
+SymPy's automatic evaluation cancels what SymEngine kept apart (``cos(-phi1 + phi1 + phi2)``,
+``-(-a - b)``), every symbol is real (coordinates, rates, parameters, inputs and t are), so
+``sqrt((x + 1)**2)`` reads ``|x + 1|``, and small entries go through trigonometric
+simplification, all within a time budget. Matrices that need more than
+:data:`MAX_DISPLAY_OPS` operations are summarized by their size instead.
 """
 
 from __future__ import annotations
 
+import re
+import time
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -14,6 +24,19 @@ from typing import Any
 import symengine as se
 
 Expr = se.Basic
+
+#: Matrices whose entries need more operations (after CSE) are summarized, not printed.
+MAX_DISPLAY_OPS = 600
+#: Entries up to this many operations are simplified for display (trigonometric identities);
+#: SymPy's trigsimp of one larger entry can take seconds and cannot be interrupted.
+SIMPLIFY_OPS = 150
+#: Time budget (seconds) for simplifying the entries of one matrix for display.
+SIMPLIFY_SECONDS = 3.0
+#: Time budget (seconds) of ``repr`` and ``_repr_latex_`` (which may run in a debugger or a
+#: notebook at any moment).
+REPR_SECONDS = 1.0
+#: Matrices with more entries are summarized by ``repr`` without counting their operations.
+REPR_MAX_ENTRIES = 400
 
 
 @dataclass(frozen=True)
@@ -101,16 +124,105 @@ class SymMatrix:
         common-subexpression elimination when ``cse``."""
         return count_ops(self.entries(), cse=cse)
 
+    def _summary(self) -> str | None:
+        """``<n×m matrix, k operations after CSE>`` when too large to print, else None."""
+        n, m = self.shape
+        if n * m > REPR_MAX_ENTRIES:
+            return f"{n}×{m} matrix"
+        ops = self.count_ops(cse=True)
+        return f"{n}×{m} matrix, {ops} operations after CSE" if ops > MAX_DISPLAY_OPS else None
+
     def _repr_latex_(self) -> str:
+        """LaTeX for Jupyter: simplified for reading (:func:`simplified_sympy`, within
+        :data:`REPR_SECONDS`), rates ``<name>_d`` with a dot."""
         import sympy
 
-        return "$\\displaystyle " + sympy.latex(self.sympy()) + "$"
+        summary = self._summary()
+        if summary is not None:
+            text = summary.replace("×", "$\\times$")
+            return f"$\\text{{{text}}}$"
+        mat = simplified_sympy(self, deadline=time.perf_counter() + REPR_SECONDS)
+        names = {s: _latex_name(s.name) for s in mat.free_symbols}
+        return "$\\displaystyle " + sympy.latex(mat, symbol_names=names) + "$"
 
     def __repr__(self) -> str:
-        n, m = self.shape
-        if n * m <= 16:
-            return f"SymMatrix({[list(r) for r in self.rows]})"
-        return f"SymMatrix(<{n}x{m}>)"
+        """The entries simplified for reading (:func:`simplified_sympy`, within
+        :data:`REPR_SECONDS`); a summary for matrices too large to print."""
+        import sympy
+
+        summary = self._summary()
+        if summary is not None:
+            return f"SymMatrix(<{summary}; .sympy() gives every entry>)"
+        mat = simplified_sympy(self, deadline=time.perf_counter() + REPR_SECONDS)
+        rows = ["[" + ", ".join(sympy.sstr(e) for e in mat.row(i)) + "]"
+                for i in range(mat.rows)]
+        if len(rows) == 1:
+            return f"SymMatrix([{rows[0]}])"
+        return "SymMatrix([\n" + ",\n".join(rows) + "])"
+
+
+def _latex_name(name: str) -> str:
+    """LaTeX of a symbol name: ``phi1`` → ``\\phi_{1}`` (SymPy's), the rate ``phi1_d`` →
+    ``\\dot{\\phi}_{1}``, the acceleration ``phi1_dd`` → ``\\ddot{\\phi}_{1}``."""
+    import sympy
+
+    m = re.match(r"^(.+?)_(dd?)$", name)
+    if m is None:
+        return sympy.latex(sympy.Symbol(name))
+    base, dots = m.group(1), "\\dot" if m.group(2) == "d" else "\\ddot"
+    parts = re.match(r"^([A-Za-z]+)(\d*)$", base)
+    if parts is None:
+        return f"{dots}{{{sympy.latex(sympy.Symbol(base))}}}"
+    letters = sympy.latex(sympy.Symbol(parts.group(1)))
+    return f"{dots}{{{letters}}}" + (f"_{{{parts.group(2)}}}" if parts.group(2) else "")
+
+
+def simplified_sympy(m: SymMatrix, simplify: bool = True, deadline: float | None = None) -> Any:
+    """The matrix as a SymPy ``ImmutableMatrix`` simplified for reading.
+
+    Conversion to SymPy cancels what SymEngine kept apart and distributes numbers over sums;
+    every symbol is then taken as real, so ``sqrt(x**2)`` becomes ``|x|``; entries of at most
+    :data:`SIMPLIFY_OPS` operations are expanded and trigonometrically simplified, the result
+    kept where it is not longer (when ``simplify``). Simplification stops at ``deadline`` (a
+    ``time.perf_counter()`` value; default :data:`SIMPLIFY_SECONDS` from now), after which the
+    remaining entries are shown as converted; the result is memoized per matrix (a later call
+    reuses it, whatever its deadline). For display only: the derivation never uses it.
+    """
+    key = (m, simplify)
+    hit = _SIMPLIFIED.get(key)
+    if hit is None:
+        if deadline is None:
+            deadline = time.perf_counter() + SIMPLIFY_SECONDS
+        hit = _simplified(m, simplify, deadline)
+        if len(_SIMPLIFIED) >= 64:
+            _SIMPLIFIED.pop(next(iter(_SIMPLIFIED)))
+        _SIMPLIFIED[key] = hit
+    return hit
+
+
+#: memo of :func:`simplified_sympy` (matrices are immutable and compared by content)
+_SIMPLIFIED: dict[tuple[SymMatrix, bool], Any] = {}
+
+
+def _simplified(m: SymMatrix, simplify: bool, deadline: float) -> Any:
+    import sympy
+
+    n, k = m.shape
+    entries = to_sympy_many(m.entries())
+    symbols = set().union(*(e.free_symbols for e in entries)) if entries else set()
+    real = {s: sympy.Symbol(s.name, real=True) for s in symbols}
+    back = {v: k for k, v in real.items()}
+    out = []
+    for e in entries:
+        # xreplace rebuilds every node, so SymPy's evaluation sees real symbols: |x| for √x²
+        s = e.xreplace(real)
+        if simplify and s.free_symbols and time.perf_counter() < deadline:
+            ops = sympy.count_ops(s)
+            if ops <= SIMPLIFY_OPS:
+                short = sympy.trigsimp(sympy.expand(s))
+                s = short if sympy.count_ops(short) <= ops else s
+        out.append(s.xreplace(back))
+    return sympy.ImmutableMatrix(n, k, out)
 
 
 _SYMPY_FUNCS = {

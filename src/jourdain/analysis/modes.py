@@ -10,6 +10,11 @@ imaginary axis are semisimple (as many independent eigenvectors as their multipl
 *unstable* otherwise — an eigenvalue with a positive real part (real: divergence, complex:
 flutter) or a repeated eigenvalue on the imaginary axis with too few eigenvectors (secular,
 linearly growing motion, e.g. a free rigid-body coordinate).
+
+The verdict is about the linear system. Where the nominal motion it came from is an equilibrium
+or a steady motion that does not solve the equations of motion (``h ≠ 0``,
+:class:`jourdain.linearization.NominalCheck`), the reason says so and a
+:class:`jourdain.linearization.NominalMotionWarning` is issued.
 """
 
 from __future__ import annotations
@@ -19,11 +24,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import warn
+from ..linearization import NominalMotionWarning
 from .state_space import AnyLinearization, StateSpace, state_space
 
 ASYMPTOTICALLY_STABLE = "asymptotically stable"
 MARGINALLY_STABLE = "marginally stable"
 UNSTABLE = "unstable"
+#: real parts (and, in tables, imaginary parts) below this fraction of the largest |λ| (at
+#: least 1) count as zero: the default ``rtol`` of :func:`stability`
+ZERO_RTOL = 1e-8
 
 
 @dataclass(frozen=True)
@@ -67,11 +77,36 @@ class Modes:
         return np.flatnonzero(self.eigenvalues.imag > 1e-9 * scale)
 
     def __str__(self) -> str:
-        lines = [f"{'eigenvalue':>28}  {'f_n [Hz]':>10}  {'zeta':>8}"]
-        for lam, fn, z in zip(self.eigenvalues, self.frequencies_hz, self.damping_ratios,
-                              strict=True):
+        """A table of the eigenvalues, natural frequencies and damping ratios. Real and
+        imaginary parts below ``ZERO_RTOL`` of the largest |λ| (the tolerance of the stability
+        verdict) are shown as 0; a zero eigenvalue (a rigid-body or neutral mode) has no damping
+        ratio, shown as a dash."""
+        tol = _zero_tol(self.eigenvalues)
+        lines = [f"{'eigenvalue [1/s]':>28}  {'f_n [Hz]':>10}  {'zeta':>8}"]
+        zero = False
+        for lam in self.eigenvalues:
+            lam = _chop(lam, tol)
+            if lam == 0:
+                zero = True
+                lines.append(f"{0:>13g} {0:+13g}j  {0:>10g}  {'—':>8}")
+                continue
+            fn = abs(lam) / (2 * np.pi)
+            z = -lam.real / abs(lam) + 0.0  # + 0.0: no "-0"
             lines.append(f"{lam.real:>13.6g} {lam.imag:+13.6g}j  {fn:>10.5g}  {z:>8.4f}")
+        if zero:
+            lines.append("  (—: λ = 0, a rigid-body or neutral mode: no damping ratio)")
         return "\n".join(lines)
+
+
+def _zero_tol(lam: np.ndarray, rtol: float = ZERO_RTOL) -> float:
+    return rtol * max(1.0, float(np.abs(lam).max(initial=0.0)))
+
+
+def _chop(z: complex, tol: float) -> complex:
+    """``z`` with real and imaginary parts of at most ``tol`` set to (positive) zero."""
+    re = 0.0 if abs(z.real) <= tol else float(z.real)
+    im = 0.0 if abs(z.imag) <= tol else float(z.imag)
+    return complex(re, im)
 
 
 @dataclass(frozen=True)
@@ -79,14 +114,18 @@ class Stability:
     """Stability verdict of a linear time-invariant system.
 
     ``verdict`` is one of ``"asymptotically stable"``, ``"marginally stable"``, ``"unstable"``;
-    ``reason`` says why in words; ``max_real_part`` is the largest real part of the eigenvalues;
-    ``critical`` the eigenvalues that decide the verdict.
+    ``reason`` says why in words (and ends with a warning where the nominal motion is not a
+    solution); ``max_real_part`` is the largest real part of the eigenvalues; ``critical`` the
+    eigenvalues that decide the verdict; ``nominal_is_solution`` whether the equilibrium or
+    steady motion linearized about solves the equations of motion (``h = 0``; None where not
+    known or for other nominal motions).
     """
 
     verdict: str
     reason: str
     max_real_part: float
     critical: np.ndarray
+    nominal_is_solution: bool | None = None
 
     @property
     def is_stable(self) -> bool:
@@ -131,13 +170,32 @@ def modes(system: StateSpace | AnyLinearization, t: float | None = None,
 
 
 def stability(system: StateSpace | AnyLinearization, t: float | None = None,
-              parameters: Mapping[str, float] | None = None, rtol: float = 1e-8) -> Stability:
+              parameters: Mapping[str, float] | None = None, rtol: float = ZERO_RTOL) -> Stability:
     """Stability verdict with its reason (see the module docstring for the definitions).
 
     ``rtol`` is the relative tolerance (to the largest |λ|, at least 1) below which a real part
     counts as zero.
+
+    Warns
+    -----
+    NominalMotionWarning
+        When the linearization is about an equilibrium or a steady motion that leaves h ≠ 0
+        (:attr:`StateSpace.nominal_check`); the reason ends with the same warning.
     """
     ss = _as_state_space(system, t, parameters)
+    st = _verdict(ss, rtol)
+    check = ss.nominal_check
+    if check is None or check.kind == "nominal motion":
+        return st
+    if check.is_solution:
+        return Stability(st.verdict, st.reason, st.max_real_part, st.critical, True)
+    message = check.message()
+    warn(message, NominalMotionWarning)
+    return Stability(st.verdict, f"{st.reason}. WARNING: {message}", st.max_real_part,
+                     st.critical, False)
+
+
+def _verdict(ss: StateSpace, rtol: float) -> Stability:
     A = ss.A
     lam = np.linalg.eigvals(A)
     n = lam.size
@@ -174,25 +232,27 @@ def stability(system: StateSpace | AnyLinearization, t: float | None = None,
         kind = ("flutter: an oscillating mode grows" if abs(worst.imag) > tol
                 else "divergence: a real eigenvalue is positive")
         reason = (f"{len(lu)} eigenvalue(s) with positive real part, largest "
-                  f"λ = {_fmt(worst)} ({kind})")
+                  f"λ = {_fmt(worst, tol)} ({kind})")
         return Stability(UNSTABLE, reason, max_re, lu)
     if defective:
         centre, alg, geo = defective[0]
-        reason = (f"eigenvalue λ = {_fmt(centre)} on the imaginary axis is repeated {alg} times "
+        reason = (f"eigenvalue λ = {_fmt(centre, tol)} on the imaginary axis is repeated {alg} times "
                   f"with only {geo} eigenvector(s): the motion grows linearly in time "
                   "(e.g. a free rigid-body coordinate without stiffness)")
         return Stability(UNSTABLE, reason, max_re, lam[on_axis])
     if on_axis:
         la = lam[on_axis]
         reason = (f"no eigenvalue has a positive real part; {len(la)} lie on the imaginary axis "
-                  f"(undamped or rigid-body motion, e.g. λ = {_fmt(la[np.argmax(la.imag)])}) "
+                  f"(undamped or rigid-body motion, e.g. λ = {_fmt(la[np.argmax(la.imag)], tol)}) "
                   "and are semisimple")
         return Stability(MARGINALLY_STABLE, reason, max_re, la)
     worst = lam[np.argmax(lam.real)]
     reason = (f"all {n} eigenvalues have negative real parts (largest real part {max_re:.6g} "
-              f"at λ = {_fmt(worst)})")
+              f"at λ = {_fmt(worst, tol)})")
     return Stability(ASYMPTOTICALLY_STABLE, reason, max_re, np.array([worst]))
 
 
-def _fmt(z: complex) -> str:
+def _fmt(z: complex, tol: float) -> str:
+    """``z`` for a sentence, parts below ``tol`` (round-off about the axes) shown as 0."""
+    z = _chop(complex(z), tol)
     return f"{z.real:.6g}{z.imag:+.6g}j"

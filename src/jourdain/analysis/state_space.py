@@ -10,15 +10,16 @@ M̃ is factored numerically (Cholesky), never inverted symbolically.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 
-from ..errors import EvaluationError, SingularMassMatrix
+from ..errors import EvaluationError, JourdainError, SingularMassMatrix
 from ..linearization import (
     CompiledLinearization,
     Linearization,
+    NominalCheck,
     NumericLinearization,
     TimeVariantError,
 )
@@ -47,6 +48,9 @@ class StateSpace:
         The time at which the matrices were evaluated.
     parameters : dict
         All parameter values used.
+    nominal_check : NominalCheck or None
+        Whether the nominal motion solves the equations of motion at ``t`` (None where not
+        known, e.g. in sweeps); :func:`jourdain.analysis.stability` warns when it does not.
     """
 
     A: np.ndarray
@@ -61,6 +65,7 @@ class StateSpace:
     input_names: tuple[str, ...]
     t: float
     parameters: dict[str, float]
+    nominal_check: NominalCheck | None = None
 
     @property
     def state_names(self) -> tuple[str, ...]:
@@ -122,8 +127,14 @@ def state_space(lin: AnyLinearization, t: float | None = None,
         )
     num = numbers(lin, t, parameters)
     if isinstance(base, NumericLinearization):
-        return _from_numbers(base, num, base.t, base.parameters)
-    return _from_numbers(base, num, 0.0 if t is None else float(t), parameters)
+        ss = _from_numbers(base, num, base.t, base.parameters)
+        return replace(ss, nominal_check=base.nominal_check)
+    ss = _from_numbers(base, num, 0.0 if t is None else float(t), parameters)
+    try:
+        check = base.check_nominal(ss.t, parameters)
+    except JourdainError:  # the matrices have numbers, so this is not expected; no verdict on h
+        check = None
+    return replace(ss, nominal_check=check)
 
 
 def _from_numbers(base: Linearization | NumericLinearization, num: Mapping[str, np.ndarray],

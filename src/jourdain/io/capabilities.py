@@ -7,6 +7,7 @@ uses only the public API of :class:`~jourdain.System` (``evaluate``, ``linearize
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -58,8 +59,13 @@ def linearization_at(model: ModelFile, y: Any, yd: Any, t: float,
                      ) -> dict[str, np.ndarray]:
     """``M_tilde, P, Q, h`` about the state (y, ẏ) at time t (nominal ÿ_s = 0), and ``D, G, K,
     N``, the symmetric and skew parts of P and Q at that instant."""
+    from ..linearization import NominalMotionWarning
+
     system = model.system
-    lin = system.linearize(state_nominal(system, y, yd, t, inputs))
+    with warnings.catch_warnings():
+        # any state, not a claimed equilibrium: h = M·ÿ there is expected
+        warnings.simplefilter("ignore", NominalMotionWarning)
+        lin = system.linearize(state_nominal(system, y, yd, t, inputs))
     num = lin.evaluate(t=t, parameters=dict(parameters) or None)
     out = {k: num[k] for k in ("M_tilde", "P", "Q", "h")}
     out.update(split(out["P"], out["Q"]))
@@ -67,7 +73,8 @@ def linearization_at(model: ModelFile, y: Any, yd: Any, t: float,
 
 
 def nominal_mapping(system: Any, nominal: NominalMotion) -> dict[str, se.Basic]:
-    return dict(zip(system.coordinate_names, nominal.y, strict=True))
+    """The nominal motion and its nominal inputs by name, for :meth:`System.linearize`."""
+    return {**dict(zip(system.coordinate_names, nominal.y, strict=True)), **dict(nominal.inputs)}
 
 
 def linear_analysis(model: ModelFile, about: str | None,
@@ -78,14 +85,30 @@ def linear_analysis(model: ModelFile, about: str | None,
     Returns a dict: ``nominal`` (the NominalMotion), ``linearization``, ``numbers`` (M_tilde, P,
     Q, h, B and, time-invariant, D, G, K, N at ``t``), ``time_invariant``, ``conservative``
     (None when time-variant), ``modes`` and ``stability`` (None when time-variant or not
-    available), ``h_norm``.
+    available), ``h_norm``, ``nominal_check`` (:class:`~jourdain.linearization.NominalCheck`
+    at ``t``).
+
+    The warnings of a nominal motion that is not a solution are not issued here: they are in
+    ``nominal_check`` and the stability verdict, which the text and the report show.
     """
+    from ..linearization import NominalMotionWarning
+
     system = model.system
     nominal = model.nominal_motion(about)
-    lin = system.linearize(nominal_mapping(system, nominal))
     params = dict(parameters or {}) or None
-    num = lin.evaluate(t=t, parameters=params)
-    res: dict[str, Any] = {"nominal": nominal, "linearization": lin, "numbers": num,
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", NominalMotionWarning)
+        lin = system.linearize(nominal_mapping(system, nominal))
+        num = lin.evaluate(t=t, parameters=params)
+        check = lin.check_nominal(t, params)
+        res = _analyse(lin, num, check, params, t)
+    res["nominal"] = nominal
+    return res
+
+
+def _analyse(lin: Any, num: dict[str, np.ndarray], check: Any,
+             params: Mapping[str, float] | None, t: float) -> dict[str, Any]:
+    res: dict[str, Any] = {"linearization": lin, "numbers": num, "nominal_check": check,
                            "time_invariant": lin.is_time_invariant, "t": t,
                            "h_norm": float(np.abs(num["h"]).max(initial=0.0))}
     res["conservative"] = None
@@ -105,7 +128,7 @@ def linear_analysis(model: ModelFile, about: str | None,
                     float(np.abs(num["M_tilde"]).max()))
         res["conservative"] = bool(np.abs(D).max(initial=0) <= 1e-9 * scale
                                    and np.abs(N).max(initial=0) <= 1e-9 * scale
-                                   and res["h_norm"] <= 1e-9 * scale)
+                                   and check.is_solution)
         try:
             from ..analysis.modes import modes, stability
             from ..analysis.state_space import state_space
@@ -138,6 +161,9 @@ def jsonable(res: Mapping[str, Any]) -> dict[str, Any]:
         "nominal_y": [str(e) for e in res["nominal"].y],
         "t": res["t"], "time_invariant": res["time_invariant"],
         "conservative": res["conservative"], "h_norm": res["h_norm"],
+        "nominal_inputs": {k: str(v) for k, v in res["nominal"].inputs},
+        "nominal_is_solution": res["nominal_check"].is_solution,
+        "h_relative": _finite_list([res["nominal_check"].relative])[0],
         "matrices": {k: np.asarray(v, float).tolist() for k, v in res["numbers"].items()},
     }
     m = res.get("modes")
@@ -158,22 +184,34 @@ def _finite_list(a: np.ndarray) -> list[float | None]:
 
 def linear_text(res: Mapping[str, Any]) -> str:
     """A plain-text account of :func:`linear_analysis`."""
+    from .export import format_array
+
     lin = res["linearization"]
     num = res["numbers"]
     nominal = res["nominal"]
+    check = res["nominal_check"]
     lines = [f"{lin.system.name}: linearized about \"{nominal.name}\""
              + (f" ({nominal.description})" if nominal.description else ""),
              "  y_s(t) = " + ", ".join(f"{n} = {e}" for n, e in
-                                       zip(lin.system.coordinate_names, nominal.y, strict=True)),
-             "  M̃·η̈ + P·η̇ + Q·η = h" + (" + B·Δu" if lin.system.inputs else ""),
-             "  time-invariant" if res["time_invariant"] else
-             f"  time-variant (depends on t: {', '.join(lin.time_dependence)}); numbers at "
-             f"t = {res['t']:g}"]
+                                       zip(lin.system.coordinate_names, nominal.y, strict=True))]
+    if lin.system.inputs:
+        given = dict(nominal.inputs)
+        lines.append("  u_s(t) = " + ", ".join(f"{n} = {given.get(n, 0)}"
+                                               for n in lin.system.input_names))
+    lines += ["  M̃·η̈ + P·η̇ + Q·η = h" + (" + B·Δu" if lin.system.inputs else ""),
+              "  time-invariant" if res["time_invariant"] else
+              f"  time-variant (depends on t: {', '.join(lin.time_dependence)}); numbers at "
+              f"t = {res['t']:g}"]
+    if check.kind != "nominal motion" and not check.is_solution:
+        lines.append(f"  WARNING: {check.message()}")
     keys = ["M_tilde", "P", "Q", "h"] + (["B"] if lin.system.inputs else [])
     if res["time_invariant"]:
         keys += ["D", "G", "K", "N"]
+    # round-off is judged against the matrix a part comes from, h against the forces at work
+    scales = {"D": num["P"], "G": num["P"], "K": num["Q"], "N": num["Q"],
+              "h": check.scale if np.any(check.scale) else num["h"]}
     for k in keys:
-        lines.append(f"\n{k} =\n{np.asarray(num[k])}")
+        lines.append(f"\n{k} =\n{format_array(num[k], scales.get(k))}")
     if res["conservative"] is not None:
         lines.append("\nconservative (D = 0, N = 0, h = 0): " + ("yes" if res["conservative"]
                                                                 else "no"))

@@ -10,7 +10,6 @@ SymEngine.
 from __future__ import annotations
 
 import re
-import time
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
@@ -18,20 +17,20 @@ from typing import TYPE_CHECKING, Any
 import symengine as se
 
 from ..cse import cse as graph_cse
-from ..symbolic import SymMatrix, to_sympy
+from ..symbolic import (  # noqa: F401 - the display settings, re-exported
+    MAX_DISPLAY_OPS,
+    SIMPLIFY_OPS,
+    SIMPLIFY_SECONDS,
+    SymMatrix,
+    simplified_sympy,
+    to_sympy,
+)
 
 if TYPE_CHECKING:
     from ..model.system import System
 
-#: Default cap: matrices whose entries need more operations (after CSE) are summarized.
-MAX_DISPLAY_OPS = 600
 #: Matrices with more rows are summarized in text output (a 36×36 M̄ helps nobody on a terminal).
 MAX_TEXT_ROWS = 18
-#: Entries up to this many operations are simplified for display (trigonometric identities);
-#: SymPy's trigsimp of one larger entry can take seconds and cannot be interrupted.
-SIMPLIFY_OPS = 150
-#: Time budget (seconds) for simplifying the entries of one matrix for display.
-SIMPLIFY_SECONDS = 3.0
 
 _GREEK = {
     "alpha": "α", "beta": "β", "gamma": "γ", "delta": "δ", "epsilon": "ε", "zeta": "ζ",
@@ -122,46 +121,11 @@ def too_large(m: SymMatrix, max_ops: int = MAX_DISPLAY_OPS) -> bool:
 
 
 def to_sympy_matrix(m: SymMatrix, simplify: bool = True, deadline: float | None = None) -> Any:
-    """The matrix as SymPy, each entry lightly simplified (trigonometric identities) when small.
-
-    Simplification is for reading only; it stops at ``deadline`` (a ``time.perf_counter()``
-    value; default :data:`SIMPLIFY_SECONDS` from now), after which the remaining entries are
-    shown as derived, and its result is memoized per matrix (a later call reuses it, whatever
-    its deadline).
-    """
-    key = (m, simplify)
-    hit = _SIMPLIFIED.get(key)
-    if hit is None:
-        if deadline is None:
-            deadline = time.perf_counter() + SIMPLIFY_SECONDS
-        hit = _sympy_matrix(m, simplify, deadline)
-        if len(_SIMPLIFIED) >= 64:
-            _SIMPLIFIED.pop(next(iter(_SIMPLIFIED)))
-        _SIMPLIFIED[key] = hit
-    return hit
-
-
-#: memo of :func:`to_sympy_matrix` (matrices are immutable and compared by content)
-_SIMPLIFIED: dict[tuple[SymMatrix, bool], Any] = {}
-
-
-def _sympy_matrix(m: SymMatrix, simplify: bool, deadline: float) -> Any:
-    import sympy
-
-    memo: dict = {}
-    rows = []
-    for r in m.rows:
-        row = []
-        for e in r:
-            s = to_sympy(e, memo)
-            if simplify and e.free_symbols and time.perf_counter() < deadline:
-                n = sympy.count_ops(s)
-                if n <= SIMPLIFY_OPS:
-                    short = sympy.trigsimp(sympy.expand(s))
-                    s = short if sympy.count_ops(short) <= n else s
-            row.append(s)
-        rows.append(row)
-    return sympy.ImmutableMatrix(rows)
+    """The matrix as SymPy simplified for reading (:func:`jourdain.symbolic.simplified_sympy`:
+    cancellations, real symbols so that ``sqrt((x + 1)**2)`` reads ``|x + 1|``, trigonometric
+    identities for small entries), within ``deadline`` (a ``time.perf_counter()`` value;
+    default :data:`SIMPLIFY_SECONDS` from now); memoized per matrix."""
+    return simplified_sympy(m, simplify, deadline)
 
 
 # ------------------------------------------------------------------------------------------
@@ -181,9 +145,30 @@ def matrix_latex(m: SymMatrix, system: System, max_ops: int = MAX_DISPLAY_OPS,
 
     if too_large(m, max_ops):
         n, k = m.shape
-        return f"\\text{{{n}×{k} matrix, {display_ops(m)} operations after CSE}}"
+        return f"\\text{{{n}$\\times${k} matrix, {display_ops(m)} operations after CSE}}"
     return sympy.latex(to_sympy_matrix(m, deadline=deadline), symbol_names=latex_symbol_names(system),
                        mat_str="pmatrix", mat_delim="")
+
+
+def latex_fragment(matrices: Mapping[str, SymMatrix], symbols: Mapping[str, str],
+                   system: System, title: str, max_ops: int = MAX_DISPLAY_OPS,
+                   deadline: float | None = None) -> str:
+    """A LaTeX fragment to ``\\input`` into a document that loads ``amsmath``: a comment line
+    with ``title``, ``\\setcounter{MaxMatrixCols}{n}`` for the widest matrix printed (amsmath
+    allows 10 columns by default; M̄ of two bodies has 12), and one displayed equation
+    ``\\[ symbol = matrix \\]`` per matrix (a summary for matrices above ``max_ops``).
+    ``symbols`` gives the LaTeX of each matrix's name."""
+    cols = 10
+    body = []
+    for name, m in matrices.items():
+        tex = matrix_latex(m, system, max_ops, deadline)
+        if "\\begin{pmatrix}" in tex:
+            cols = max(cols, m.shape[1])
+        body += [f"\\[ {symbols.get(name, name)} = {tex} \\]", ""]
+    head = [f"% {title} (jourdain)",
+            "% A LaTeX fragment: \\input it into a document that loads amsmath.",
+            f"\\setcounter{{MaxMatrixCols}}{{{cols}}}", ""]
+    return "\n".join([*head, *body]).rstrip() + "\n"
 
 
 # ------------------------------------------------------------------------------------------
@@ -315,6 +300,36 @@ def matrices_json(matrices: Mapping[str, SymMatrix], system: System) -> dict[str
 def _expr_str(e: se.Basic) -> str:
     # SymEngine prints abs as Abs; the expression language says abs
     return re.sub(r"\bAbs\(", "abs(", str(e))
+
+
+#: In text output, numbers below this fraction of the largest entry of their matrix or vector
+#: (or of a given scale) are shown as 0: round-off of evaluations and linear solves (a few eps
+#: times the condition number), far below the 6 significant digits shown. JSON output keeps
+#: the numbers as computed.
+ROUNDOFF_RTOL = 1e-10
+
+
+def chop(values: Any, scale: Any = None, rtol: float = ROUNDOFF_RTOL) -> Any:
+    """``values`` (an array) with entries ``|x| ≤ rtol·max|scale|`` set to 0 (``scale``
+    defaults to ``values``; NaN and inf are kept); ``-0.0`` becomes ``0.0``."""
+    import numpy as np
+
+    a = np.array(values, dtype=float)
+    ref = np.abs(np.asarray(a if scale is None else scale, dtype=float))
+    ref = ref[np.isfinite(ref)]
+    tol = rtol * float(ref.max(initial=0.0))
+    with np.errstate(invalid="ignore"):
+        a[np.abs(a) <= tol] = 0.0
+    return a + 0.0
+
+
+def format_array(values: Any, scale: Any = None) -> str:
+    """A matrix or vector for text output: round-off shown as 0 (:func:`chop`), 6 significant
+    digits."""
+    import numpy as np
+
+    return np.array2string(chop(values, scale), precision=6, suppress_small=True,
+                           max_line_width=120, threshold=10_000)
 
 
 def nested(values: Iterable[Any]) -> Sequence[Any]:

@@ -73,7 +73,8 @@ class NominalMotion:
 
     ``y``, ``yd``, ``ydd`` are tuples (one entry per coordinate, in the system's order) of
     expressions in ``t`` and the parameters; ``yd`` and ``ydd`` are the time derivatives of ``y``
-    unless the file gives the rates explicitly.
+    unless the file gives the rates explicitly. ``inputs`` holds the nominal inputs ``u_s`` as
+    ``(name, expression)`` pairs (inputs not given are 0).
     """
 
     name: str
@@ -81,6 +82,7 @@ class NominalMotion:
     yd: tuple[se.Basic, ...]
     ydd: tuple[se.Basic, ...]
     description: str = ""
+    inputs: tuple[tuple[str, se.Basic], ...] = ()
 
     @property
     def is_equilibrium(self) -> bool:
@@ -910,7 +912,7 @@ class _Loader:
         for nname, spec in tbl.items():
             p = (*path, nname)
             self.name(nname, p, "nominal motion")
-            spec = self.table(spec, p, {"y", "yd", "description"})
+            spec = self.table(spec, p, {"y", "yd", "inputs", "description"})
 
             def values(key: str, spec: dict = spec, p: Path = p) -> dict[str, se.Basic]:
                 tb = self.table(spec.get(key, {}), (*p, key),
@@ -933,7 +935,14 @@ class _Loader:
                 yd_full = tuple(se.diff(e, t) for e in y_full)
             ydd_full = tuple(se.diff(e, t) for e in yd_full)
             desc = self.string(spec.get("description", ""), (*p, "description"))
-            out.append(NominalMotion(nname, y_full, yd_full, ydd_full, desc))
+            ins = []
+            for iname, v in self.table(spec.get("inputs", {}), (*p, "inputs"),
+                                       what="a table of input = value").items():
+                if iname not in self.inputs:
+                    raise self.fail((*p, "inputs", iname), f'"{iname}" is not a declared input'
+                                    f"{self.suggest(iname, self.inputs)}")
+                ins.append((iname, self.expr(v, (*p, "inputs", iname), allowed, ctx)))
+            out.append(NominalMotion(nname, y_full, yd_full, ydd_full, desc, tuple(ins)))
         return tuple(out)
 
     def read_simulation(self, data: dict, system: System) -> SimulationSettings:

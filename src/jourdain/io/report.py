@@ -676,18 +676,19 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
                                 "ẏ", "rates"))
             try:
                 Tk, V, W = res.kinetic_energy, res.potential_energy, res.work_nonconservative
+                Wd = res.work_drive
                 s.append(_time_plot(res.t, {"T (kinetic)": Tk, "V (potential)": V,
-                                            "T + V − W_nc": Tk + V - W},
+                                            "T + V − W_nc − W_drive": Tk + V - W - Wd},
                                     "energy", "energy balance"))
                 driven = _prescribed_joints(system)
-                why = (f" — not expected to close: the prescribed motion of "
-                       f"{', '.join(driven)} does work on the system" if driven else "")
+                why = (f" (with the work W_drive of the prescribed motion of "
+                       f"{', '.join(driven)})" if driven else "")
                 s.append(f"<p class='meta'>energy balance error (relative): "
                          f"{res.energy_balance_error:.2e}{_e(why)}</p>")
                 info.summary_lines.append(
                     f"  simulated t = 0 … {res.t[-1]:g} s, energy balance error "
                     f"{res.energy_balance_error:.1e}"
-                    + (" (prescribed motion does work)" if driven else ""))
+                    + (" (prescribed motion's work included)" if driven else ""))
             except (JourdainError, KeyError, AttributeError, ValueError) as exc:
                 s.append(_note(f"energies not available: {exc}"))
                 info.summary_lines.append(f"  simulated t = 0 … {res.t[-1]:g} s")

@@ -197,12 +197,14 @@ class System:
 
         return reactions(self.newton_euler())
 
-    def linearize(self, nominal: Mapping[Any, Any] | Any) -> Linearization:
-        """Linearization M̃·η̈ + P·η̇ + Q·η = h + B·Δu about a nominal motion (METHOD §5);
-        see :func:`jourdain.linearization.linearization`."""
+    def linearize(self, nominal: Mapping[Any, Any] | Any,
+                  inputs: Mapping[Any, Any] | None = None) -> Linearization:
+        """Linearization M̃·η̈ + P·η̇ + Q·η = h + B·Δu about a nominal motion (METHOD §5), with
+        nominal ``inputs`` ``{input: u_s}`` where given (zero otherwise); see
+        :func:`jourdain.linearization.linearization`."""
         from ..linearization import linearization
 
-        return linearization(self.equations_of_motion(), nominal)
+        return linearization(self.equations_of_motion(), nominal, inputs)
 
     def evaluate(self, y: Any, yd: Any, t: float = 0.0, parameters: Mapping[str, float] | None = None,
                  inputs: Mapping[str, float] | Sequence[float] | None = None) -> dict[str, np.ndarray]:
