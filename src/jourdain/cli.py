@@ -442,15 +442,16 @@ def _state_text(system: Any, y: np.ndarray, yd: np.ndarray, t: float,
 
 def _display_scales(values: dict[str, np.ndarray]) -> dict[str, Any]:
     """What the round-off of each quantity is judged against: the symmetric and skew parts
-    against P and Q, the generalized forces k, q, h against the body forces and torques
-    projected (``max|J̄|·(max|q̄^c| + max|q̄^e|)``, which stays large where q itself cancels to
+    against P and Q, the generalized forces k, q, h against the forces at work
+    (:func:`jourdain.linearization.force_scale`, which stays large where q itself cancels to
     round-off, as for a pendulum standing upright); the others against themselves."""
+    from .linearization import force_scale
+
     out: dict[str, Any] = {"D": values.get("P"), "G": values.get("P"), "K": values.get("Q"),
                            "N": values.get("Q")}
-    if all(k in values for k in ("J_bar", "q_c", "q_e")):
-        forces = [float(np.abs(values["J_bar"]).max(initial=0.0)
-                        * (np.abs(values["q_c"]).max(initial=0.0)
-                           + np.abs(values["q_e"]).max(initial=0.0)))]
+    if all(k in values for k in ("J_bar", "q_c", "q_e", "k", "q")):
+        forces = force_scale(values["J_bar"], values["q_c"], values["q_e"], values["k"],
+                             values["q"])
         out.update({k: forces for k in ("k", "q", "h")})
     return out
 

@@ -81,11 +81,10 @@ class NominalCheck:
     h : (f,) array
         The residual (METHOD.md §5).
     scale : (f,) array
-        ``‖J̄_i‖·(‖q̄^c‖ + ‖q̄^e‖ + ‖M̄·J̄·ÿ_s‖) + |k_i| + |q_i|`` with ``J̄_i`` the column of
-        coordinate i: by Cauchy–Schwarz on ``q_i = J̄_iᵀ·q̄^e``, the largest generalized force the
-        body forces and torques at the nominal state could make on coordinate i. It stays large
-        where those forces balance (a pendulum standing upright, where ``q`` itself is round-off).
-        Zeros where h is exactly zero (not evaluated).
+        :func:`force_scale` at the nominal state, ``‖J̄_i‖·(‖q̄^c‖ + ‖q̄^e‖ + ‖M̄·J̄·ÿ_s‖) +
+        |k_i| + |q_i|`` with ``J̄_i`` the column of coordinate i: it stays large where the forces
+        balance (a pendulum standing upright, where ``q`` itself is round-off). Zeros where h is
+        exactly zero (not evaluated).
     relative : float
         ``max |h_i| / scale_i`` (inf where ``scale_i = 0 < |h_i|``).
     kind : str
@@ -153,12 +152,20 @@ class NominalCheck:
         return text + " Correct y_s (jourdain.find_equilibrium finds equilibria)."
 
 
-def _h_scale(J_bar: np.ndarray, q_c: np.ndarray, q_e: np.ndarray, M_bar: np.ndarray,
-             ydd_s: np.ndarray, k: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """The scale of :class:`NominalCheck` from the numbers at the nominal state."""
-    forces = (np.linalg.norm(q_c) + np.linalg.norm(q_e)
-              + np.linalg.norm(M_bar @ (J_bar @ ydd_s)))
-    return np.linalg.norm(J_bar, axis=0) * forces + np.abs(k) + np.abs(q)
+def force_scale(J_bar: np.ndarray, q_c: np.ndarray, q_e: np.ndarray, k: np.ndarray,
+                q: np.ndarray, M_bar: np.ndarray | None = None,
+                ydd: np.ndarray | None = None) -> np.ndarray:
+    """The size of the generalized forces at work on each coordinate at one state, (f,):
+    ``‖J̄_i‖·(‖q̄^c‖ + ‖q̄^e‖ + ‖M̄·J̄·ÿ‖) + |k_i| + |q_i|`` (the last norm where ``M_bar`` and
+    ``ydd`` are given). By Cauchy–Schwarz on ``q_i = J̄_iᵀ·q̄^e`` it bounds what the body forces
+    and torques could make on coordinate i, so it stays large where they balance (a pendulum
+    standing upright, where q itself is round-off): the scale against which h (the nominal
+    check) and, in text output, k, q and h (round-off) are judged."""
+    forces = np.linalg.norm(q_c) + np.linalg.norm(q_e)
+    if M_bar is not None and ydd is not None:
+        forces += np.linalg.norm(M_bar @ (J_bar @ ydd))
+    return (np.linalg.norm(J_bar, axis=0) * forces + np.abs(np.ravel(k))
+            + np.abs(np.ravel(q)))
 
 
 def _kind(y_s: list[se.Basic], yd_s: list[se.Basic], ydd_s: list[se.Basic]) -> str:
@@ -328,7 +335,7 @@ class Linearization:
                 parts.append(flat[i:i + r * c].reshape(r, c))
                 i += r * c
             Jb, qc, qe, Mb, k, q = parts
-            scale = _h_scale(Jb, qc[:, 0], qe[:, 0], Mb, ydds, k[:, 0], q[:, 0])
+            scale = force_scale(Jb, qc[:, 0], qe[:, 0], k[:, 0], q[:, 0], Mb, ydds)
         return _nominal_check(h, scale, _kind(self.y_s.entries(), self.yd_s.entries(),
                                               self.ydd_s.entries()),
                               tv, _describe_nominal(self), system, us, B)
@@ -810,8 +817,8 @@ def linearize_numeric(source: System | EquationsOfMotion, nominal: Mapping[Any, 
             dJ = J.jacobian[2 * f:nJ].reshape(n6, f, nv)
             dJa = np.einsum("rjv,j->rv", dJ, ydds)
             dr = dr + np.einsum("rjv,r->jv", dJ, MJ @ ydds) + MJ.T @ dJa
-        scale = _h_scale(Jb, J.values[nJ:nJ + n6], J.values[nJ + n6:], M_bar, ydds,
-                         J.values[:f], J.values[f:2 * f])
+        scale = force_scale(Jb, J.values[nJ:nJ + n6], J.values[nJ + n6:], J.values[:f],
+                            J.values[f:2 * f], M_bar, ydds)
         return {"M_tilde": Mt, "Q": dr[:, :f], "P": dr[:, f:2 * f],
                 "B": -dr[:, 2 * f:2 * f + m], "h": -r, "h_scale": scale,
                 "u_s": np.array(us, dtype=float)}

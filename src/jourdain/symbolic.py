@@ -150,6 +150,8 @@ class SymMatrix:
         :data:`REPR_SECONDS`); a summary for matrices too large to print."""
         import sympy
 
+        if not self.rows:
+            return "SymMatrix([])"
         summary = self._summary()
         if summary is not None:
             return f"SymMatrix(<{summary}; .sympy() gives every entry>)"
