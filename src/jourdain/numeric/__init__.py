@@ -264,7 +264,6 @@ def lambdify(system: System, matrices: Mapping[str, SymMatrix],
     The cache key is a hash of the generated source itself: SymEngine's own hashes cannot serve,
     since they do not tell ``k*(x - x0)`` from ``k*(x0 - x)``.
     """
-    args = arguments(system)
     names = tuple(matrices)
     shapes = tuple(matrices[n].shape for n in names)
     exprs: list[se.Basic] = []
@@ -280,16 +279,23 @@ def lambdify(system: System, matrices: Mapping[str, SymMatrix],
     cnames = argument_names(system.y, system.yd, system.t, system.parameter_symbols,
                             system.inputs)
     source = HEADER + function_source("jd_fn", exprs, cnames) + extra_source
-    key = content_key(_GENERATOR_VERSION, source)
-    lib = build(key, source)  # loads the cached library when there is one
+    return _load(system, names, shapes, source)  # the cached library when there is one
+
+
+def _load(system: System, names: tuple[str, ...], shapes: tuple[tuple[int, int], ...],
+          source: str | tuple[str, ...], n_bodies: int = 0) -> CompiledFunction:
+    """Build (or load from the cache) the library of ``jd_fn`` and ``jd_fn_batch``."""
+    units = (source,) if isinstance(source, str) else source
+    key = content_key(_GENERATOR_VERSION, *units)
+    lib = build(key, source)
     vp = ctypes.c_void_p
     lib.jd_fn.restype = None
     lib.jd_fn.argtypes = [vp, vp, ctypes.c_double, vp, vp, vp]
     lib.jd_fn_batch.restype = None
     lib.jd_fn_batch.argtypes = [ctypes.c_long, ctypes.c_long, vp, vp, vp, vp, ctypes.c_long, vp,
                                 ctypes.c_long, vp]
-    return CompiledFunction(names, shapes, args, key, system.f, len(system.parameters),
-                            len(system.inputs), lib)
+    return CompiledFunction(names, shapes, arguments(system), key, system.f,
+                            len(system.parameters), len(system.inputs), lib, n_bodies=n_bodies)
 
 
 def _interpreted(system: System, names: tuple[str, ...], shapes: tuple[tuple[int, int], ...],
@@ -334,16 +340,7 @@ def _recursive(system: System, full: bool, extra_source: str = "",
         return lambdify(system, mats, extra_source)
     template = ACCEL_TEMPLATE.replace("JD_F_VALUE", str(f)) if accel else None
     units = recursive_units(system, full, directions, extra_source, template)
-    key = content_key(_GENERATOR_VERSION, *units)
-    lib = build(key, units)
-    vp = ctypes.c_void_p
-    lib.jd_fn.restype = None
-    lib.jd_fn.argtypes = [vp, vp, ctypes.c_double, vp, vp, vp]
-    lib.jd_fn_batch.restype = None
-    lib.jd_fn_batch.argtypes = [ctypes.c_long, ctypes.c_long, vp, vp, vp, vp, ctypes.c_long, vp,
-                                ctypes.c_long, vp]
-    return CompiledFunction(names, shapes, arguments(system), key, f, len(system.parameters),
-                            len(system.inputs), lib, n_bodies=p)
+    return _load(system, names, shapes, units, n_bodies=p)
 
 
 @lru_cache(maxsize=32)
