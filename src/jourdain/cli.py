@@ -99,6 +99,16 @@ def _overrides(system: Any, sets: Sequence[str]) -> dict[str, float]:
                 raise UsageError(f'--set: "{name}" is not a parameter of the model; parameters '
                                  f"are {', '.join(params) or '(none)'}")
             out[name] = _number(value, f"--set {name}")
+    if out:
+        # the model's numbers at these values pass the checks made at the file's defaults
+        from .errors import ModelError
+        from .model.bodies import check_values
+
+        try:
+            check_values(system.bodies, {**params, **out})
+        except ModelError as exc:
+            given = ", ".join(f"{k}={v:g}" for k, v in out.items())
+            raise ModelError(f"with --set {given}: {exc}") from None
     return out
 
 

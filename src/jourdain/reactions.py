@@ -575,7 +575,10 @@ def _singular_rows(system: System) -> tuple[tuple[int, ...], dict[str, tuple[lis
         if regular:
             sub = [[I[a][c] for c in regular] for a in regular]
             Ir = np.array([[num(x) for x in r] for r in sub])
-            if abs(np.linalg.det(Ir)) <= 1e-12 * max(1.0, float(np.abs(Ir).max())) ** len(regular):
+            # |det| <= 1e-12·s^n, s = max(1, max|I|), tested as det(I/s): s^n overflows for
+            # inertias above 1e102 (a mass of 1e300)
+            s = max(1.0, float(np.abs(Ir).max()))
+            if abs(np.linalg.det(Ir / s)) <= 1e-12:
                 raise ModelError(
                     f'body "{b.name}": its inertia tensor is singular, but not along body axes '
                     "(no row and column of zeros); give the inertia in a frame whose axes are "

@@ -455,7 +455,9 @@ class Results:
         suffix = path.suffix.lower()
         if suffix == ".csv":
             cols, data = self._columns()
-            header = "\n".join(f"{k}: {v}" for k, v in self._meta().items())
+            # one line per entry: a line break in a name or message would shift the header
+            header = "\n".join(f"{k}: {' '.join(str(v).splitlines())}"
+                               for k, v in self._meta().items())
             np.savetxt(path, data, delimiter=",", header=header + "\n" + ",".join(cols),
                        comments="# ", fmt="%.17g")
             # the last header line is the column names without the comment mark

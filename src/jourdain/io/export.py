@@ -132,6 +132,18 @@ def to_sympy_matrix(m: SymMatrix, simplify: bool = True, deadline: float | None 
 # LaTeX
 # ------------------------------------------------------------------------------------------
 
+#: Line breaks (which end a TeX comment), the other control characters and the Unicode line
+#: separators (which editors show as line breaks).
+_TEX_LINE_BREAKS = re.compile("[\x00-\x1f\x7f-\x9f\u2028\u2029]+")
+
+
+def latex_comment(text: str) -> str:
+    """``text`` (a model's name, a title) as one TeX comment line ``% text``: line breaks and
+    other control characters become spaces, so nothing of ``text`` can leave the comment and be
+    read by TeX as commands (``\\immediate\\write18{...}`` after a newline in a name)."""
+    return "% " + _TEX_LINE_BREAKS.sub(" ", text)
+
+
 def latex_symbol_names(system: System) -> dict[Any, str]:
     import sympy
 
@@ -165,7 +177,7 @@ def latex_fragment(matrices: Mapping[str, SymMatrix], symbols: Mapping[str, str]
         if "\\begin{pmatrix}" in tex:
             cols = max(cols, m.shape[1])
         body += [f"\\[ {symbols.get(name, name)} = {tex} \\]", ""]
-    head = [f"% {title} (jourdain)",
+    head = [latex_comment(f"{title} (jourdain)"),
             "% A LaTeX fragment: \\input it into a document that loads amsmath.",
             f"\\setcounter{{MaxMatrixCols}}{{{cols}}}", ""]
     return "\n".join([*head, *body]).rstrip() + "\n"

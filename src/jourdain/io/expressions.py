@@ -19,6 +19,7 @@ nothing is ever passed to ``eval``, ``exec`` or ``sympify``.
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Callable, Container
 from dataclasses import dataclass
@@ -32,8 +33,15 @@ from ..errors import ModelError
 MAX_LENGTH = 20_000
 #: Deepest nesting of parentheses, unary signs and powers accepted.
 MAX_DEPTH = 100
-#: Largest integer exponent applied to a number (``10^1000000`` would build a huge integer).
+#: Largest magnitude of a numeric exponent (``10^1000000`` would build a huge integer).
 MAX_NUMERIC_EXPONENT = 1000
+#: Largest exact number the arithmetic on constants may build, in bits of its numerator or
+#: denominator (10 000 bits: about 3 000 decimal digits; ``1000^1000`` fits). Every power is
+#: bounded before it is computed, so ``((2^999)^999)^999`` is refused instead of building a
+#: number of a billion bits (or crashing the big-integer library).
+MAX_NUMBER_BITS = 10_000
+#: Longest number literal (characters).
+MAX_NUMBER_LENGTH = 1000
 
 
 def _atan2(y: se.Basic, x: se.Basic) -> se.Basic:
@@ -185,6 +193,17 @@ class _Parser:
     def _what(tok: Token) -> str:
         return "the end of the expression" if tok.kind == "end" else repr(tok.text)
 
+    def checked(self, e: se.Basic, tok: Token) -> se.Basic:
+        """``e``, the result of the operation at ``tok``, if its constant part is a finite number
+        of bounded size. Sums and products only add the sizes of their operands, so the
+        numbers on top (the number itself, a product's coefficient, a sum's constant term) are
+        enough here; the whole result is checked once at the end (:func:`_real_and_finite`)."""
+        for node in (e, *(e.args[:1] if e.is_Mul or e.is_Add else ())):
+            why = _bad_number(node, final=False)
+            if why:
+                raise self.error(f"{why} here", tok)
+        return e
+
     def enter(self) -> None:
         self.depth += 1
         if self.depth > MAX_DEPTH:
@@ -208,9 +227,9 @@ class _Parser:
     def expr(self) -> se.Basic:
         e = self.term()
         while self.tok.kind == "op" and self.tok.text in "+-":
-            op = self.take().text
+            tok = self.take()
             rhs = self.term()
-            e = e + rhs if op == "+" else e - rhs
+            e = self.checked(e + rhs if tok.text == "+" else e - rhs, tok)
         return e
 
     def term(self) -> se.Basic:
@@ -221,9 +240,9 @@ class _Parser:
             if tok.text == "/":
                 if rhs.is_Number and rhs == 0:
                     raise self.error("division by zero", tok)
-                e = e / rhs
+                e = self.checked(e / rhs, tok)
             else:
-                e = e * rhs
+                e = self.checked(e * rhs, tok)
         return e
 
     def unary(self) -> se.Basic:
@@ -242,19 +261,33 @@ class _Parser:
             self.enter()
             exponent = self.unary()
             self.depth -= 1
-            if base.is_Number and exponent.is_Number:
-                if abs(float(exponent)) > MAX_NUMERIC_EXPONENT:
-                    raise self.error(f"numeric exponent {exponent} is too large", tok)
-                if base == 0 and float(exponent) < 0:
+            if exponent.is_Number:
+                n = abs(float(exponent))
+                if n > MAX_NUMERIC_EXPONENT:
+                    raise self.error(f"numeric exponent {_short(exponent)} is too large (at most "
+                                     f"{MAX_NUMERIC_EXPONENT} in magnitude)", tok)
+                # the power multiplies the size of the exact numbers in its base by |exponent|
+                # (a coefficient 2^999 of a product raised to 999 is 2^998001): bounded
+                # before SymEngine computes it
+                bits = _power_bits(base) * n
+                if bits > MAX_NUMBER_BITS:
+                    raise self.error(f"this power would build a number of about {bits:.3g} bits "
+                                     f"(at most {MAX_NUMBER_BITS} bits, about "
+                                     f"{int(MAX_NUMBER_BITS * 0.30103)} digits, are allowed)",
+                                     tok)
+                if base.is_Number and base == 0 and float(exponent) < 0:
                     raise self.error("zero raised to a negative power", tok)
-            return base**exponent
+            return self.checked(base**exponent, tok)
         return base
 
     def atom(self) -> se.Basic:
         tok = self.tok
         if tok.kind == "num":
             self.i += 1
-            return _number(tok.text)
+            try:
+                return _number(tok.text)
+            except ExpressionError as exc:
+                raise self.error(str(exc), tok) from None
         if tok.kind == "op" and tok.text == "(":
             self.i += 1
             self.enter()
@@ -309,23 +342,95 @@ class _Parser:
             raise self.error(f"{tok.text}() takes {nargs} argument{'s' if nargs > 1 else ''}, "
                              f"got {len(args)}", tok)
         try:
-            return fn(*args)
+            value = fn(*args)
         except (RuntimeError, ValueError, ZeroDivisionError) as exc:
             raise self.error(f"{tok.text}(): {exc}", tok) from None
+        return self.checked(value, tok)
 
 
 def _number(text: str) -> se.Basic:
     """Exact value of a decimal literal (``0.1`` is 1/10), a float when the exponent is huge."""
+    if len(text) > MAX_NUMBER_LENGTH:
+        raise ExpressionError(f"number {_short(text)} is too long ({len(text)} characters, at "
+                              f"most {MAX_NUMBER_LENGTH})")
     mantissa, _, exp = text.lower().partition("e")
     if exp and abs(int(exp)) > 300:
         value = float(text)
         if value in (float("inf"), float("-inf")):
-            raise ExpressionError(f"number {text} is too large")
+            raise ExpressionError(f"number {_short(text)} is too large for a floating-point "
+                                  "number (at most about 1.8e308)")
         return se.Float(value)
     frac = Fraction(text)
-    if frac.denominator == 1:
-        return se.Integer(frac.numerator)
-    return se.Rational(frac.numerator, frac.denominator)
+    out = (se.Integer(frac.numerator) if frac.denominator == 1
+           else se.Rational(frac.numerator, frac.denominator))
+    why = _bad_number(out)
+    if why:
+        raise ExpressionError(f"number {_short(text)}: {why}")
+    return out
+
+
+def _short(x: object, n: int = 40) -> str:
+    """``x`` as text, shortened in the middle when longer than ``n`` characters."""
+    s = str(x)
+    return s if len(s) <= n else f"{s[:n // 2]}…{s[-n // 2:]} ({len(s)} characters)"
+
+
+def _bits(x: se.Basic) -> int:
+    """Size of an exact number: the bit length of its numerator or denominator (0 otherwise)."""
+    if x.is_Integer:
+        return int(x).bit_length()
+    if x.is_Rational:
+        num, den = x.get_num_den()
+        return max(int(num).bit_length(), int(den).bit_length())
+    return 0
+
+
+def _power_bits(base: se.Basic) -> float:
+    """Bits of the largest exact number that raising ``base`` to an exponent n multiplies by
+    |n|: a number itself, a product's numeric factors, and b^k of a number b (b^(k·n))."""
+    if base.is_Number:
+        return max(_bits(base), 1)
+    if base.is_Pow:
+        b, k = base.args
+        if b.is_Number and k.is_Number:
+            return max(_bits(b), 1) * abs(float(k))
+        return 1.0
+    if base.is_Mul:
+        return max(_power_bits(a) for a in base.args)
+    return 1.0
+
+
+def _bad_number(x: se.Basic, final: bool = True) -> str | None:
+    """Why the number ``x`` is not allowed in an expression (None when it is, or for a
+    non-number): too large an exact number, an infinite or undefined floating-point constant,
+    or (``final``: in the expression read, not in an intermediate result such as the 10^400 of
+    10^400/10^399) an exact number beyond floating-point range."""
+    if not x.is_Number:
+        return None
+    if x.is_Rational:
+        bits = _bits(x)
+        if bits > MAX_NUMBER_BITS:
+            return (f"the exact number built would have {bits} bits (at most {MAX_NUMBER_BITS} "
+                    "bits are allowed)")
+        if not final:
+            return None
+        if x.is_Integer:
+            big = bits > 1024
+        else:
+            num, den = x.get_num_den()
+            big = int(num).bit_length() - int(den).bit_length() > 1024
+        if big:
+            return (f"the constant {_short(x)} is too large for a floating-point number (at "
+                    "most about 1.8e308)")
+        return None
+    try:
+        v = complex(x)
+    except (RuntimeError, TypeError, ValueError, OverflowError):
+        return None
+    if not (math.isfinite(v.real) and math.isfinite(v.imag)):
+        what = "undefined (NaN)" if v != v else "infinite"
+        return f"the constant {x} is {what} (beyond floating-point range)"
+    return None
 
 
 def _no_hint(name: str) -> str:
@@ -367,14 +472,28 @@ _NOT_REAL = {"ImaginaryUnit": "is complex (contains the imaginary unit)",
 
 
 def _real_and_finite(expr: se.Basic, text: str) -> se.Basic:
-    """Reject constants such as sqrt(-1), log(0) or 0*oo that the arithmetic produced."""
+    """Reject constants such as sqrt(-1), log(0) or 0*oo that the arithmetic produced, infinite
+    floating-point constants (1e308*1e308) and exact numbers too large for floating point."""
     stack = [expr]
     while stack:
         node = stack.pop()
         why = _NOT_REAL.get(type(node).__name__)
         if why:
-            raise ExpressionError(f"the expression {why}: {text.strip()} = {expr}")
+            raise ExpressionError(f"the expression {why}: {_short(text.strip(), 200)} = "
+                                  f"{_short(expr, 200)}")
+        bad = _bad_number(node)
+        if bad:
+            raise ExpressionError(f"in {_short(text.strip(), 200)}: {bad}")
         stack.extend(node.args)
+    if not expr.free_symbols:
+        # a constant must be a real number: (-8)^(1/3) is 2*(-1)^(1/3), complex
+        try:
+            value = float(expr)
+        except (RuntimeError, TypeError, ValueError, OverflowError):
+            value = math.nan
+        if not math.isfinite(value):
+            raise ExpressionError(f"the expression is not a finite real number: "
+                                  f"{_short(text.strip(), 200)} = {_short(expr, 200)}")
     return expr
 
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import difflib
 import math
+import os
 import re
 import tomllib
 from collections.abc import Callable, Container, Mapping
@@ -47,12 +48,21 @@ from ..model import (
     disc,
     rod,
 )
+from ..model.bodies import mass_data_problem
 from ..model.expressions import unit_axis
+from ..model.joints import orientation_problem
 from .expressions import RESERVED_NAMES, ExpressionError, _number, parse_expression
-from .toml_positions import Path, key_lines, line_of
+from .toml_positions import Path, deep_nesting, key_lines, line_of
 
-__all__ = ["ModelFile", "ModelFileError", "NominalMotion", "SimulationSettings", "load_model",
-           "loads_model"]
+__all__ = ["MAX_FILE_BYTES", "ModelFile", "ModelFileError", "NominalMotion",
+           "SimulationSettings", "load_model", "loads_model"]
+
+#: Largest model file read (bytes). Real models are a few kB to a few hundred kB; reading and
+#: locating the keys of a file takes about a second per MB, so larger files are refused at once.
+MAX_FILE_BYTES = 4_000_000
+#: Deepest nesting of arrays and inline tables reported by name when the TOML reader gives up
+#: (model files nest three or four levels).
+_MAX_NESTING = 32
 
 
 class ModelFileError(ModelError):
@@ -126,11 +136,11 @@ class ModelFile:
         joint whose constrained directions violate J̄ᵀQ̄ = 0), located in the file by the body,
         joint or force that the message names."""
         try:
-            text = FsPath(self.path).read_text(encoding="utf-8")
-        except OSError:
+            with open(self.path, "rb") as fh:
+                text = fh.read(MAX_FILE_BYTES + 1).decode("utf-8")
+        except (OSError, UnicodeDecodeError):
             text = ""
-        loader = _Loader(text, self.path)
-        loader.lines = key_lines(text)
+        loader = _Loader(text if len(text) <= MAX_FILE_BYTES else "", self.path)
         loader.body_names = self.system.body_names
         loader.joint_of_body = {b.name: b.joint.name for b in self.system.bodies}
         path = loader.locate(message)
@@ -181,6 +191,23 @@ _FORCE_KEYS: dict[str, set[str]] = {
 _SHAPES = {"point": set(), "rod": {"length", "axis"}, "disc": {"radius", "axis"},
            "cylinder": {"radius", "length", "axis"}, "box": {"a", "b", "c"}}
 _IDENT = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
+# line breaks and other control characters (C0, DEL, C1, the Unicode line separators)
+_CONTROL = re.compile("[\x00-\x1f\x7f-\x9f\u2028\u2029]")
+
+
+def _clip(text: str, n: int = 120) -> str:
+    """``text`` for a message: at most ``n`` characters, the middle left out."""
+    return text if len(text) <= n else f"{text[:n // 2]} … {text[-n // 2:]}"
+
+
+def _too_big(size: int, text: str | None = None) -> str | None:
+    """Why a file of ``size`` bytes (or characters of ``text``) is refused, or None."""
+    if text is not None and size <= MAX_FILE_BYTES < 4 * size:
+        size = len(text.encode("utf-8", "surrogatepass"))
+    if size <= MAX_FILE_BYTES:
+        return None
+    return (f"the file is too large ({size / 1e6:.1f} MB); model files are at most "
+            f"{MAX_FILE_BYTES / 1e6:g} MB")
 
 
 def _type_name(v: object) -> str:
@@ -228,7 +255,7 @@ class _Loader:
     def __init__(self, text: str, filename: str) -> None:
         self.file = filename
         self.text = text
-        self.lines: dict[Path, int] = {}
+        self._lines: dict[Path, int] | None = None
         self.coords: list[str] = []
         self.params: dict[str, float] = {}
         self.inputs: list[str] = []
@@ -238,10 +265,22 @@ class _Loader:
         self.joint_of_body: dict[str, str] = {}
         self.driven: dict[str, str] = {}
 
+    @property
+    def lines(self) -> dict[Path, int]:
+        """Line of every key path, scanned on first use: only a file with a mistake needs it."""
+        if self._lines is None:
+            self._lines = key_lines(self.text)
+        return self._lines
+
     # --- errors ---------------------------------------------------------------------------
     def fail(self, path: Path, message: str) -> ModelFileError:
         line = line_of(self.lines, path)
         where = describe_path(path)
+        for k in range(len(path), 0, -1):  # a core message that names the same element
+            prefix = describe_path(path[:k]) + ": "
+            if message.startswith(prefix):
+                message = message[len(prefix):]
+                break
         loc = f"{self.file}:{line}" if line else self.file
         return ModelFileError(f"{loc}: {where}: {message}", self.file, line, path, message)
 
@@ -272,17 +311,37 @@ class _Loader:
             raise self.fail(path, f"expected a string, got {_type_name(value)}")
         return value
 
+    def line_string(self, value: object, path: Path) -> str:
+        """A string of one line: no line breaks or other control characters (a model's name
+        and units are written into comments and headers of the output files)."""
+        s = self.string(value, path)
+        bad = next((c for c in s if _CONTROL.match(c)), None)
+        if bad is not None:
+            raise self.fail(path, f"expected one line of text, got a string with the control "
+                            f"character {bad!r} at position {s.index(bad) + 1}")
+        return s
+
     def number(self, value: object, path: Path, positive: bool = False,
                integer: bool = False) -> float:
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise self.fail(path, f"expected a number, got {_type_name(value)}")
         if integer and not isinstance(value, int):
             raise self.fail(path, f"expected an integer, got {_type_name(value)}")
+        if isinstance(value, int):
+            self.integer_in_range(value, path)
         if not math.isfinite(value):
             raise self.fail(path, f"expected a finite number, got {value}")
         if positive and value <= 0:
             raise self.fail(path, f"expected a positive number, got {value}")
         return float(value)
+
+    def integer_in_range(self, value: int, path: Path) -> None:
+        """An integer of the file must be a floating-point number (|value| < 1.8e308)."""
+        try:
+            float(value)
+        except OverflowError:
+            raise self.fail(path, f"the integer of {len(str(abs(value)))} digits is too large for "
+                            "a floating-point number (at most about 1.8e308)") from None
 
     def name(self, value: object, path: Path, what: str) -> str:
         s = self.string(value, path)
@@ -313,6 +372,7 @@ class _Loader:
         if isinstance(value, bool):
             raise self.fail(path, "expected a number or an expression string, got a boolean")
         if isinstance(value, int):
+            self.integer_in_range(value, path)
             return se.Integer(value)
         if isinstance(value, float):
             if not math.isfinite(value):
@@ -323,10 +383,30 @@ class _Loader:
             raise self.fail(path, f"expected a number or an expression string, got "
                             f"{_type_name(value)}")
         try:
-            return parse_expression(value, allowed, describe=self.names_hint(allowed, context))
+            e = parse_expression(value, allowed, describe=self.names_hint(allowed, context))
         except ExpressionError as exc:
             col = f" at column {exc.column}" if exc.column else ""
-            raise self.fail(path, f'in expression "{value}"{col}: {exc}') from None
+            raise self.fail(path, f'in expression "{_clip(value)}"{col}: {exc}') from None
+        self.real_at_defaults(e, value, path)
+        return e
+
+    def real_at_defaults(self, e: se.Basic, text: str, path: Path) -> None:
+        """An expression of the parameters alone must be a finite real number at their default
+        values (``sqrt(-l1)``, ``1/(l1 - 1)`` with l1 = 1 are refused where they are written);
+        expressions of coordinates, rates, inputs or t are checked when evaluated."""
+        syms = e.free_symbols
+        if not syms or not all(str(x) in self.params for x in syms):
+            return
+        values = {x: self.params[str(x)] for x in syms}
+        at = e.subs(values)
+        try:
+            v = float(at)
+        except (RuntimeError, TypeError, ValueError, OverflowError):
+            v = math.nan
+        if not math.isfinite(v):
+            given = ", ".join(f"{x} = {values[x]:g}" for x in sorted(values, key=str))
+            raise self.fail(path, f'"{_clip(text)}" is not a finite real number at the default '
+                            f"parameter values ({given}): it is {_clip(str(at))}")
 
     def vector(self, value: object, path: Path, allowed: Container[str], context: str,
                n: int = 3) -> tuple[se.Basic, ...]:
@@ -369,8 +449,13 @@ class _Loader:
 
     # --- sections -------------------------------------------------------------------------
     def load(self) -> ModelFile:
+        too_big = _too_big(len(self.text), self.text)
+        if too_big:
+            raise ModelFileError(f"{self.file}: {too_big}", self.file, None, (), too_big)
         try:
             data = tomllib.loads(self.text)
+        except RecursionError:
+            raise self.nesting_error() from None
         except tomllib.TOMLDecodeError as exc:
             msg = str(exc)
             m = re.search(r"\(at line (\d+), column (\d+)\)", msg)
@@ -382,11 +467,16 @@ class _Loader:
             loc = f"{self.file}:{line}" if line else self.file
             raise ModelFileError(f"{loc}: TOML syntax error{col}: {core}", self.file, line,
                                  (), core) from None
-        self.lines = key_lines(self.text)
+        except ValueError as exc:  # a number that Python will not convert (> 4300 digits)
+            m = re.search(r"[0-9_]{1000,}", self.text)
+            line = self.text.count("\n", 0, m.start()) + 1 if m else None
+            loc = f"{self.file}:{line}" if line else self.file
+            core = f"a number the TOML reader refuses: {exc}"
+            raise ModelFileError(f"{loc}: {core}", self.file, line, (), core) from None
         self.table(data, (), _TOP)
         model = self.table(data.get("model", {}), ("model",),
                            {"name", "description", "view"})
-        name = self.string(model.get("name", FsPath(self.file).stem), ("model", "name"))
+        name = self.line_string(model.get("name", FsPath(self.file).stem), ("model", "name"))
         description = self.string(model.get("description", ""), ("model", "description"))
         view = None
         if "view" in model:
@@ -412,6 +502,17 @@ class _Loader:
         sim = self.read_simulation(data, system)
         return ModelFile(self.file, system, description, nominal, sim,
                          tuple(self.descriptions.items()), view)
+
+    def nesting_error(self) -> ModelFileError:
+        """The TOML reader recursed too deeply: name the value nested deepest."""
+        found = deep_nesting(self.text, _MAX_NESTING)
+        why = (f"arrays or inline tables nested too deeply (more than {_MAX_NESTING} levels; "
+               "a model file needs a few)")
+        if found is None:
+            return ModelFileError(f"{self.file}: {why}", self.file, None, (), why)
+        path, line = found
+        return ModelFileError(f"{self.file}:{line}: {describe_path(path)}: {why}", self.file,
+                              line, path, why)
 
     def locate(self, message: str) -> Path:
         """Best key path for an error the core raised about the assembled system: the element
@@ -447,12 +548,12 @@ class _Loader:
             self.name(cname, p, "coordinate")
             self.coords.append(cname)
             if isinstance(spec, str):  # shorthand: the unit
-                self.units[cname] = spec
+                self.units[cname] = self.line_string(spec, p)
                 continue
             spec = self.table(spec, p, {"unit", "description"},
                               what='a table such as { unit = "rad" }')
             if "unit" in spec:
-                self.units[cname] = self.string(spec["unit"], (*p, "unit"))
+                self.units[cname] = self.line_string(spec["unit"], (*p, "unit"))
             if "description" in spec:
                 self.descriptions[cname] = self.string(spec["description"], (*p, "description"))
         if not self.coords:
@@ -468,7 +569,7 @@ class _Loader:
                 spec = self.table(spec, p, {"value", "unit", "description"})
                 value = self.number(self.require(spec, "value", p), (*p, "value"))
                 if "unit" in spec:
-                    self.units[pname] = self.string(spec["unit"], (*p, "unit"))
+                    self.units[pname] = self.line_string(spec["unit"], (*p, "unit"))
                 if "description" in spec:
                     self.descriptions[pname] = self.string(spec["description"],
                                                            (*p, "description"))
@@ -492,11 +593,11 @@ class _Loader:
             self.name(iname, p, "input")
             self.inputs.append(iname)
             if isinstance(spec, str):
-                self.units[iname] = spec
+                self.units[iname] = self.line_string(spec, p)
                 continue
             spec = self.table(spec, p, {"unit", "description"})
             if "unit" in spec:
-                self.units[iname] = self.string(spec["unit"], (*p, "unit"))
+                self.units[iname] = self.line_string(spec["unit"], (*p, "unit"))
             if "description" in spec:
                 self.descriptions[iname] = self.string(spec["description"], (*p, "description"))
 
@@ -577,9 +678,14 @@ class _Loader:
         if "description" in spec:
             self.descriptions[bname] = self.string(spec["description"], (*p, "description"))
         try:
-            return Body(bname, parent, joint, mass=mass, com=com, inertia=inertia)
+            body = Body(bname, parent, joint, mass=mass, com=com, inertia=inertia)
         except ModelError as exc:
-            raise self.fail(p, str(exc)) from None
+            raise self.fail((*p, "inertia") if "inertia" in str(exc) else p, str(exc)) from None
+        problem = mass_data_problem(body, self.params)
+        if problem:
+            key, why = problem
+            raise self.fail((*p, key), why)
+        return body
 
     def inertia(self, value: object, path: Path, mass: se.Basic, params: set[str],
                 ctx: str) -> Any:
@@ -655,6 +761,11 @@ class _Loader:
         if "orientation" in spec:
             orientation = self.orientation(spec["orientation"], (*p, "orientation"), params,
                                            ctx_const)
+            if not isinstance(orientation, list):  # a list of rotations is one by construction
+                why = orientation_problem(orientation, self.params)
+                if why:
+                    raise self.fail((*p, "orientation"), f'the orientation of joint "{jname}" '
+                                    f"{why}")
         kw = {"position": position, "orientation": orientation}
 
         def coord(key: str) -> se.Symbol:
@@ -1023,10 +1134,21 @@ def load_model(path: str | FsPath) -> ModelFile:
     """Read a model file. Raises :class:`ModelFileError` (a :class:`~jourdain.ModelError`)."""
     name = str(path)
     try:
-        raw = FsPath(path).read_bytes()
+        with open(path, "rb") as fh:
+            # at most one byte more than allowed: a huge file (or /dev/zero) is not read whole
+            raw = fh.read(MAX_FILE_BYTES + 1)
+            size = len(raw)
+            if size > MAX_FILE_BYTES:
+                try:
+                    size = max(size, os.fstat(fh.fileno()).st_size)
+                except OSError:
+                    pass
     except OSError as exc:
         raise ModelFileError(f"{name}: cannot read the model file: {exc.strerror}", name,
                              None) from None
+    too_big = _too_big(size)
+    if too_big:
+        raise ModelFileError(f"{name}: {too_big}", name, None, (), too_big)
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as exc:

@@ -500,7 +500,7 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
     s.append("<p class='meta'>Operation counts after common-subexpression elimination: "
              + ", ".join(f"{k} {v}" for k, v in ops.items()) + ".</p>")
     sections.append("".join(s))
-    tex = [f"% {system.name}: jourdain, {_dt.date.today().isoformat()}"]
+    tex = [export.latex_comment(f"{system.name}: jourdain, {_dt.date.today().isoformat()}")]
     latex_names = {"M_bar": r"\bar{M}", "J_bar": r"\bar{J}", "q_c": r"\bar{q}^{c}",
                    "q_e": r"\bar{q}^{e}", "M": "M", "k": "k", "q": "q"}
     for k, m in mats.items():

@@ -4,70 +4,85 @@
 scans the (already syntax-checked) text once and records, for every key path — table headers,
 ``key = value`` lines, keys inside inline tables and elements of arrays — the line it starts on.
 It only follows the structure; values are not interpreted.
+
+The scan moves from token to token with regular expressions (whitespace and comments, strings,
+bare values are each skipped by one match), so its time grows with the number of keys and
+values, not of characters (a few MB of model file in well under a second), and it follows
+nested arrays and inline tables with an explicit stack, so no nesting depth makes it recurse.
 """
 
 from __future__ import annotations
 
+import re
+
 Path = tuple[str | int, ...]
 
-_BARE = set("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_-")
+# whitespace, newlines and comments between tokens
+_SPACE = re.compile(r"(?:[ \t\r\n]++|#[^\n]*+)*+")
+_INLINE_SPACE = re.compile(r"[ \t]*+")
+# string literals (possessive quantifiers: no backtracking on any input)
+_STRINGS = {
+    '"""': re.compile(r'"""(?:[^"\\]++|\\.|"(?!""))*+"""(?:"(?!"""))?(?:"(?!"""))?', re.S),
+    "'''": re.compile(r"'''(?:[^']++|'(?!''))*+'''(?:'(?!'''))?(?:'(?!'''))?"),
+    '"': re.compile(r'"(?:[^"\\\n]++|\\.)*+"?'),
+    "'": re.compile(r"'[^'\n]*+'?"),
+}
+_BARE_KEY = re.compile(r"[A-Za-z0-9_-]++")
+# a scalar that is not a string: numbers, booleans, dates (which may hold a space)
+_BARE_VALUE = re.compile(r"[^,\]}\n#\"'\[{]*+")
+# the common line, read in one match: `key = scalar` or `key = { k = scalar, ... }` (scalars
+# without brackets, braces, commas, '=' or escapes), then a comment or the end of the line
+_SCALAR = r"""(?:"[^"\\\n,={}]*+"|'[^'\n,={}]*+'|[^\s,\[\]{}#"'=]++)"""
+_SIMPLE_LINE = re.compile(
+    rf"""([A-Za-z0-9_-]++)[ \t]*+=[ \t]*+(?:{_SCALAR}|\{{((?:[ \t]*+[A-Za-z0-9_-]++[ \t]*+=[ \t]*+"""
+    rf"""{_SCALAR}[ \t]*+,)*+[ \t]*+(?:[A-Za-z0-9_-]++[ \t]*+=[ \t]*+{_SCALAR}[ \t]*+)?)\}}"""
+    rf"""|\[((?:[ \t]*+{_SCALAR}[ \t]*+,)*+[ \t]*+(?:{_SCALAR}[ \t]*+)?)\])"""
+    r"""[ \t\r]*+(?:\#[^\n]*+)?(?=\n|\Z)""")
+_INLINE_KEY = re.compile(r"([A-Za-z0-9_-]++)[ \t]*+=")
+_ELEMENT = re.compile(_SCALAR)
 
 
 class _Scanner:
-    def __init__(self, text: str) -> None:
+    def __init__(self, text: str, max_depth: int | None = None) -> None:
         self.s = text
+        self.n = len(text)
         self.i = 0
-        self.line = 1
+        self._pos = 0  # the offset up to which newlines are counted into _line
+        self._line = 1
         self.out: dict[Path, int] = {}
         self.aot: dict[Path, int] = {}
+        self.max_depth = max_depth
+        #: (path, line) of the first value nested deeper than max_depth
+        self.too_deep: tuple[Path, int] | None = None
 
     # --- low level ------------------------------------------------------------------------
-    def peek(self, k: int = 0) -> str:
-        j = self.i + k
-        return self.s[j] if j < len(self.s) else ""
+    @property
+    def line(self) -> int:
+        """The line of the current offset (newlines counted since the last call)."""
+        if self.i > self._pos:
+            self._line += self.s.count("\n", self._pos, self.i)
+            self._pos = self.i
+        return self._line
 
-    def advance(self, n: int = 1) -> None:
-        for _ in range(n):
-            if self.i < len(self.s):
-                if self.s[self.i] == "\n":
-                    self.line += 1
-                self.i += 1
+    def peek(self) -> str:
+        return self.s[self.i] if self.i < self.n else ""
 
     def skip_ws(self, newlines: bool) -> None:
-        while self.i < len(self.s):
-            c = self.s[self.i]
-            if c in " \t\r" or (newlines and c == "\n"):
-                self.advance()
-            elif c == "#":
-                while self.i < len(self.s) and self.s[self.i] != "\n":
-                    self.i += 1
-            else:
-                return
+        if newlines:
+            self.i = _SPACE.match(self.s, self.i).end()
+        else:
+            self.i = _INLINE_SPACE.match(self.s, self.i).end()
+            if self.i < self.n and self.s[self.i] == "#":
+                end = self.s.find("\n", self.i)
+                self.i = self.n if end < 0 else end
 
     def string(self) -> str:
         """Skip a string literal starting here; return its (approximate) content."""
-        q = self.peek()
-        if self.s.startswith(q * 3, self.i):
-            self.advance(3)
-            start = self.i
-            while self.i < len(self.s) and not self.s.startswith(q * 3, self.i):
-                if q == '"' and self.peek() == "\\":
-                    self.advance()
-                self.advance()
-            content = self.s[start:self.i]
-            self.advance(3)
-            while self.peek() == q:  # up to two quotes may end a multi-line string
-                self.advance()
-            return content
-        self.advance()
-        start = self.i
-        while self.i < len(self.s) and self.peek() != q and self.peek() != "\n":
-            if q == '"' and self.peek() == "\\":
-                self.advance()
-            self.advance()
-        content = self.s[start:self.i]
-        self.advance()
-        return content
+        q = self.s[self.i]
+        opener = q * 3 if self.s.startswith(q * 3, self.i) else q
+        m = _STRINGS[opener].match(self.s, self.i)
+        self.i = m.end()
+        return m.group()[len(opener):].rstrip(q)
 
     def key(self) -> tuple[str, ...]:
         """A dotted key; stops before '=' or ']'."""
@@ -78,12 +93,11 @@ class _Scanner:
             if c in ('"', "'"):
                 parts.append(self.string())
             else:
-                start = self.i
-                while self.peek() and self.peek() in _BARE:
-                    self.i += 1
-                if self.i == start:
+                m = _BARE_KEY.match(self.s, self.i)
+                if m is None:
                     return tuple(parts)
-                parts.append(self.s[start:self.i])
+                parts.append(m.group())
+                self.i = m.end()
             self.skip_ws(False)
             if self.peek() == ".":
                 self.i += 1
@@ -95,9 +109,21 @@ class _Scanner:
         current: Path = ()
         while True:
             self.skip_ws(True)
-            if self.i >= len(self.s):
+            if self.i >= self.n or self.too_deep:
                 return self.out
             line = self.line
+            m = _SIMPLE_LINE.match(self.s, self.i)
+            if m:
+                path = (*current, m.group(1))
+                self.out.setdefault(path, line)
+                if m.group(2):
+                    for k in _INLINE_KEY.findall(m.group(2)):
+                        self.out.setdefault((*path, k), line)
+                elif m.group(3):
+                    for k in range(len(_ELEMENT.findall(m.group(3)))):
+                        self.out.setdefault((*path, k), line)
+                self.i = m.end()
+                continue
             if self.s.startswith("[[", self.i):
                 self.i += 2
                 path = self.key()
@@ -120,8 +146,8 @@ class _Scanner:
             else:
                 keys = self.key()
                 if not keys:  # not a key: skip the line (the text was checked by tomllib)
-                    while self.peek() and self.peek() != "\n":
-                        self.i += 1
+                    end = self.s.find("\n", self.i)
+                    self.i = self.n if end < 0 else end
                     continue
                 path = (*current, *keys)
                 self.out.setdefault(path, line)
@@ -141,48 +167,60 @@ class _Scanner:
         return tuple(out)
 
     def value(self, path: Path) -> None:
-        self.skip_ws(False)
-        c = self.peek()
-        if c == "{":
-            self.i += 1
-            while True:
-                self.skip_ws(True)
-                if self.peek() in ("}", ""):
-                    self.i += 1
-                    return
-                line = self.line
-                keys = self.key()
-                if not keys:
-                    self.i += 1
-                    continue
-                sub = (*path, *keys)
-                self.out.setdefault(sub, line)
+        """Skip the value at ``path``, recording its keys and elements; nested arrays and
+        inline tables are followed with a stack of [kind, path, next index] frames."""
+        top = path
+        stack: list[list] = []
+        start = True  # a value begins here (else: continue in the innermost container)
+        while True:
+            if start:
                 self.skip_ws(False)
-                if self.peek() == "=":
+                c = self.peek()
+                if c in ("{", "["):
                     self.i += 1
-                self.value(sub)
-                self.skip_ws(True)
-                if self.peek() == ",":
-                    self.i += 1
-        elif c == "[":
-            self.i += 1
-            idx = 0
-            while True:
-                self.skip_ws(True)
-                if self.peek() in ("]", ""):
-                    self.i += 1
-                    return
-                self.out.setdefault((*path, idx), self.line)
-                self.value((*path, idx))
-                self.skip_ws(True)
-                if self.peek() == ",":
-                    self.i += 1
-                idx += 1
-        elif c in ('"', "'"):
-            self.string()
-        else:
-            while self.peek() and self.peek() not in ",]}\n#":
+                    if self.max_depth is not None and len(stack) >= self.max_depth:
+                        self.too_deep = (top, self.line)
+                        self.i = self.n
+                        return
+                    stack.append([c, path, 0])
+                elif c in ('"', "'"):
+                    self.string()
+                else:
+                    self.i = _BARE_VALUE.match(self.s, self.i).end()
+                start = False
+            if not stack:
+                return
+            frame = stack[-1]
+            kind, fpath, idx = frame
+            self.skip_ws(True)
+            c = self.peek()
+            if c in ("}", "]", ""):
                 self.i += 1
+                stack.pop()
+                if self.i > self.n:
+                    return
+                continue
+            if c == ",":
+                self.i += 1
+                if kind == "[":
+                    frame[2] = idx + 1
+                continue
+            if kind == "[":
+                path = (*fpath, idx)
+                self.out.setdefault(path, self.line)
+                start = True
+                continue
+            line = self.line
+            keys = self.key()
+            if not keys:
+                self.i += 1
+                continue
+            path = (*fpath, *keys)
+            self.out.setdefault(path, line)
+            self.skip_ws(False)
+            if self.peek() == "=":
+                self.i += 1
+            start = True
 
 
 def key_lines(text: str) -> dict[Path, int]:
@@ -193,8 +231,19 @@ def key_lines(text: str) -> dict[Path, int]:
     """
     try:
         return _Scanner(text).document()
-    except (IndexError, ValueError):  # defensive: positions are a convenience, never fatal
+    except (IndexError, ValueError, AttributeError):  # positions are a convenience, never fatal
         return {}
+
+
+def deep_nesting(text: str, depth: int) -> tuple[Path, int] | None:
+    """The first value of ``text`` whose arrays or inline tables are nested more than ``depth``
+    levels deep: its key path and the line where it goes deeper (None when there is none)."""
+    scanner = _Scanner(text, max_depth=depth)
+    try:
+        scanner.document()
+    except (IndexError, ValueError, AttributeError):
+        pass
+    return scanner.too_deep
 
 
 def line_of(lines: dict[Path, int], path: Path) -> int | None:

@@ -6,13 +6,16 @@ A body's frame is the frame its joint ends in; the centre of mass ``com`` and th
 
 from __future__ import annotations
 
+import math
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
+import numpy as np
 import symengine as se
 
 from ..errors import ModelError
-from .expressions import Expr, as_expr, as_matrix3, as_vector
-from .joints import Joint, Mat3, Vec3
+from .expressions import Expr, as_expr, as_matrix3, as_vector, values_at
+from .joints import Joint, Mat3, Vec3, check_joint_values
 
 WORLD = "world"
 
@@ -84,11 +87,75 @@ class Body:
         object.__setattr__(self, "mass", m)
         object.__setattr__(self, "com", c)
         object.__setattr__(self, "inertia", I)
+        if not any(x.free_symbols for x in (m, *c, *(x for row in I for x in row))):
+            # numbers only: checked now (with parameters: by the System, at their values)
+            check_mass_data(self, {})
 
     @property
     def has_inertia(self) -> bool:
         """False for point masses and massless frames (inertia tensor identically zero)."""
         return any(x != 0 for row in self.inertia for x in row)
+
+
+#: Tolerance of the physical checks of an inertia tensor: eigenvalues ≥ −1e-12·max(1, |I|)
+#: and each principal moment at most the sum of the other two plus 1e-9 times the largest.
+TRIANGLE_TOL = 1e-9
+
+
+def mass_data_problem(body: Body, values: Mapping[str, float]) -> tuple[str, str] | None:
+    """What is wrong with the mass data of ``body`` at the parameter ``values`` — as (key,
+    message), the key ``mass``, ``com`` or ``inertia`` — or None when nothing is.
+
+    The mass must be a finite number ≥ 0, the centre of mass a finite vector, and the inertia
+    tensor one a rigid body can have: finite, symmetric, positive semi-definite, and its
+    principal moments must satisfy the triangle inequality (each at most the sum of the other
+    two: I₁ + I₂ − I₃ = 2∫x₃² dm ≥ 0). A massless body has no rotational inertia.
+    """
+    nums = values_at([body.mass, *body.com, *(x for row in body.inertia for x in row)], values)
+    m, com, I = nums[0], nums[1:4], np.array(nums[4:]).reshape(3, 3)
+    if not math.isfinite(m):
+        return "mass", "the mass is not a finite real number at the parameter values"
+    if m < 0:
+        return "mass", f"mass must be a non-negative number, got {m:g}"
+    if not all(math.isfinite(x) for x in com):
+        return "com", ("the centre of mass is not a finite real vector at the parameter values "
+                       f"({', '.join(f'{x:g}' for x in com)})")
+    if not np.all(np.isfinite(I)):
+        return "inertia", "inertia tensor has entries that are not finite real numbers"
+    scale = max(1.0, float(np.abs(I).max()))
+    if np.abs(I - I.T).max() > 1e-12 * scale:
+        return "inertia", "inertia tensor is not symmetric"
+    ev = np.linalg.eigvalsh(0.5 * (I + I.T))
+    if ev.min() < -1e-12 * scale:
+        return "inertia", ("inertia tensor is not positive semi-definite (eigenvalues "
+                           f"{np.array2string(ev, precision=4)})")
+    if ev[2] > ev[0] + ev[1] + TRIANGLE_TOL * ev[2]:
+        return "inertia", ("inertia tensor is not that of a rigid body: its largest principal "
+                           f"moment {ev[2]:.6g} exceeds the sum of the other two "
+                           f"({ev[0]:.6g} + {ev[1]:.6g}); each principal moment must be at most "
+                           "the sum of the other two (the triangle inequality)")
+    if m == 0 and np.abs(I).max() > 0:
+        return "inertia", "a massless body cannot have rotational inertia"
+    return None
+
+
+def check_mass_data(body: Body, values: Mapping[str, float]) -> None:
+    """Raise a :class:`ModelError` naming the body when :func:`mass_data_problem` finds one."""
+    problem = mass_data_problem(body, values)
+    if problem:
+        raise ModelError(f'body "{body.name}": {problem[1]}')
+
+
+def check_values(bodies: Iterable[Body], values: Mapping[str, float]) -> None:
+    """The checks of the model's numbers at other parameter ``values`` (e.g. overrides given on
+    the command line): every body's mass data (:func:`check_mass_data`) and joint frame and axes
+    (:func:`jourdain.model.joints.check_joint_values`), as at the default values."""
+    for b in bodies:
+        check_mass_data(b, values)
+        try:
+            check_joint_values(b.joint, values)
+        except ModelError as exc:
+            raise ModelError(f'{exc} (body "{b.name}")') from None
 
 
 def _diag(a: object, b: object, c: object) -> Mat3:

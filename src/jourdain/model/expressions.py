@@ -7,8 +7,9 @@ parsed or evaluated as code.
 
 from __future__ import annotations
 
+import math
 import numbers
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 
 import symengine as se
 
@@ -39,7 +40,7 @@ def as_expr(value: object, where: str) -> Expr:
     ``where`` names the model element for the error message.
     """
     if isinstance(value, se.Basic):
-        return value
+        return finite_constants(value, where)
     if isinstance(value, bool):
         raise ModelError(f"{where}: expected a number or an expression, got a bool {value!r}")
     if isinstance(value, numbers.Integral):
@@ -53,13 +54,53 @@ def as_expr(value: object, where: str) -> Expr:
     # SymPy expressions (duck-typed: do not import sympy on the hot path)
     if hasattr(value, "free_symbols") and hasattr(value, "subs") and not isinstance(value, str):
         try:
-            return se.sympify(value)
+            converted = se.sympify(value)
         except Exception as exc:  # noqa: BLE001 - conversion failure reported with context
             raise ModelError(f"{where}: cannot convert {value!r} to SymEngine: {exc}") from exc
+        return finite_constants(converted, where)
     raise ModelError(
         f"{where}: expected a number or a SymPy/SymEngine expression, got {type(value).__name__} "
         f"{value!r}"
     )
+
+
+_NOT_FINITE = {"Infinity": "an infinite constant", "NegativeInfinity": "an infinite constant",
+               "ComplexInfinity": "an infinite constant (zoo)", "NaN": "an undefined constant (NaN)"}
+
+
+def finite_constants(e: Expr, where: str) -> Expr:
+    """``e``, after checking that no number in it is infinite or NaN (``-l*inf``, ``1.0e308 *
+    1.0e308``): such constants would make every result built from ``e`` undefined, and compiled
+    code cannot hold them."""
+    stack = [e]
+    while stack:
+        node = stack.pop()
+        why = _NOT_FINITE.get(type(node).__name__)
+        if why is None and node.is_Number and not node.is_Rational:
+            try:
+                z = complex(node)
+            except (RuntimeError, TypeError, ValueError, OverflowError):
+                z = complex(0.0)
+            if not (math.isfinite(z.real) and math.isfinite(z.imag)):
+                why = f"the non-finite number {node}"
+        if why:
+            raise ModelError(f"{where}: {e} contains {why}")
+        stack.extend(node.args)
+    return e
+
+
+def values_at(exprs: Iterable[Expr], values: Mapping[str, float]) -> list[float]:
+    """Each expression as a float at the parameter ``values`` (by name); NaN where it has no
+    finite real value there (``sqrt(-l)``), or uses a name that ``values`` lacks."""
+    out = []
+    for e in exprs:
+        syms = e.free_symbols
+        try:
+            v = float(e.subs({s: values[str(s)] for s in syms}) if syms else e)
+        except (KeyError, RuntimeError, TypeError, ValueError, OverflowError):
+            v = math.nan
+        out.append(v if math.isfinite(v) else math.nan)
+    return out
 
 
 def as_vector(value: object, where: str, n: int = 3) -> tuple[Expr, ...]:

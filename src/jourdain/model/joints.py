@@ -17,13 +17,14 @@ is refused, the same rule as in model files. Axes may depend on parameters only.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
+import numpy as np
 import symengine as se
 
 from ..errors import ModelError
-from .expressions import Expr, as_expr, as_matrix3, as_vector, axis_vector
+from .expressions import Expr, as_expr, as_matrix3, as_vector, axis_vector, values_at
 
 Vec3 = tuple[Expr, Expr, Expr]
 Mat3 = tuple[Vec3, Vec3, Vec3]
@@ -140,6 +141,10 @@ def _frame(name: str, position: object, orientation: object) -> tuple[Vec3, Mat3
             ori = _matmul(ori, rotation_matrix(r.axis, r.angle))
     else:
         ori = as_matrix3(orientation, f'joint "{name}" orientation')
+        if not any(x.free_symbols for row in ori for x in row):
+            why = orientation_problem(ori, {})
+            if why:
+                raise ModelError(f'joint "{name}": the orientation {why}')
     for v in (*pos, *(x for row in ori for x in row)):
         if "t" in {str(s) for s in v.free_symbols}:
             raise ModelError(
@@ -147,6 +152,58 @@ def _frame(name: str, position: object, orientation: object) -> tuple[Vec3, Mat3
                 "use a General joint with Rot/Trans steps for prescribed motion"
             )
     return pos, ori
+
+
+#: Tolerance of the check that a joint's orientation A is a rotation: |AᵀA − E| entrywise. A
+#: matrix of decimals rounded to 4 digits (0.7071) is refused: write sqrt(2)/2, or rotations.
+ROTATION_TOL = 1e-9
+
+
+def orientation_problem(orientation: Mat3, values: Mapping[str, float]) -> str | None:
+    """Why the 3×3 ``orientation`` is not a rotation matrix at the parameter ``values`` (None
+    when it is one): it must be finite, orthonormal (AᵀA = E to :data:`ROTATION_TOL`) and have
+    determinant +1 (not a reflection). The text completes "the orientation ..."."""
+    A = np.array(values_at([x for row in orientation for x in row], values)).reshape(3, 3)
+    if not np.all(np.isfinite(A)):
+        return "has entries that are not finite real numbers at the parameter values"
+    err = float(np.abs(A.T @ A - np.eye(3)).max())
+    if err > ROTATION_TOL:
+        rows = "; ".join(", ".join(f"{v:.6g}" for v in r) for r in A)
+        return (f"[{rows}] is not a rotation matrix: its columns are not orthonormal (AᵀA "
+                f"differs from the identity by {err:.3g}); give a rotation (orthonormal, "
+                "determinant +1), e.g. as a list of rotations about axes")
+    det = float(np.linalg.det(A))
+    if det < 0:
+        return (f"is a reflection (determinant {det:.3g}), not a rotation: a rotation has "
+                "determinant +1")
+    return None
+
+
+def joint_problem(joint: Joint, values: Mapping[str, float]) -> tuple[str, str] | None:
+    """What is wrong with ``joint`` at the parameter ``values``, as (key, message) with the key
+    ``position``, ``orientation`` or ``axis``; None when nothing is. The position must be
+    finite, the orientation a rotation and the axes of the steps finite (an axis u/|u| with
+    parameters is undefined where u = 0)."""
+    pos = values_at(joint.position, values)
+    if not all(np.isfinite(pos)):
+        return "position", ("the position is not a finite real vector at the parameter values "
+                            f"({', '.join(f'{v:g}' for v in pos)})")
+    why = orientation_problem(joint.orientation, values)
+    if why:
+        return "orientation", f"the orientation {why}"
+    for k, step in enumerate(joint.steps):
+        if step.axis is not None and any(c.free_symbols for c in step.axis):
+            if not all(np.isfinite(values_at(step.axis, values))):
+                which = "the axis" if len(joint.steps) == 1 else f"the axis of step {k}"
+                return "axis", f"{which} is the zero vector at the parameter values"
+    return None
+
+
+def check_joint_values(joint: Joint, values: Mapping[str, float]) -> None:
+    """Raise a :class:`ModelError` naming the joint when :func:`joint_problem` finds one."""
+    problem = joint_problem(joint, values)
+    if problem:
+        raise ModelError(f'joint "{joint.name}": {problem[1]}')
 
 
 def _coord(name: str, c: object, what: str = "coordinate") -> se.Symbol:

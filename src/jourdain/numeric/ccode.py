@@ -12,7 +12,9 @@ function ``NAME_batch`` loops over many states in C (see :func:`function_source`
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
+from fractions import Fraction
 
 import symengine as se
 
@@ -40,16 +42,36 @@ _FUNCS = {
 }
 
 
+class _NotFinite(EvaluationError):
+    """A number that is no finite double (inf, NaN, an integer beyond 1.8e308)."""
+
+    def __init__(self, number: se.Basic) -> None:
+        text = str(number)
+        self.text = text if len(text) <= 60 else f"{text[:30]}…{text[-30:]} ({len(text)} characters)"
+        super().__init__(f"the number {self.text} is not a finite double")
+        self.number = number
+
+
 def _number(e: se.Basic) -> str:
+    try:
+        if e.is_Rational:  # exactly rounded, also where numerator or denominator overflow
+            n, d = e.get_num_den()
+            v = float(Fraction(int(n), int(d)))
+        else:
+            v = float(e)
+    except OverflowError:
+        v = math.inf
+    except (RuntimeError, TypeError, ValueError):
+        raise EvaluationError(f"cannot generate C code for the number {e}") from None
+    if not math.isfinite(v):
+        # C would read "inf" as an undeclared name, a 400-digit literal as inf
+        raise _NotFinite(e)
     if e.is_Integer:
         return f"{int(e)}.0"
     if type(e).__name__ == "Rational":
         n, d = e.get_num_den()
-        return f"({int(n)}.0/{int(d)}.0)"
-    try:
-        v = float(e)
-    except (RuntimeError, TypeError, ValueError):
-        raise EvaluationError(f"cannot generate C code for the number {e}") from None
+        if max(abs(int(n)), int(d)) < 2**1000:  # both finite doubles: exact quotient
+            return f"({int(n)}.0/{int(d)}.0)"
     return repr(v)
 
 
@@ -131,6 +153,22 @@ PART = 200
 
 
 def function_source(name: str, exprs: Sequence[se.Basic], names: Mapping[str, str]) -> str:
+    """C source of ``NAME(y, yd, t, p, u, out)`` and ``NAME_batch`` computing ``exprs``
+    (:func:`_function_source`); an expression holding an infinite or undefined number (no C
+    literal can hold it) raises an :class:`EvaluationError` that names it."""
+    exprs = list(exprs)
+    try:
+        return _function_source(name, exprs, names)
+    except _NotFinite as exc:
+        k = next((k for k, e in enumerate(exprs) if e == exc.number or e.has(exc.number)), None)
+        text = "" if k is None else str(exprs[k])
+        which = "" if k is None else (f" in expression {k} of {len(exprs)}, "
+                                      f"{text if len(text) <= 200 else text[:200] + ' …'}")
+        raise EvaluationError(f"cannot generate C code{which}: the number {exc.text} is not a "
+                              "finite double (an infinite or undefined constant)") from None
+
+
+def _function_source(name: str, exprs: Sequence[se.Basic], names: Mapping[str, str]) -> str:
     """C source of ``NAME(y, yd, t, p, u, out)`` and ``NAME_batch`` computing ``exprs``.
 
     ``NAME_batch(n, y, yd, t, p, p_stride, u, u_stride, out)`` evaluates ``n`` states stored

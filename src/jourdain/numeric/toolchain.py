@@ -5,17 +5,27 @@ The cache is a plain directory (``$JOURDAIN_CACHE``, else ``$XDG_CACHE_HOME/jour
 library), where ``<key>`` is a SHA-256 hash of the content that determines the code. Deleting
 the directory, or any file in it, is always safe: the library is rebuilt on the next use. Only
 shared libraries compiled from jourdain's own generated source are loaded; nothing is pickled.
+
+Loading a library runs its code, so a library is loaded only from a directory that belongs to
+the user and that no one else may write to, and only if the file itself belongs to the user and
+is not writable by others (as Python's own caches are trusted only when private): a library
+another user could have put or changed there is never loaded. A library file that fails the
+check is rebuilt; a cache directory that fails it is not used at all: jourdain says so once
+and compiles into a private temporary directory instead (removed at exit).
 """
 
 from __future__ import annotations
 
+import atexit
 import ctypes
 import hashlib
 import os
 import shutil
+import stat
 import subprocess
 import sys
 import tempfile
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -25,6 +35,8 @@ from ..errors import JourdainError
 CFLAGS = ("-O2", "-fPIC", "-shared", "-fno-math-errno", "-std=c99")
 
 _loaded: dict[str, ctypes.CDLL] = {}
+#: the private directory used instead of a cache directory that is not safe (one per process)
+_fallback: Path | None = None
 
 
 class CompilerError(JourdainError, RuntimeError):
@@ -32,13 +44,56 @@ class CompilerError(JourdainError, RuntimeError):
 
 
 def cache_dir() -> Path:
-    """The directory of compiled libraries (created on demand; safe to delete)."""
+    """The directory of compiled libraries (created on demand; safe to delete): the private
+    temporary one when the configured directory was found not to be private."""
+    if _fallback is not None:
+        return _fallback
     env = os.environ.get("JOURDAIN_CACHE")
     if env:
         return Path(env).expanduser()
     xdg = os.environ.get("XDG_CACHE_HOME")
     base = Path(xdg).expanduser() if xdg else Path.home() / ".cache"
     return base / "jourdain"
+
+
+def not_private(path: Path) -> str | None:
+    """Why ``path`` cannot be trusted to hold code to load, or None: it must belong to the user
+    running jourdain and be writable by no one else (no group or other write permission)."""
+    try:
+        st = os.stat(path)
+    except OSError as exc:
+        return f"{path} cannot be examined ({exc.strerror})"
+    uid = os.getuid() if hasattr(os, "getuid") else None
+    if uid is not None and st.st_uid != uid:
+        return f"{path} belongs to user id {st.st_uid}, not to you (user id {uid})"
+    if st.st_mode & (stat.S_IWGRP | stat.S_IWOTH):
+        who = " and ".join(w for w, bit in (("its group", stat.S_IWGRP),
+                                            ("all users", stat.S_IWOTH)) if st.st_mode & bit)
+        return f"{path} is writable by {who} (mode {stat.filemode(st.st_mode)})"
+    return None
+
+
+def library_dir() -> Path:
+    """Where libraries are built and loaded from: :func:`cache_dir` when it is private (created
+    with mode 0700 if missing), else a private temporary directory, with a warning saying why."""
+    global _fallback
+    if _fallback is not None:
+        return _fallback
+    d = cache_dir()
+    try:
+        d.mkdir(parents=True, exist_ok=True, mode=0o700)
+        why = not_private(d)
+    except OSError as exc:
+        why = f"{d} cannot be created ({exc.strerror})"
+    if why is None:
+        return d
+    _fallback = Path(tempfile.mkdtemp(prefix="jourdain-"))  # mode 0700, this user's
+    atexit.register(shutil.rmtree, _fallback, True)
+    warnings.warn(f"jourdain does not load compiled code from its cache directory: {why}. "
+                  f"Compiling into the private directory {_fallback} for this run instead; make "
+                  f"the cache yours and not writable by others (chmod go-w), or set "
+                  "JOURDAIN_CACHE to a private directory.", RuntimeWarning, stacklevel=2)
+    return _fallback
 
 
 def compiler() -> str:
@@ -66,8 +121,10 @@ def cached_library(key: str) -> ctypes.CDLL | None:
     """The library cached under ``key``, or None if it was never built (or was deleted)."""
     if key in _loaded:
         return _loaded[key]
-    so = cache_dir() / f"{key}.so"
+    so = library_dir() / f"{key}.so"
     if not so.exists():
+        return None
+    if not_private(so):  # someone else's or writable by others: rebuilt, never loaded
         return None
     try:
         lib = ctypes.CDLL(str(so))
@@ -87,8 +144,7 @@ def build(key: str, source: str | Sequence[str]) -> ctypes.CDLL:
     if lib is not None:
         return lib
     units = [source] if isinstance(source, str) else list(source)
-    d = cache_dir()
-    d.mkdir(parents=True, exist_ok=True)
+    d = library_dir()
     so = d / f"{key}.so"
     src = d / f"{key}.c"
     # write and compile under private names, then rename: a concurrent build of the same key
@@ -124,6 +180,7 @@ def build(key: str, source: str | Sequence[str]) -> ctypes.CDLL:
             fh.write("\n".join(units))
         if failed:
             raise CompilerError(f"compiling {src} failed:\n{failed[0][-4000:]}")
+        os.chmod(tmp, 0o700)  # this user's alone, whatever the umask
         os.replace(tmp, so)
     finally:
         for leftover in (tmp, *tmp_units, *objects):
