@@ -357,8 +357,9 @@ MISTAKES = [
      "inertia = [[1, 0.5, 0], [0, 1, 0], [0, 0, 1]]", "not symmetric", "inertia = [[1, 0.5"),
     ("inertia not positive", "inertia = [0.1, 0.01, 0.1]", "inertia = [0.1, -0.01, 0.1]",
      "not positive semi-definite", "inertia = [0.1, -0.01, 0.1]"),
+    # the parameter's value is what is wrong: its line, not the body's (issue 17, item 6)
     ("negative mass", "m2 = 0.5", "m2 = -0.5", "mass must be a non-negative number",
-     'mass = "m2"'),
+     "m2 = -0.5"),
     ("parameter given as string", "m2 = 0.5", 'm2 = "0.5"',
      "a parameter value must be a number", 'm2 = "0.5"'),
     ("parameter table without value", 'm1 = { value = 1.0, unit = "kg" }', 'm1 = { unit = "kg" }',

@@ -21,7 +21,7 @@ from typing import Any
 
 import symengine as se
 
-from ..errors import ModelError
+from ..errors import JourdainError, ModelError
 from ..model import (
     WORLD,
     Body,
@@ -51,6 +51,17 @@ from ..model import (
 from ..model.bodies import mass_data_problem
 from ..model.expressions import unit_axis
 from ..model.joints import orientation_problem
+from ..simulate import (
+    DEFAULT_ATOL,
+    DEFAULT_METHOD,
+    DEFAULT_RTOL,
+    DEFAULT_SAMPLES,
+    DEFAULT_T_END,
+    check_atol,
+    check_rtol,
+    check_samples,
+    check_t_end,
+)
 from .expressions import RESERVED_NAMES, ExpressionError, _number, parse_expression
 from .toml_positions import Path, deep_nesting, key_lines, line_of
 
@@ -109,11 +120,11 @@ class SimulationSettings:
     input name to an expression in ``t`` and the parameters (0 when not given).
     """
 
-    t_end: float = 5.0
-    samples: int = 501
-    method: str = "DOP853"
-    rtol: float = 1e-8
-    atol: float = 1e-10
+    t_end: float = DEFAULT_T_END
+    samples: int = DEFAULT_SAMPLES
+    method: str = DEFAULT_METHOD
+    rtol: float = DEFAULT_RTOL
+    atol: float = DEFAULT_ATOL
     y0: tuple[float, ...] = ()
     yd0: tuple[float, ...] = ()
     inputs: tuple[tuple[str, se.Basic], ...] = ()
@@ -286,6 +297,8 @@ class _Loader:
 
     def suggest(self, word: str, options: list[str]) -> str:
         close = difflib.get_close_matches(word, options, n=1)
+        if not close:  # a name in the other case ("G" for "g") is close, however short
+            close = [o for o in options if o.lower() == word.lower()][:1]
         return f' (did you mean "{close[0]}"?)' if close else ""
 
     # --- typed access ---------------------------------------------------------------------
@@ -663,9 +676,10 @@ class _Loader:
         spec = self.table(spec, p, {"parent", "joint", "mass", "com", "inertia", "description"})
         parent = self.string(self.require(spec, "parent", p), (*p, "parent"))
         if parent != WORLD and parent not in self.body_names:
+            others = [b for b in self.body_names if b != bname]  # a body is not its own parent
             raise self.fail((*p, "parent"), f'unknown parent "{parent}"'
-                            f'{self.suggest(parent, self.body_names)}; expected "world" or one '
-                            f"of the bodies {', '.join(self.body_names)}")
+                            f'{self.suggest(parent, others)}; expected "world"'
+                            + (f" or one of the bodies {', '.join(others)}" if others else ""))
         if parent == bname:
             raise self.fail((*p, "parent"), "a body cannot be its own parent")
         params = set(self.params)
@@ -684,6 +698,11 @@ class _Loader:
         problem = mass_data_problem(body, self.params)
         if problem:
             key, why = problem
+            value = {"mass": mass, "com": None, "inertia": None}[key]
+            if value is not None and value.is_Symbol and str(value) in self.params:
+                # the mass is a parameter: its value is what is wrong, so say it at its line
+                raise self.fail(("parameters", str(value)),
+                                f'{why} (the mass of body "{bname}" is this parameter)')
             raise self.fail((*p, key), why)
         return body
 
@@ -1061,13 +1080,17 @@ class _Loader:
         spec = self.table(data.get("simulation", {}), p,
                           {"t_end", "samples", "method", "rtol", "atol", "y0", "yd0", "inputs"})
         kw: dict[str, Any] = {}
-        if "t_end" in spec:
-            kw["t_end"] = self.number(spec["t_end"], (*p, "t_end"), positive=True)
-        if "samples" in spec:
-            n = self.number(spec["samples"], (*p, "samples"), positive=True, integer=True)
-            if n < 2:
-                raise self.fail((*p, "samples"), "expected at least 2 samples")
-            kw["samples"] = int(n)
+        checks = {"t_end": check_t_end, "rtol": check_rtol,
+                  "atol": lambda v, name: check_atol(v, 1, name)[0],
+                  "samples": lambda v, name: check_samples(v, system.f, len(system.inputs),
+                                                           name)}
+        for k, check in checks.items():
+            if k in spec:
+                v = self.number(spec[k], (*p, k), positive=True, integer=k == "samples")
+                try:  # the bounds of jourdain.simulate, one place for the API and the files
+                    kw[k] = check(v, k)
+                except JourdainError as exc:
+                    raise self.fail((*p, k), str(exc)) from None
         if "method" in spec:
             methods = ("DOP853", "RK45", "Radau", "BDF", "LSODA")
             m = self.string(spec["method"], (*p, "method"))
@@ -1076,9 +1099,6 @@ class _Loader:
                                 f"{self.suggest(m, list(methods))}; expected one of "
                                 f"{', '.join(methods)}")
             kw["method"] = m
-        for k in ("rtol", "atol"):
-            if k in spec:
-                kw[k] = self.number(spec[k], (*p, k), positive=True)
         nums: set[str] = set()  # initial values are constant expressions (pi/4)
         for key in ("y0", "yd0"):
             tb = self.table(spec.get(key, {}), (*p, key), what="a table of coordinate = value")
