@@ -322,20 +322,22 @@ class Linearization:
         B = nums[4 * f + m:].reshape(f, m)
         scale = np.zeros(f)
         if np.any(h != 0):
-            eom = self.equations_of_motion
-            ne = eom.newton_euler
+            ne = self.equations_of_motion.newton_euler
             state = dict(values)
             for syms, vals in ((system.y, ys), (system.yd, yds), (system.inputs, us)):
                 state.update({str(s): float(v) for s, v in zip(syms, vals, strict=True)})
-            mats = (ne.J_bar, ne.q_c, ne.q_e, ne.M_bar, eom.k, eom.q)
+            # k = J̄ᵀq̄^c and q = J̄ᵀq̄^e add nothing to the bound (Cauchy–Schwarz); M̄ (36p²
+            # entries) only where the nominal motion accelerates
+            mats = (ne.J_bar, ne.q_c, ne.q_e, *((ne.M_bar,) if np.any(ydds != 0) else ()))
             flat = np.array(evaluate_float([e for mat in mats for e in mat.entries()], state))
             parts, i = [], 0
             for mat in mats:
                 r, c = mat.shape
                 parts.append(flat[i:i + r * c].reshape(r, c))
                 i += r * c
-            Jb, qc, qe, Mb, k, q = parts
-            scale = force_scale(Jb, qc[:, 0], qe[:, 0], k[:, 0], q[:, 0], Mb, ydds)
+            zero = np.zeros(f)
+            scale = force_scale(parts[0], parts[1][:, 0], parts[2][:, 0], zero, zero,
+                                parts[3] if len(parts) > 3 else None, ydds)
         return _nominal_check(h, scale, _kind(self.y_s.entries(), self.yd_s.entries(),
                                               self.ydd_s.entries()),
                               tv, _describe_nominal(self), system, us, B)
