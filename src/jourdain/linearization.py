@@ -81,10 +81,10 @@ class NominalCheck:
     h : (f,) array
         The residual (METHOD.md §5).
     scale : (f,) array
-        :func:`force_scale` at the nominal state, ``‖J̄_i‖·(‖q̄^c‖ + ‖q̄^e‖ + ‖M̄·J̄·ÿ_s‖) +
-        |k_i| + |q_i|`` with ``J̄_i`` the column of coordinate i: it stays large where the forces
-        balance (a pendulum standing upright, where ``q`` itself is round-off). Zeros where h is
-        exactly zero (not evaluated).
+        :func:`force_scale` at the nominal state, ``‖J̄_i‖·(‖q̄^c‖ + ‖q̄^e‖ + ‖M̄·J̄·ÿ_s‖)`` with
+        ``J̄_i`` the column of coordinate i (which bounds ``|k_i|`` and ``|q_i|``): it stays large
+        where the forces balance (a pendulum standing upright, where ``q`` itself is round-off).
+        Zeros where h is exactly zero (not evaluated).
     relative : float
         ``max |h_i| / scale_i`` (inf where ``scale_i = 0 < |h_i|``).
     kind : str
