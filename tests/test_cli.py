@@ -228,8 +228,11 @@ def test_simulate_simple_pendulum_small_swing(tmp_path, capsys):
     (["eval", "EX", "--at", "phi1=__import__(x)"], 2, "double-underscore"),
     (["eval", "EX", "--set", "mass=2"], 2, '"mass" is not a parameter'),
     (["run", "EX"], 2, "--out"),
-    (["check", "missing.toml"], 1, "cannot read the model file"),
-    (["linearize", "EX", "--about", "nowhere"], 1, 'no nominal motion "nowhere"'),
+    # usage errors, not model errors (issue 17, item 5): a file or a name that is not there
+    (["check", "missing.toml"], 2, "missing.toml: no such model file"),
+    (["linearize", "EX", "--about", "nowhere"], 2, 'no nominal motion "nowhere"'),
+    (["linearize", "EX", "--about", "uprigt"], 2, '(did you mean "upright"?)'),
+    (["simulate", "EX", "--out", "sim.json"], 2, "unknown file type '.json'; use .csv, .h5"),
     ([], 2, "usage"),
 ])
 def test_exit_status_and_messages(args, code, message, capsys):

@@ -1,15 +1,23 @@
 """The ``jourdain`` command: model files in, equations, numbers and reports out.
 
 A thin layer over the public API. Exit status: 0 on success, 1 on a model error (the message,
-no traceback), 2 on a usage error. Every subcommand has ``--help`` with an example.
+no traceback; a failed simulation writes the motion up to the failure first), 2 on a usage error
+(a malformed option, a name the model does not have, an output that cannot be written), 130
+when interrupted (Ctrl-C: what was computed is written and says so). Every subcommand has
+``--help`` with an example. Control characters in any text printed (names and messages from a
+model file) are shown escaped, never sent to the terminal.
 """
 
 from __future__ import annotations
 
 import argparse
+import difflib
 import json
 import os
+import re
 import sys
+import tempfile
+import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
@@ -18,7 +26,9 @@ import numpy as np
 
 from .errors import JourdainError
 
-EXIT_OK, EXIT_MODEL, EXIT_USAGE = 0, 1, 2
+EXIT_OK, EXIT_MODEL, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
+#: seconds between two progress lines of a long simulation
+PROGRESS_SECONDS = 2.0
 
 #: The format tag of ``jourdain eval --json`` (bump the number on incompatible changes).
 EVAL_FORMAT = "jourdain-eval/1"
@@ -139,7 +149,21 @@ def _state(model: Any, at: str | None) -> tuple[np.ndarray, np.ndarray, float, d
 def _load(path: str) -> Any:
     from .io import load_model
 
+    try:  # a model file that is not there is a usage error; what it says, a model error
+        with open(path, "rb"):
+            pass
+    except FileNotFoundError:
+        raise UsageError(f"{path}: no such model file") from None
+    except IsADirectoryError:
+        raise UsageError(f"{path}: is a folder; expected a model file (.toml)") from None
+    except OSError as exc:
+        raise UsageError(f"{path}: cannot read the model file: {exc.strerror}") from None
     return load_model(path)
+
+
+def _suggest(name: str, names: Sequence[str]) -> str:
+    close = difflib.get_close_matches(name, list(names), n=1)
+    return f' (did you mean "{close[0]}"?)' if close else ""
 
 
 # ------------------------------------------------------------------------------------------
@@ -196,7 +220,9 @@ def _step_exprs(step: Any) -> set[Any]:
 def _check_initial_state(model: Any) -> None:
     """The equations of motion at the model's initial state (its [simulation] y0, yd0 and
     inputs at t = 0, else zeros) must be finite numbers: a NaN there (a spring of zero length,
-    a square root of a negative number) is a model error naming its source."""
+    a square root of a negative number) is a model error naming its source. M must be positive
+    definite there: a coordinate that moves no mass or inertia (every body it moves is massless)
+    or a singular configuration leaves ÿ undetermined, and nothing can be simulated."""
     from .differentiate import evaluate_float
 
     system, sim = model.system, model.simulation
@@ -207,9 +233,58 @@ def _check_initial_state(model: Any) -> None:
     try:
         u = [evaluate_float([given[n]], values)[0] if n in given else 0.0
              for n in system.input_names]
-        system.evaluate(y0, yd0, 0.0, inputs=u or None)
+        out = system.evaluate(y0, yd0, 0.0, inputs=u or None)
     except JourdainError as exc:
         raise model.error(f"at the initial state: {exc}") from None
+    problem = _mass_matrix_problem(system, np.asarray(out["M"], float), values)
+    if problem:
+        state = ", ".join(f"{c}={v:g}" for c, v in zip(system.coordinate_names, y0, strict=True))
+        raise model.error(f"at the initial state ({state}): {problem}")
+
+
+#: M counts as singular where its smallest eigenvalue is below this fraction of its largest
+#: (the relative pivot limit of the integrator's Cholesky factorization)
+SINGULAR_RTOL = 1e-13
+
+
+def _mass_matrix_problem(system: Any, M: np.ndarray, values: dict[str, float]) -> str | None:
+    """Why M is not positive definite (None when it is): the coordinates that move no mass or
+    inertia and the massless bodies they move, else the eigenvalues of a singular
+    configuration."""
+    from .differentiate import evaluate_float
+
+    M = 0.5 * (M + M.T)
+    w = np.linalg.eigvalsh(M) if M.size else np.ones(1)
+    top = max(float(w.max()), 0.0)
+    if w.min() > SINGULAR_RTOL * top:
+        return None
+    coords = system.coordinate_names
+    idle = [c for i, c in enumerate(coords) if not M[i, i] > SINGULAR_RTOL * top]
+    if idle:
+        moved: dict[str, set[str]] = {}  # body -> the coordinates that move it
+        for b in system.bodies:
+            own = {str(c) for c in b.joint.coordinates}
+            moved[b.name] = own | moved.get(b.parent, set())
+        bodies = [b for b in system.bodies if moved[b.name] & set(idle)]
+        massless = []
+        for b in bodies:
+            try:
+                nums = evaluate_float([b.mass, *(e for row in b.inertia for e in row)], values)
+            except JourdainError:
+                continue
+            if not any(nums):
+                massless.append(b.name)
+        named = ", ".join(f'body "{n}"' for n in massless)
+        one = len(massless) == 1
+        who = (f"; {'it moves' if len(idle) == 1 else 'they move'} only {named}, which "
+               f"{'has' if one else 'have'} no mass and no inertia"
+               if massless and len(massless) == len(bodies) else "")
+        fix = ("it" if one else "one of them") if who else "a body they move"
+        return (f"the mass matrix M is singular: no mass or inertia moves with "
+                f"{', '.join(idle)}{who}; give {fix} a mass or an inertia")
+    return (f"the mass matrix M is not positive definite (its eigenvalues range from "
+            f"{w.min():.3g} to {top:.3g}): the coordinates are not independent at this state "
+            "(a singular configuration of the joints); start from another state")
 
 
 def cmd_check(args: argparse.Namespace) -> int:
@@ -472,6 +547,11 @@ def cmd_linearize(args: argparse.Namespace) -> int:
     _capability(system, "linearize", "the linearization")
     from .io import capabilities as integration
 
+    if args.about is not None and args.about not in [n.name for n in model.nominal]:
+        names = [n.name for n in model.nominal]
+        raise UsageError(f'--about: no nominal motion "{args.about}" in {model.path}'
+                         f"{_suggest(args.about, names)}; the model has: "
+                         f"{', '.join(names) or '(none: add a [nominal.<name>] table)'}")
     params = _overrides(system, args.set)
     result = integration.linear_analysis(model, args.about, params)
     if args.json:
@@ -481,26 +561,224 @@ def cmd_linearize(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+# --- simulation options, outputs and progress ---------------------------------------------
+
+def _sim_options(model: Any, args: argparse.Namespace) -> dict[str, Any]:
+    """The simulation options given on the command line (those of ``args`` that the command
+    has), checked against the bounds of :mod:`jourdain.simulate` before any work: a value out
+    of range is a usage error naming the option."""
+    from .errors import EvaluationError
+    from .simulate import check_atol, check_rtol, check_samples, check_t_end
+
+    system = model.system
+    opts: dict[str, Any] = {}
+    checks: dict[str, Callable[[float, str], Any]] = {
+        "t_end": check_t_end, "rtol": check_rtol,
+        "atol": lambda v, name: check_atol(v, 1, name)[0],
+        "samples": lambda v, name: check_samples(v, system.f, len(system.inputs), name)}
+    for key, check in checks.items():
+        text = getattr(args, key, None)
+        if text is None:
+            continue
+        option = "--" + key.replace("_", "-")
+        try:
+            opts[key] = check(_number(text, option), option)
+        except EvaluationError as exc:
+            raise UsageError(str(exc)) from None
+    if getattr(args, "method", None):
+        opts["method"] = args.method
+    for key, rates in (("y0", False), ("yd0", True)):
+        if getattr(args, key, None):
+            opts[key] = _coordinate_values(system, args.__dict__[key], f"--{key}", rates)
+    if getattr(args, "input", None):
+        opts["inputs"] = _input_laws(system, args.input)
+    return opts
+
+
+def _coordinate_values(system: Any, texts: Sequence[str], option: str,
+                       rates: bool) -> dict[str, float]:
+    """``--y0 "phi1=0.3, phi2=0"`` (``--yd0`` also takes ``phi1_d=...``): numbers by
+    coordinate name (numbers and constant expressions such as ``pi/4``)."""
+    coords = system.coordinate_names
+    out: dict[str, float] = {}
+    for text in texts:
+        for name, value in _split_assignments(text, option):
+            key = name[:-2] if rates and name.endswith("_d") and name[:-2] in coords else name
+            if key not in coords:
+                raise UsageError(f'{option}: "{name}" is not a coordinate{_suggest(name, coords)};'
+                                 f" coordinates are {', '.join(coords)}")
+            out[key] = _number(value, f"{option} {name}")
+    return out
+
+
+def _input_laws(system: Any, texts: Sequence[str]) -> dict[str, Any]:
+    """``--input "F=2.0, tau=0.5*sin(3*t)"``: a law per input, a number or an expression in t
+    and the parameters (jourdain's expression language, never evaluated as Python)."""
+    from .io import ExpressionError, parse_expression
+
+    names = system.input_names
+    allowed = set(system.parameter_values) | {"t"}
+    out: dict[str, Any] = {}
+    for text in texts:
+        for name, value in _split_assignments(text, "--input"):
+            if name not in names:
+                raise UsageError(f'--input: "{name}" is not an input of the model'
+                                 f"{_suggest(name, names)}; inputs are "
+                                 f"{', '.join(names) or '(none)'}")
+            try:
+                law = parse_expression(value, names=allowed)
+            except ExpressionError as exc:
+                raise UsageError(f'--input {name}: "{value}": {exc} (input laws may use t and '
+                                 "the parameters)") from None
+            out[name] = float(law) if not law.free_symbols else law
+    return out
+
+
+def _writable_folder(folder: Path, option: str, text: str) -> None:
+    """Create ``folder`` (and its parents) and check that a file can be written in it."""
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=folder):
+            pass
+    except (FileExistsError, NotADirectoryError):
+        raise UsageError(f"{option} {text}: a part of the path {folder} is a file, not a "
+                         "folder") from None
+    except OSError as exc:
+        raise UsageError(f"{option} {text}: cannot write in the folder {folder}: "
+                         f"{exc.strerror or exc}") from None
+
+
+def _output_file(text: str, force: bool, suffixes: Sequence[str],
+                 option: str = "--out") -> Path:
+    """The results file of ``--out``, checked before any work: a known type, a folder that
+    can be written, not an existing file unless ``--force``."""
+    path = Path(text)
+    if path.is_dir():
+        raise UsageError(f"{option} {text}: is a folder; expected a file name ending in "
+                         f"{', '.join(suffixes)}")
+    if path.suffix.lower() not in suffixes:
+        kind = repr(path.suffix) if path.suffix else "(no extension)"
+        raise UsageError(f"{option} {text}: unknown file type {kind}; use "
+                         f"{', '.join(suffixes)}")
+    if path.exists() and not force:
+        raise UsageError(f"{option} {text}: the file exists; --force overwrites it")
+    _writable_folder(path.parent, option, text)
+    return path
+
+
+def _output_folder(text: str, force: bool, model: Any) -> Path:
+    """The report folder of ``run --out``, checked before any work: a folder (created if
+    missing) that can be written, not the model file's own, holding none of the files the
+    report writes unless ``--force``."""
+    from .io.report import report_files
+
+    out = Path(text)
+    if out.exists() and not out.is_dir():
+        raise UsageError(f"--out {text}: is a file; expected a folder for the report")
+    src = Path(model.path)
+    if out.is_dir() and src.is_file() and out.resolve() == src.resolve().parent:
+        raise UsageError(f"--out {text}: is the folder of the model file {model.path}; the "
+                         "report writes model.toml, report.html and its data files into a "
+                         "folder of their own (e.g. --out report/)")
+    if out.is_dir() and not force:
+        clash = [n for n in report_files(model) if (out / n).exists()]
+        if clash:
+            shown = ", ".join(clash[:6]) + (", …" if len(clash) > 6 else "")
+            raise UsageError(f"--out {text}: would overwrite {shown}; --force overwrites them")
+    _writable_folder(out, "--out", text)
+    return out
+
+
+class _Progress:
+    """Prints t and the fraction done to stderr every :data:`PROGRESS_SECONDS` of a long
+    simulation (on a terminal one line rewritten in place, else a line each time)."""
+
+    def __init__(self, stream: Any, tty: bool, label: str) -> None:
+        self.stream, self.tty, self.label = stream, tty, printable(label)
+        self.last = time.monotonic()
+        self.width = 0
+
+    def __call__(self, t: float, t1: float) -> None:
+        now = time.monotonic()
+        if now - self.last < PROGRESS_SECONDS:
+            return
+        self.last = now
+        line = f"{self.label}: t = {t:.6g} of {t1:.6g} ({100 * t / t1:.0f} %)"
+        if self.tty:
+            self.stream.write("\r" + line.ljust(self.width))
+            self.width = len(line)
+        else:
+            self.stream.write(line + "\n")
+        self.stream.flush()
+
+    def done(self) -> None:
+        if self.tty and self.width:
+            self.stream.write("\n")
+            self.stream.flush()
+            self.width = 0
+
+
+def _progress(asked: bool, label: str) -> _Progress | None:
+    """A progress printer when asked (``--progress``) or when stderr is a terminal."""
+    stream = sys.stderr
+    tty = bool(getattr(stream, "isatty", lambda: False)())
+    if not (asked or tty):
+        return None
+    return _Progress(getattr(stream, "raw", stream), tty, label)
+
+
+def _samples(n: int) -> str:
+    return f"{n} sample" + ("" if n == 1 else "s")
+
+
 def cmd_simulate(args: argparse.Namespace) -> int:
+    from .simulate import OUTPUT_SUFFIXES
+
     model = _load(args.model)
     system = model.system
     _capability(system, "simulate", "simulation")
     from .io import capabilities as integration
 
+    # every option and the output file are checked before the work
     params = _overrides(system, args.set)
-    res = integration.simulate(model, params, t_end=args.t_end, samples=args.samples)
+    opts = _sim_options(model, args)
+    out = _output_file(args.out, args.force, OUTPUT_SUFFIXES) if args.out else None
+    progress = _progress(args.progress, f"simulating {system.name}")
+    failure: JourdainError | None = None
+    try:
+        # with --out the results are written as the run goes, and complete at its end
+        res = integration.simulate(model, params, **opts, progress=progress or False,
+                                   output=out)
+    except JourdainError as exc:
+        if getattr(exc, "results", None) is None:
+            raise
+        if len(exc.results.t) == 0:  # failed before the first sample
+            raise JourdainError(f"{exc}; nothing was computed"
+                                + (f" ({out} holds the header only)" if out else "")) from None
+        res, failure = exc.results, exc
+    finally:
+        if progress:
+            progress.done()
     names = system.coordinate_names
-    if args.out:
-        out = Path(args.out)
-        out.parent.mkdir(parents=True, exist_ok=True)
-        integration.write_csv(res, system, out)
-        print(f"wrote {out} ({len(res.t)} samples, t = {res.t[0]:g} … {res.t[-1]:g})")
+    span = f"t = {res.t[0]:g} … {res.t[-1]:g}"
+    if out:
+        print(f"wrote {out} ({_samples(len(res.t))}, {span}"
+              + ("" if res.status == "finished" else f"; {res.status}") + ")")
     else:
-        print(f"{system.name}: simulated t = {res.t[0]:g} … {res.t[-1]:g} ({len(res.t)} samples)")
-    print("final state: " + ", ".join(f"{n}={v:.6g}" for n, v in
-                                        zip(names, res.y[-1], strict=True)))
-    print("final rates: " + ", ".join(f"{n}_d={v:.6g}" for n, v in
-                                        zip(names, res.yd[-1], strict=True)))
+        print(f"{system.name}: simulated {span} ({_samples(len(res.t))})")
+    where = ("final {}: " if res.status == "finished" else f"{{}} at t = {res.t[-1]:g}: ").format
+    print(where("state") + ", ".join(f"{n}={v:.6g}" for n, v in
+                                     zip(names, res.y[-1], strict=True)))
+    print(where("rates") + ", ".join(f"{n}_d={v:.6g}" for n, v in
+                                     zip(names, res.yd[-1], strict=True)))
+    kept = (f"the motion up to t = {res.t[-1]:g} ({_samples(len(res.t))}) is in {out}" if out
+            else "give --out FILE to keep the motion up to there")
+    if failure is not None:
+        raise JourdainError(f"{failure}; {kept}")
+    if res.interrupted:
+        print(f"jourdain simulate: interrupted (Ctrl-C) at t = {res.t[-1]:g}; {kept}",
+              file=sys.stderr)
+        return EXIT_INTERRUPTED
     return EXIT_OK
 
 
@@ -509,11 +787,25 @@ def cmd_run(args: argparse.Namespace) -> int:
 
     model = _load(args.model)
     params = _overrides(model.system, args.set)
-    info = write_report(model, Path(args.out), parameters=params, t_end=args.t_end,
-                        max_ops=args.max_ops)
+    opts = _sim_options(model, args)
+    out = _output_folder(args.out, args.force, model)
+    progress = _progress(args.progress, f"simulating {model.system.name}")
+    try:
+        info = write_report(model, out, parameters=params, t_end=opts.get("t_end"),
+                            max_ops=args.max_ops, progress=progress or False)
+    finally:
+        if progress:
+            progress.done()
     for line in info.summary_lines:
         print(line)
     print(f"report: {info.html}")
+    if info.status == "interrupted":
+        print(f"jourdain run: {info.message}; the report holds what was computed",
+              file=sys.stderr)
+        return EXIT_INTERRUPTED
+    if info.status == "failed":
+        print(f"jourdain run: error: {info.message}", file=sys.stderr)
+        return EXIT_MODEL
     return EXIT_OK
 
 
@@ -557,7 +849,7 @@ def build_parser() -> argparse.ArgumentParser:
              "jourdain eom examples/double_pendulum.toml --format latex", cmd_eom)
     p.add_argument("--format", choices=("text", "latex", "json"), default="text",
                    help="text (default), latex, or json (expressions with shared temporaries)")
-    p.add_argument("--max-ops", type=int, default=600, metavar="N",
+    p.add_argument("--max-ops", type=_operations, default=600, metavar="N",
                    help="summarize matrices needing more than N operations (text, latex)")
 
     state_help = ('state as "name=value, ..." with coordinates, rates <name>_d, inputs and t '
@@ -586,27 +878,110 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", help=set_help)
     p.add_argument("--json", action="store_true", help="print JSON")
 
+    import importlib
+
+    from .io.capabilities import SIM_METHODS
+
+    sim = importlib.import_module(".simulate", __package__)  # (the package exports a function)
+
+    default = "(default: the model's [simulation] {}, else {})".format
+    t_end_help = (f"end time, at most {sim.MAX_TIME:g} {default('t_end', sim.DEFAULT_T_END)}")
+    progress_help = (f"print t and the fraction done to stderr every {PROGRESS_SECONDS:g} s "
+                     "(without it: only when stderr is a terminal)")
     p = _sub(subs, "simulate", "integrate the nonlinear equations of motion",
-             "jourdain simulate examples/double_pendulum.toml --t-end 10 --out sim.csv",
-             cmd_simulate)
-    p.add_argument("--t-end", type=float, metavar="T", help="end time (default: [simulation])")
-    p.add_argument("--samples", type=int, metavar="N", help="output samples")
-    p.add_argument("--out", metavar="FILE", help="write the results (.csv, or .h5 for HDF5)")
+             "jourdain simulate examples/double_pendulum.toml --t-end 10 --out sim.csv\n  "
+             'jourdain simulate examples/quarter_car.toml --method Radau --rtol 1e-9 '
+             '--y0 "z_b=0.05" --input "z_r=0.02*sin(8*t)"', cmd_simulate)
+    p.add_argument("--t-end", metavar="T", help=t_end_help)
+    p.add_argument("--samples", metavar="N",
+                   help=f"output samples, evenly spaced from t = 0 ({sim.MIN_SAMPLES} to "
+                        f"{sim.MAX_SAMPLES:g}) {default('samples', sim.DEFAULT_SAMPLES)}")
+    p.add_argument("--method", choices=SIM_METHODS,
+                   help=f"integration method {default('method', sim.DEFAULT_METHOD)}")
+    p.add_argument("--rtol", metavar="R",
+                   help=f"relative tolerance, {sim.RTOL_MIN:g} <= R < 1 "
+                        f"{default('rtol', f'{sim.DEFAULT_RTOL:g}')}")
+    p.add_argument("--atol", metavar="A",
+                   help=f"absolute tolerance, 0 < A <= {sim.ATOL_MAX:g} "
+                        f"{default('atol', f'{sim.DEFAULT_ATOL:g}')}")
+    p.add_argument("--y0", action="append", default=[], metavar="STATE",
+                   help='initial coordinates: --y0 "phi1=0.3, phi2=0" (the others: the model\'s '
+                        "[simulation] y0, else 0)")
+    p.add_argument("--yd0", action="append", default=[], metavar="RATES",
+                   help='initial rates: --yd0 "phi1=1.0" (or phi1_d=1.0; the others: the '
+                        "model's [simulation] yd0, else 0)")
+    p.add_argument("--input", action="append", default=[], metavar="NAME=LAW",
+                   help='input law: --input "F=2.0" or "F=2*sin(3*t)", an expression in t and '
+                        "the parameters (the others: the model's [simulation] inputs, else 0)")
+    p.add_argument("--out", metavar="FILE",
+                   help="write the results as the run goes (.csv, or .h5 for HDF5)")
+    p.add_argument("--force", action="store_true", help="overwrite an existing --out file")
+    p.add_argument("--progress", action="store_true", help=progress_help)
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", help=set_help)
 
     p = _sub(subs, "run", "everything for a model, written as a self-contained HTML report "
              "plus data files", "jourdain run examples/double_pendulum.toml --out report/",
              cmd_run)
-    p.add_argument("--out", required=True, metavar="DIR", help="output folder")
-    p.add_argument("--t-end", type=float, metavar="T", help="simulation end time")
+    p.add_argument("--out", required=True, metavar="DIR",
+                   help="output folder (not the model file's own)")
+    p.add_argument("--force", action="store_true",
+                   help="overwrite the files of an earlier report in --out")
+    p.add_argument("--t-end", metavar="T", help="simulation " + t_end_help)
+    p.add_argument("--progress", action="store_true", help=progress_help)
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", help=set_help)
-    p.add_argument("--max-ops", type=int, default=600, metavar="N",
+    p.add_argument("--max-ops", type=_operations, default=600, metavar="N",
                    help="summarize matrices needing more than N operations")
     return parser
 
 
+def _operations(text: str) -> int:
+    """``--max-ops``: a whole number of operations, 0 or more."""
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+    if n < 0:
+        raise argparse.ArgumentTypeError(f"expected 0 or more operations, got {n}")
+    return n
+
+
+_CONTROL = re.compile("[\x00-\x08\x0b-\x1f\x7f-\x9f\u2028\u2029\u202a-\u202e\u2066-\u2069]")
+
+
+def printable(text: str) -> str:
+    """``text`` with control characters other than line breaks and tabs written as escapes
+    (``\\x1b``): names and messages from a model file never reach the terminal as escape
+    sequences or hidden text."""
+    return _CONTROL.sub(lambda m: m.group().encode("unicode_escape").decode("ascii"), text)
+
+
+class _Printable:
+    """A text stream that writes through :func:`printable` (``raw``: the stream itself)."""
+
+    def __init__(self, raw: Any) -> None:
+        self.raw = raw
+
+    def write(self, text: str) -> int:
+        return self.raw.write(printable(text))
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.raw, name)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``jourdain`` console script; returns the exit status."""
+    out, err = sys.stdout, sys.stderr
+    sys.stdout, sys.stderr = _Printable(out), _Printable(err)
+    try:
+        return _main(argv)
+    finally:
+        if isinstance(sys.stdout, _Printable):
+            sys.stdout = out
+        if isinstance(sys.stderr, _Printable):
+            sys.stderr = err
+
+
+def _main(argv: Sequence[str] | None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     if args.command is None:
@@ -621,13 +996,22 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"jourdain {args.command}: {exc}", file=sys.stderr)
         return EXIT_MODEL
     except JourdainError as exc:
+        if isinstance(exc.__cause__, KeyboardInterrupt):  # a SciPy method's run, Ctrl-C
+            print(f"jourdain {args.command}: interrupted (Ctrl-C): {exc}", file=sys.stderr)
+            return EXIT_INTERRUPTED
         print(f"jourdain {args.command}: error: {exc}", file=sys.stderr)
         return EXIT_MODEL
     except KeyboardInterrupt:
-        return 130
+        print(f"jourdain {args.command}: interrupted (Ctrl-C)", file=sys.stderr)
+        return EXIT_INTERRUPTED
     except BrokenPipeError:  # output piped into head & co.
         sys.stdout = open(os.devnull, "w")  # noqa: SIM115 - silence the flush at exit
         return EXIT_OK
+    except OSError as exc:  # an output that failed after the checks (a full disk)
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"jourdain {args.command}: error: cannot write {where}{exc.strerror or exc}",
+              file=sys.stderr)
+        return EXIT_MODEL
 
 
 if __name__ == "__main__":

@@ -19,7 +19,11 @@ A run that writes as it goes (``simulate(..., output=path)``) first fills
 complete layout replaces it when the run ends, so a crashed run leaves a readable file.
 
 CSV (``.csv``): one header line of column names (``t, <y>, <y>_d, <y>_dd, <inputs>, W, T, V``)
-after comment lines starting with ``#`` that hold the metadata.
+after comment lines starting with ``#`` that hold the metadata (``status``: finished, event,
+interrupted, failed; ``message``: what happened and, for a run cut short, where it ends). A run
+that writes as it goes appends rows ``t, <y>, <y>_d, W`` under ``status: running``; the complete
+file replaces them when the run ends. Both formats are written to a temporary file beside the
+target and renamed over it: an interruption while saving leaves the previous file whole.
 
 Sampling: without ``t_eval`` a run keeps the integrator's accepted steps (as many as its
 tolerances need: a pendulum swinging for 10 s takes about 100), with the rates and accelerations
@@ -36,6 +40,8 @@ pendulum: 8e-8).
 from __future__ import annotations
 
 import json
+import os
+import re
 from collections.abc import Sequence
 from functools import lru_cache
 from pathlib import Path
@@ -450,24 +456,28 @@ class Results:
                 "wall_time": float(self.wall_time)}
 
     def save(self, path: str | Path) -> Path:
-        """Write to ``.h5``/``.hdf5`` (HDF5, see module docs) or ``.csv``."""
+        """Write to ``.h5``/``.hdf5`` (HDF5, see module docs) or ``.csv``, through a temporary
+        file renamed over ``path`` (an interruption leaves the previous file whole)."""
         path = Path(path)
         suffix = path.suffix.lower()
-        if suffix == ".csv":
-            cols, data = self._columns()
-            # one line per entry: a line break in a name or message would shift the header
-            header = "\n".join(f"{k}: {' '.join(str(v).splitlines())}"
-                               for k, v in self._meta().items())
-            np.savetxt(path, data, delimiter=",", header=header + "\n" + ",".join(cols),
-                       comments="# ", fmt="%.17g")
-            # the last header line is the column names without the comment mark
-            text = path.read_text().splitlines()
-            i = len(self._meta())
-            text[i] = text[i][2:]
-            path.write_text("\n".join(text) + "\n")
-            return path
-        if suffix not in (".h5", ".hdf5"):
+        if suffix not in (".csv", ".h5", ".hdf5"):
             raise EvaluationError(f"unknown results file type {path.suffix!r}: use .h5 or .csv")
+        tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp{suffix}")
+        try:
+            if suffix == ".csv":
+                cols, data = self._columns()
+                with open(tmp, "w", encoding="utf-8") as fh:
+                    fh.write(_csv_header(self._meta(), cols))
+                    np.savetxt(fh, data, delimiter=",", fmt="%.17g")
+            else:
+                self._save_h5(tmp)
+            os.replace(tmp, path)
+        finally:
+            if tmp.exists():
+                tmp.unlink()
+        return path
+
+    def _save_h5(self, path: Path) -> None:
         import h5py
 
         with h5py.File(path, "w") as h:
@@ -492,7 +502,6 @@ class Results:
                 g = grp.create_group(name.replace("/", "_"))
                 for k in ("t", "y", "yd"):
                     g[k] = ev[k]
-        return path
 
     @classmethod
     def load(cls, path: str | Path, system: System | None = None) -> Results:
@@ -731,15 +740,17 @@ def _load_csv(path: Path, system: System | None) -> Results:
     inputs = json.loads(meta["inputs"])
     col = {c: i for i, c in enumerate(cols)}
 
-    def block(keys: list[str]) -> np.ndarray:
-        return data[:, [col[k] for k in keys]] if keys else np.zeros((len(data), 0))
+    def block(keys: list[str], missing: float = 0.0) -> np.ndarray:
+        if all(k in col for k in keys):
+            return data[:, [col[k] for k in keys]] if keys else np.zeros((len(data), 0))
+        return np.full((len(data), len(keys)), missing)  # a partial file: t, y, ẏ, W only
 
     energies = {}
     if "T" in col and system is None:
         energies = {"T": data[:, col["T"]], "V": data[:, col["V"]], "conservative": False,
                     "nonconservative": ()}
     return Results(system, data[:, 0], block(names), block([f"{n}_d" for n in names]),
-                   block([f"{n}_dd" for n in names]), block(inputs), data[:, col["W"]],
+                   block([f"{n}_dd" for n in names], np.nan), block(inputs), data[:, col["W"]],
                    json.loads(meta["parameters"]), method=meta.get("method", ""),
                    rtol=float(meta.get("rtol", "nan")), status=meta.get("status", ""),
                    message=meta.get("message", ""), nfev=int(meta.get("nfev", 0)),
@@ -750,8 +761,50 @@ def _load_csv(path: Path, system: System | None) -> Results:
 
 
 # --- incremental writing ------------------------------------------------------------------------
+_CONTROL = re.compile("[\x00-\x1f\x7f-\x9f\u2028\u2029]")
+
+
+def _csv_header(meta: dict[str, Any], cols: Sequence[str]) -> str:
+    """The comment lines of a results CSV, one per item (a line break in a name or message
+    becomes a space, other control characters are written escaped, so that no value shifts
+    the header), and the line of column names."""
+    lines = [f"# {k}: " + _CONTROL.sub(lambda m: repr(m.group())[1:-1],
+                                       " ".join(str(v).splitlines()))
+             for k, v in meta.items()]
+    return "\n".join([*lines, ",".join(cols)]) + "\n"
+
+
+class _PartialCsv:
+    """A results CSV filled row by row while a run goes: ``t, <y>, <y>_d, W`` under
+    ``status: running``; :meth:`Results.save` replaces it with the complete file."""
+
+    def __init__(self, path: str | Path, system: System) -> None:
+        names = system.coordinate_names
+        meta = {"format": FORMAT, "version": VERSION, "system": system.name, "method": "",
+                "rtol": float("nan"), "status": "running",
+                "message": "run in progress (or killed): the rows hold the accepted steps "
+                           "(t, y, ẏ, W)",
+                "coordinates": json.dumps(names), "inputs": json.dumps(system.input_names),
+                "parameters": json.dumps(system.parameter_values),
+                "units": json.dumps(dict(system.units)), "nfev": 0, "nsteps": 0,
+                "wall_time": 0.0}
+        self.fh = open(path, "w", encoding="utf-8")  # noqa: SIM115 - closed by close()
+        self.fh.write(_csv_header(meta, ["t", *names, *(f"{n}_d" for n in names), "W"]))
+        self.fh.flush()
+
+    def append(self, t: np.ndarray, x: np.ndarray) -> None:
+        np.savetxt(self.fh, np.column_stack([t, x]), delimiter=",", fmt="%.17g")
+        self.fh.flush()
+
+    def close(self) -> None:
+        self.fh.close()
+
+
 def open_incremental(path: str | Path, system: System) -> Any:
-    """Create a results file that :func:`append_incremental` fills while a run goes."""
+    """Create a results file (``.h5``, ``.hdf5`` or ``.csv``) that :func:`append_incremental`
+    fills while a run goes."""
+    if Path(path).suffix.lower() == ".csv":
+        return _PartialCsv(path, system)
     import h5py
 
     n = 2 * system.f + 1
@@ -778,6 +831,9 @@ def open_incremental(path: str | Path, system: System) -> Any:
 def append_incremental(h: Any, t: np.ndarray, x: np.ndarray) -> None:
     """Append accepted steps and flush, so the file is readable if the process dies."""
     if len(t) == 0:
+        return
+    if isinstance(h, _PartialCsv):
+        h.append(t, x)
         return
     dt, dx = h["partial/t"], h["partial/x"]
     m = dt.shape[0]

@@ -62,6 +62,28 @@ C_METHODS = {"DOP853": 1, "RK45": 0, "DOPRI5": 0, "Radau": 2}
 #: methods of scipy.integrate.solve_ivp (one call from Python per right-hand side)
 SCIPY_METHODS = ("BDF", "LSODA", "scipy:Radau", "scipy:RK45", "scipy:DOP853")
 
+#: the defaults of every simulation: :func:`simulate`, :meth:`System.simulate`, the
+#: ``[simulation]`` table of model files and ``jourdain simulate`` all take them from here
+DEFAULT_METHOD = "DOP853"
+DEFAULT_RTOL = 1e-8
+DEFAULT_ATOL = 1e-10
+DEFAULT_T_END = 5.0
+DEFAULT_SAMPLES = 501
+
+#: the bounds of the options (docs/model-format.md, ``[simulation]``): below ``RTOL_MIN`` the
+#: error estimate is round-off; an ``atol`` above ``ATOL_MAX`` switches the error control off
+#: for states of any ordinary size; ``|t| <= MAX_TIME`` (a longer run of a mechanical model
+#: cannot finish); ``max_step`` asks for at most ``MAX_STEPS`` steps over the span; the output
+#: holds ``MIN_SAMPLES`` to ``MAX_SAMPLES`` samples and at most ``MAX_OUTPUT_BYTES``
+RTOL_MIN = 1e-14
+ATOL_MAX = 1e3
+MAX_TIME = 1e9
+MAX_STEPS = 10**9
+MIN_SAMPLES, MAX_SAMPLES = 2, 10**7
+MAX_OUTPUT_BYTES = 4 * 2**30
+#: the results files that ``output=`` writes as the run goes (Results.save's formats)
+OUTPUT_SUFFIXES = (".csv", ".h5", ".hdf5")
+
 _DONE, _CONTINUE, _EVENT = 0, 1, 2
 _ESINGULAR, _ENAN, _ESTEP, _ECALLBACK, _ENOMEM = -1, -2, -3, -4, -5
 
@@ -287,6 +309,157 @@ def _takes_state(fn: Callable[..., Any]) -> bool:
     return len(positional) >= 3 or any(p.kind == p.VAR_POSITIONAL for p in params)
 
 
+# --- options: one check each, shared by the API, the model files and the command line ------
+# Each raises EvaluationError naming the option as the caller calls it (``name``: "rtol" in
+# Python, "--rtol" on the command line); the model file loader adds the file, line and key.
+
+def _real(value: Any, name: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise EvaluationError(f"{name} must be a number, got {_shown(value)}")
+    return float(value)
+
+
+def _shown(value: Any, n: int = 60) -> str:
+    """``value`` for a message: its repr, clipped, control characters escaped."""
+    text = repr(value)
+    return text if len(text) <= n else f"{text[:n // 2]} … {text[-n // 2:]}"
+
+
+def check_method(method: Any, name: str = "method") -> str:
+    """``method`` if it is one of :data:`C_METHODS` or :data:`SCIPY_METHODS`."""
+    if not isinstance(method, str) or (method not in C_METHODS and method not in SCIPY_METHODS):
+        raise EvaluationError(f"unknown {name} {_shown(method)}; methods are "
+                              f"{', '.join(sorted(C_METHODS) + list(SCIPY_METHODS))}")
+    return method
+
+
+def check_rtol(rtol: Any, name: str = "rtol") -> float:
+    """The relative tolerance: ``RTOL_MIN <= rtol < 1``."""
+    v = _real(rtol, name)
+    if not (RTOL_MIN <= v < 1):
+        raise EvaluationError(
+            f"{name} = {v:g}: the relative tolerance must be at least {RTOL_MIN:g} (below it "
+            "the error estimate is round-off) and below 1 (at 1 or more nothing is controlled)")
+    return v
+
+
+def check_atol(atol: Any, size: int, name: str = "atol") -> np.ndarray:
+    """The absolute tolerance, one number or ``size`` numbers, each in ``(0, ATOL_MAX]``;
+    returned as ``size`` numbers."""
+    if isinstance(atol, (str, bytes, bool)) or atol is None:
+        raise EvaluationError(f"{name} must be a number or {size} numbers, got {_shown(atol)}")
+    try:
+        a = np.asarray(atol, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise EvaluationError(f"{name} must be a number or {size} numbers, got "
+                              f"{_shown(atol)}") from None
+    if a.size == 1:
+        a = np.full(size, a[0])
+    if a.size != size:
+        raise EvaluationError(f"{name} must be a number or {size} numbers (y then ẏ), got "
+                              f"{a.size} numbers")
+    if not np.all(np.isfinite(a)) or not np.all(a > 0) or np.any(a > ATOL_MAX):
+        bad = next(float(x) for x in a if not (math.isfinite(x) and 0 < x <= ATOL_MAX))
+        raise EvaluationError(
+            f"{name} = {bad:g}: the absolute tolerance must be positive, finite and at most "
+            f"{ATOL_MAX:g} (a larger one switches the error control off)")
+    return a
+
+
+def check_t_span(t_span: Any, name: str = "t_span") -> tuple[float, float]:
+    """``(t0, t1)``: finite, ``t1 > t0``, both within ±``MAX_TIME``, the span above the
+    round-off of t."""
+    try:
+        t0, t1 = (_real(v, name) for v in t_span)
+    except (TypeError, ValueError, EvaluationError):
+        raise EvaluationError(f"{name} must be (t0, t1), two numbers, got "
+                              f"{_shown(t_span)}") from None
+    if not (math.isfinite(t0) and math.isfinite(t1)) or t1 <= t0:
+        raise EvaluationError(f"{name} must be finite with t1 > t0, got ({t0:g}, {t1:g})")
+    if max(abs(t0), abs(t1)) > MAX_TIME:
+        raise EvaluationError(
+            f"{name} = ({t0:g}, {t1:g}): times must lie within ±{MAX_TIME:g} (about 32 years "
+            "in seconds; a run that long cannot finish with the steps of a mechanical model)")
+    if t1 - t0 < 1000 * math.ulp(max(abs(t0), abs(t1))):
+        raise EvaluationError(f"{name} = ({t0!r}, {t1!r}): the span is below the round-off of t")
+    return t0, t1
+
+
+def check_t_end(t_end: Any, name: str = "t_end") -> float:
+    """The end time of a run from t = 0: positive, finite, at most ``MAX_TIME``."""
+    v = _real(t_end, name)
+    if not (v > 0 and math.isfinite(v)):
+        raise EvaluationError(f"{name} = {v:g}: the end time must be positive and finite")
+    if v > MAX_TIME:
+        raise EvaluationError(
+            f"{name} = {v:g}: the end time must be at most {MAX_TIME:g} (about 32 years in "
+            "seconds; a run that long cannot finish with the steps of a mechanical model)")
+    return v
+
+
+def max_samples(f: int, n_inputs: int = 0) -> int:
+    """The most output samples of a model with ``f`` coordinates and ``n_inputs`` inputs:
+    ``MAX_SAMPLES``, fewer where the results would take more than ``MAX_OUTPUT_BYTES``."""
+    per_sample = 8 * (2 * (2 * f + 1) + 2 * (3 * f + n_inputs + 4))  # the loop's, the results'
+    return max(MIN_SAMPLES, min(MAX_SAMPLES, MAX_OUTPUT_BYTES // per_sample))
+
+
+def check_samples(samples: Any, f: int, n_inputs: int = 0, name: str = "samples") -> int:
+    """The number of output samples: an integer from ``MIN_SAMPLES`` to
+    :func:`max_samples`."""
+    v = _real(samples, name)
+    if not (math.isfinite(v) and v == int(v)):
+        raise EvaluationError(f"{name} = {samples!r}: the number of samples must be a whole "
+                              "number")
+    n, top = int(v), max_samples(f, n_inputs)
+    if n < MIN_SAMPLES:
+        raise EvaluationError(f"{name} = {n}: at least {MIN_SAMPLES} samples are needed (the "
+                              "start and the end)")
+    if n > top:
+        why = ("" if top == MAX_SAMPLES else
+               f" for a model with f = {f} (the results would take more than "
+               f"{MAX_OUTPUT_BYTES / 2**30:g} GiB)")
+        raise EvaluationError(f"{name} = {n}: at most {top} samples{why}")
+    return n
+
+
+def check_t_eval(t_eval: Any, t0: float, t1: float, f: int, n_inputs: int = 0,
+                 name: str = "t_eval") -> np.ndarray:
+    """Output times: finite, sorted, within ``[t0, t1]``, at most :func:`max_samples`."""
+    try:
+        te = np.ascontiguousarray(t_eval, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise EvaluationError(f"{name} must be a sequence of numbers, got "
+                              f"{_shown(t_eval)}") from None
+    top = max_samples(f, n_inputs)
+    if te.size == 0 or te.size > top:
+        raise EvaluationError(f"{name} holds {te.size} times: from 1 to {top} are allowed")
+    bad = np.flatnonzero(~np.isfinite(te))
+    if bad.size:
+        raise EvaluationError(f"{name}[{bad[0]}] = {float(te[bad[0]])}: output times must be finite")
+    down = np.flatnonzero(np.diff(te) < 0)
+    if down.size:
+        i = int(down[0])
+        raise EvaluationError(f"{name} must be sorted: {name}[{i + 1}] = {te[i + 1]:g} comes "
+                              f"after {name}[{i}] = {te[i]:g}")
+    if te[0] < t0 or te[-1] > t1:
+        raise EvaluationError(f"{name} must lie within t_span ({t0:g}, {t1:g}), got "
+                              f"{te[0]:g} … {te[-1]:g}")
+    return te
+
+
+def check_max_step(max_step: Any, t0: float, t1: float, name: str = "max_step") -> float:
+    """The largest step: positive (``inf``: no limit) and at least ``(t1 − t0)/MAX_STEPS``."""
+    v = _real(max_step, name)
+    if not v > 0:
+        raise EvaluationError(f"{name} must be positive, got {v:g}")
+    if (t1 - t0) / v > MAX_STEPS:
+        raise EvaluationError(
+            f"{name} = {v:g} over a span of {t1 - t0:g} means at least {(t1 - t0) / v:.3g} "
+            f"steps; at most {MAX_STEPS:g} are allowed ({name} >= {(t1 - t0) / MAX_STEPS:.3g})")
+    return v
+
+
 def steps_per_call(f: int) -> int:
     """Steps per call of the C loop: about 0.1 s of work estimated from the model's size
     (Ctrl-C and the progress report wait at most that long). Never from the wall clock: the
@@ -318,8 +491,11 @@ def _error(code: int, setup: _Setup, fail: np.ndarray) -> JourdainError:
             "check the parameters and inputs"
         return IntegrationError(f"NaN or inf in the state or its derivative {where} ({cause})")
     if code == _ESTEP:
+        hint = ("try method='Radau'" if setup.problem.method != C_METHODS["Radau"] else
+                "the stiff method Radau does not get past it either: look for a singular "
+                "configuration or a force that grows without bound there")
         return IntegrationError(f"step size fell below the round-off limit {where}; the motion "
-                                "may be singular or very stiff (try method='Radau')")
+                                f"may be singular or very stiff ({hint})")
     if code == _ECALLBACK:
         return IntegrationError(f"an input function raised {setup.callback_error!r} {where}")
     return IntegrationError(f"integrator failed with code {code}")
@@ -327,8 +503,8 @@ def _error(code: int, setup: _Setup, fail: np.ndarray) -> JourdainError:
 
 def simulate(system: System, t_span: tuple[float, float], y0: Any, yd0: Any,
              parameters: Mapping[str, float] | None = None,
-             inputs: Mapping[str, Any] | None = None, method: str = "DOP853",
-             rtol: float = 1e-6, atol: float | Sequence[float] = 1e-8,
+             inputs: Mapping[str, Any] | None = None, method: str = DEFAULT_METHOD,
+             rtol: float = DEFAULT_RTOL, atol: float | Sequence[float] = DEFAULT_ATOL,
              t_eval: Sequence[float] | None = None, events: Sequence[Event] = (),
              max_step: float = math.inf, first_step: float | None = None,
              progress: bool | Callable[[float, float], None] = False,
@@ -338,20 +514,25 @@ def simulate(system: System, t_span: tuple[float, float], y0: Any, yd0: Any,
     Parameters
     ----------
     system : System
-    t_span : (t0, t1) with t1 > t0
+    t_span : (t0, t1) with t1 > t0, both within ±``MAX_TIME`` (1e9)
     y0, yd0 : initial coordinates and rates (f each, in the order of ``system.coordinates``)
     parameters : overrides of parameter values by name (no recompilation)
     inputs : input name -> number, table ``(times, values)``, expression or callable (see module)
     method : "DOP853" (default), "RK45", "Radau" (step loop in C) or "BDF", "LSODA",
         "scipy:Radau", "scipy:RK45", "scipy:DOP853" (SciPy's solve_ivp)
-    rtol, atol : tolerances; the local error of each state component stays below
-        ``atol + rtol·|x|``; ``atol`` may be a vector of length 2f (y then ẏ)
-    t_eval : output times (continuous extension); default: every accepted step
+    rtol, atol : tolerances (default :data:`DEFAULT_RTOL` = 1e-8, :data:`DEFAULT_ATOL` =
+        1e-10); the local error of each state component stays below ``atol + rtol·|x|``;
+        ``RTOL_MIN`` (1e-14) <= rtol < 1; 0 < atol <= ``ATOL_MAX`` (1e3); ``atol`` may be a
+        vector of length 2f (y then ẏ)
+    t_eval : output times (continuous extension), finite, sorted, within ``t_span``, at most
+        ``MAX_SAMPLES`` (and ``MAX_OUTPUT_BYTES`` of results); default: every accepted step
     events : :class:`Event` objects
-    max_step, first_step : step size limits
+    max_step, first_step : step size limits; ``max_step`` asks for at most ``MAX_STEPS`` steps
+        over ``t_span``
     progress : True prints the progress to stderr (every 0.5 s); a callable gets ``(t, t1)``
         after every chunk of the C loop (about 0.2 s of work, at most 1024 output points)
-    output : path of a results file (``.h5``) written as the run goes
+    output : path of a results file (``.csv``, ``.h5``) written as the run goes (accepted steps
+        or ``t_eval`` samples appended under ``status: running``), then complete
     raise_on_interrupt : re-raise KeyboardInterrupt after keeping the results
 
     Returns
@@ -373,34 +554,22 @@ def simulate(system: System, t_span: tuple[float, float], y0: Any, yd0: Any,
     from .numeric import _vector
 
     f = system.f
-    try:
-        t0, t1 = (float(v) for v in t_span)
-    except (TypeError, ValueError):
-        raise EvaluationError(f"t_span must be (t0, t1), got {t_span!r}") from None
-    if not (math.isfinite(t0) and math.isfinite(t1)) or t1 <= t0:
-        raise EvaluationError(f"t_span must be finite with t1 > t0, got {t_span!r}")
+    t0, t1 = check_t_span(t_span)
     yv = _vector(y0, f, "y0", system.coordinate_names)
     ydv = _vector(yd0, f, "yd0", [f"{n}_d" for n in system.coordinate_names])
-    if not (rtol > 0 and math.isfinite(rtol)):
-        raise EvaluationError(f"rtol must be positive, got {rtol!r}")
-    a = np.asarray(atol, dtype=float).reshape(-1)
-    if a.size == 1:
-        a = np.full(2 * f, a[0])
-    if a.size != 2 * f or not np.all(a > 0) or not np.all(np.isfinite(a)):
-        raise EvaluationError(f"atol must be a positive number or {2 * f} positive numbers")
+    method = check_method(method)
+    rtol = check_rtol(rtol)
+    a = check_atol(atol, 2 * f)
     atol_x = np.concatenate([a, [a.min()]])
-    if not max_step > 0:
-        raise EvaluationError(f"max_step must be positive, got {max_step!r}")
-    if first_step is not None and not (first_step > 0 and math.isfinite(first_step)):
-        raise EvaluationError(f"first_step must be a positive number, got {first_step!r}")
-    if method not in C_METHODS and method not in SCIPY_METHODS:
-        raise EvaluationError(f"unknown method {method!r}; methods are "
-                              f"{sorted(C_METHODS) + list(SCIPY_METHODS)}")
-    te = None
-    if t_eval is not None:
-        te = np.ascontiguousarray(t_eval, dtype=float).reshape(-1)
-        if te.size == 0 or np.any(np.diff(te) < 0) or te[0] < t0 or te[-1] > t1:
-            raise EvaluationError("t_eval must be sorted and lie within t_span")
+    max_step = check_max_step(max_step, t0, t1)
+    if first_step is not None:
+        first_step = _real(first_step, "first_step")
+        if not (first_step > 0 and math.isfinite(first_step)):
+            raise EvaluationError(f"first_step must be a positive number, got {first_step!r}")
+    te = None if t_eval is None else check_t_eval(t_eval, t0, t1, f, len(system.inputs))
+    if output is not None and not str(output).lower().endswith(OUTPUT_SUFFIXES):
+        raise EvaluationError(f"output = {_shown(str(output))}: a results file ends in "
+                              f"{', '.join(OUTPUT_SUFFIXES)}")
     p = parameter_vector(system, parameters)
     mkq = mkq_function(system)
     setup = _Setup(system, mkq, p, inputs, events, C_METHODS.get(method, 1), rtol, atol_x,
@@ -457,7 +626,7 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
     if te is None:
         cap = 1024
     writer = (_Writer(output, system)
-              if output and str(output).lower().endswith((".h5", ".hdf5")) else None)
+              if output and str(output).lower().endswith(OUTPUT_SUFFIXES) else None)
     status = "finished"
     message = "reached the end of t_span"
     exception: BaseException | None = None

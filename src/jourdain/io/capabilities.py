@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 import symengine as se
 
-from ..errors import JourdainError
+from ..errors import EvaluationError
 from .modelfile import ModelFile, NominalMotion
 
 T = se.Symbol("t")
@@ -226,21 +226,51 @@ SIM_METHODS = ("DOP853", "RK45", "Radau", "BDF", "LSODA")
 
 
 def simulate(model: ModelFile, parameters: Mapping[str, float] | None = None,
-             t_end: float | None = None, samples: int | None = None) -> Any:
+             t_end: float | None = None, samples: int | None = None, *,
+             method: str | None = None, rtol: float | None = None, atol: float | None = None,
+             y0: Mapping[str, float] | None = None, yd0: Mapping[str, float] | None = None,
+             inputs: Mapping[str, Any] | None = None, progress: Any = False,
+             output: str | Path | None = None) -> Any:
     """Integrate the model from its [simulation] initial state; returns a
-    :class:`jourdain.results.Results`."""
+    :class:`jourdain.results.Results`.
+
+    Each option left out (None) is the model's ``[simulation]`` value, whose own defaults are
+    those of :mod:`jourdain.simulate`; ``y0``, ``yd0`` (by coordinate name) and ``inputs`` (by
+    input name: a number or an expression in t and the parameters) replace the model's values
+    they name. ``progress`` and ``output`` (a results file written as the run goes) are passed
+    to :func:`jourdain.simulate.simulate`. The options are checked against the bounds of
+    :mod:`jourdain.simulate` before anything is computed (:class:`EvaluationError`).
+    """
+    from ..simulate import check_samples, check_t_end
+
     system = model.system
     sim = model.simulation
-    t1 = float(t_end if t_end is not None else sim.t_end)
-    if not t1 > 0:
-        raise JourdainError(f"the end time must be positive, got {t1}")
-    n = int(samples if samples is not None else sim.samples)
-    inputs: dict[str, Any] = {name: 0.0 for name in system.input_names}
-    inputs.update(dict(sim.inputs))
-    return system.simulate((0.0, t1), list(sim.y0), list(sim.yd0),
+    t1 = check_t_end(t_end if t_end is not None else sim.t_end)
+    n = check_samples(samples if samples is not None else sim.samples, system.f,
+                      len(system.inputs))
+    coords = system.coordinate_names
+    y = dict(zip(coords, sim.y0 or [0.0] * system.f, strict=True))
+    yd = dict(zip(coords, sim.yd0 or [0.0] * system.f, strict=True))
+    for given, into, what in ((y0, y, "y0"), (yd0, yd, "yd0")):
+        for name, v in dict(given or {}).items():
+            if name not in into:
+                raise EvaluationError(f'{what}: "{name}" is not a coordinate; coordinates are '
+                                      f"{', '.join(coords)}")
+            into[name] = v
+    laws: dict[str, Any] = {name: 0.0 for name in system.input_names}
+    laws.update(dict(sim.inputs))
+    for name, v in dict(inputs or {}).items():
+        if name not in laws:
+            raise EvaluationError(f'inputs: "{name}" is not an input of the model; inputs are '
+                                  f"{', '.join(system.input_names) or '(none)'}")
+        laws[name] = v
+    return system.simulate((0.0, t1), [y[c] for c in coords], [yd[c] for c in coords],
                            parameters=dict(parameters or {}) or None,
-                           inputs=inputs or None, method=sim.method, rtol=sim.rtol,
-                           atol=sim.atol, t_eval=np.linspace(0.0, t1, n))
+                           inputs=laws or None, method=method or sim.method,
+                           rtol=sim.rtol if rtol is None else rtol,
+                           atol=sim.atol if atol is None else atol,
+                           t_eval=np.linspace(0.0, t1, n), progress=progress,
+                           output=None if output is None else str(output))
 
 
 def write_csv(results: Any, system: Any, path: Path) -> Path:

@@ -32,12 +32,28 @@ MAX_DISPLAY_ROWS = 12
 
 @dataclass
 class ReportInfo:
-    """What :func:`write_report` wrote: the HTML file, all files, and a short summary."""
+    """What :func:`write_report` wrote: the HTML file, all files, and a short summary;
+    ``status`` "complete", "interrupted" (Ctrl-C: what was computed is written) or "failed"
+    (the simulation failed: the motion up to the failure is written), ``message`` why."""
 
     html: Path
     files: list[Path] = field(default_factory=list)
     summary_lines: list[str] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
+    status: str = "complete"
+    message: str = ""
+
+
+#: the format tag of run.json, the manifest of a report folder
+RUN_FORMAT = "jourdain-run/1"
+
+
+def report_files(model: ModelFile) -> list[str]:
+    """The names of the files :func:`write_report` writes for ``model`` (the command line
+    refuses to overwrite them without ``--force``)."""
+    return ["report.html", "run.json", "model.toml", "equations.tex", "equations.json",
+            "values.json", *(f"linearization-{n.name}.json" for n in model.nominal),
+            "simulation.csv"]
 
 
 # ------------------------------------------------------------------------------------------
@@ -403,28 +419,16 @@ def _display_matrix(name: str, m: Any, system: Any, max_ops: int,
     return f'<div class="eq">{_math(f"<mrow>{_SYM[name]}<mo>=</mo>{inner}</mrow>")}</div>'
 
 
-def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | None = None,
-                 t_end: float | None = None, max_ops: int = export.MAX_DISPLAY_OPS
-                 ) -> ReportInfo:
-    """Compute everything for ``model`` and write ``out/report.html`` with the data files.
+def _sections(model: ModelFile, out: Path, params: dict[str, float], t_end: float | None,
+              max_ops: int, progress: Any, info: ReportInfo, sections: list[str],
+              ops: dict[str, int], summ: dict[str, Any], t_start: float) -> None:
+    """The sections of the report, each appended to ``sections`` when it is complete, with
+    their data files (so that an interruption leaves the sections finished before it)."""
+    from ..cli import EVAL_FORMAT, _json_array, evaluate_all, has_capability
 
-    Files: ``report.html``, ``model.toml`` (a copy of the input), ``equations.tex``,
-    ``equations.json`` (the matrices with shared temporaries), ``values.json`` (the numbers at
-    the initial state, the format of ``jourdain eval --json``), ``linearization-<name>.json``
-    per nominal motion, ``simulation.csv``.
-    """
-    from ..cli import EVAL_FORMAT, _json_array, evaluate_all, has_capability, summary
-
-    t_start = time.perf_counter()
     # one budget for simplifying every displayed matrix: the report must not wait on SymPy
     deadline = t_start + REPORT_SIMPLIFY_SECONDS
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
     system = model.system
-    params = dict(parameters or {})
-    info = ReportInfo(out / "report.html")
-    sections: list[str] = []
-    summ = summary(model)
     p = len(system.bodies)
 
     # --- the model ------------------------------------------------------------------------
@@ -433,7 +437,7 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
     pv = system.parameter_values
     pv.update(params)
     src = Path(model.path)
-    if src.is_file():
+    if src.is_file() and not (out / "model.toml").resolve() == src.resolve():
         shutil.copyfile(src, out / "model.toml")
         info.files.append(out / "model.toml")
     names = export.display_names(system)
@@ -470,7 +474,7 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
     from ..cli import _eom_matrices
 
     mats = _eom_matrices(system)
-    ops = {k: export.display_ops(m) for k, m in mats.items()}
+    ops.update({k: export.display_ops(m) for k, m in mats.items()})
     s = ["<h2>2. Newton–Euler equations and equations of motion</h2>",
          "<p>Newton–Euler equations of all bodies (translational rows in the inertial frame, "
          "rotational rows in each body frame about its centre of mass):</p>",
@@ -660,12 +664,25 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
     else:
         from . import capabilities
 
+        csv = out / "simulation.csv"
         try:
             t0 = time.perf_counter()
-            res = capabilities.simulate(model, params, t_end=t_end)
+            try:  # written as the run goes; a failed run keeps the motion up to the failure
+                res = capabilities.simulate(model, params, t_end=t_end, progress=progress,
+                                            output=csv)
+            except JourdainError as exc:
+                if getattr(exc, "results", None) is None or len(exc.results.t) < 2:
+                    raise
+                res = exc.results
+                info.status, info.message = "failed", f"the simulation failed: {exc}"
             wall = time.perf_counter() - t0
-            csv = capabilities.write_csv(res, system, out / "simulation.csv")
-            info.files.append(Path(csv))
+            info.files.append(csv)
+            if res.interrupted:
+                info.status, info.message = "interrupted", f"the simulation was {res.message}"
+            if res.status in ("interrupted", "failed"):
+                s.append(_note(f"{info.message}. The plots and simulation.csv hold the motion "
+                               f"up to t = {res.t[-1]:g} s."))
+                info.notes.append(f"simulation: {res.status} at t = {res.t[-1]:g} s")
             sim = model.simulation
             s.append(f"<p>t = 0 … {_num(res.t[-1])} s, method {_e(sim.method)}, rtol "
                      f"{sim.rtol:g}, atol {sim.atol:g}; {len(res.t)} output samples; "
@@ -714,9 +731,50 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
         except JourdainError as exc:
             s.append(_note(f"the simulation failed: {exc}"))
             info.notes.append(f"simulation: {exc}")
+            info.status, info.message = "failed", f"the simulation failed: {exc}"
+            if csv.is_file():  # the initial state, where the run failed at once
+                info.files.append(csv)
     sections.append("".join(s))
 
+
+def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | None = None,
+                 t_end: float | None = None, max_ops: int = export.MAX_DISPLAY_OPS,
+                 progress: Any = False) -> ReportInfo:
+    """Compute everything for ``model`` and write ``out/report.html`` with the data files.
+
+    Files: ``report.html``, ``model.toml`` (a copy of the input), ``equations.tex``,
+    ``equations.json`` (the matrices with shared temporaries), ``values.json`` (the numbers at
+    the initial state, the format of ``jourdain eval --json``), ``linearization-<name>.json``
+    per nominal motion, ``simulation.csv`` (written as the simulation goes; ``progress`` is
+    passed to it), ``run.json`` (``"format": "jourdain-run/1"``: how the run ended, ``status``
+    complete, interrupted or failed, and ``message``; the files and notes).
+
+    Ctrl-C stops the work: the sections finished before it are written (a simulation stops
+    where it is and its motion up to there is shown), and report.html, run.json and the header
+    of simulation.csv say that the run was interrupted (``info.status``). A simulation that
+    fails keeps its motion up to the failure (``info.status`` "failed").
+    """
+    from ..cli import summary
+
+    t_start = time.perf_counter()
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    system = model.system
+    info = ReportInfo(out / "report.html")
+    sections: list[str] = []
+    ops: dict[str, int] = {}
+    summ = summary(model)
+    try:
+        _sections(model, out, dict(parameters or {}), t_end, max_ops, progress, info,
+                  sections, ops, summ, t_start)
+    except KeyboardInterrupt:
+        info.status = "interrupted"
+        info.message = (f"interrupted by the user (Ctrl-C) after section {len(sections)} of "
+                        "5; the sections after it are missing")
+
     # --- files ----------------------------------------------------------------------------
+    info.files.insert(0, info.html)
+    info.files.insert(1, out / "run.json")
     files = "".join(f"<li><a href='{_e(f.name)}'>{_e(f.name)}</a></li>" for f in info.files)
     sections.append(f"<h2>6. Files</h2><ul>{files}</ul>")
     elapsed = time.perf_counter() - t_start
@@ -725,15 +783,24 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
     head = (f"<h1>{_e(system.name)}</h1><p class='meta'>jourdain {__version__} report of "
             f"{_e(model.path)}, {_dt.datetime.now().strftime('%Y-%m-%d %H:%M')}, "
             f"computed in {elapsed:.1f} s</p>")
+    if info.status != "complete":
+        head += f"<p class='bad'>{_e(info.status.capitalize())}: {_e(info.message)}.</p>"
     page = ("<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
             f"<meta name='viewport' content='width=device-width, initial-scale=1'>"
             f"<title>{_e(system.name)} — jourdain report</title><style>{_CSS}</style></head>"
             f"<body>{head}{''.join(sections)}</body></html>")
     info.html.write_text(page, encoding="utf-8")
-    info.files.insert(0, info.html)
-    info.summary_lines.insert(0, f"{system.name}: f = {system.f}, p = {p} bodies, "
-                                 f"{summ['constraints']} constrained directions; "
-                                 f"M·ÿ + k = q with {ops['M'] + ops['k'] + ops['q']} operations")
+    manifest = {"format": RUN_FORMAT, "model": system.name, "file": model.path,
+                "status": info.status, "message": info.message,
+                "files": [f.name for f in info.files], "notes": info.notes}
+    (out / "run.json").write_text(json.dumps(manifest, indent=1), encoding="utf-8")
+    count = (f" with {ops['M'] + ops['k'] + ops['q']} operations"
+             if all(k in ops for k in ("M", "k", "q")) else "")
+    info.summary_lines.insert(0, f"{system.name}: f = {system.f}, p = {len(system.bodies)} "
+                                 f"bodies, {summ['constraints']} constrained directions; "
+                                 f"M·ÿ + k = q{count}")
     for n in info.notes:
         info.summary_lines.append(f"  note: {n}")
+    if info.status != "complete":
+        info.summary_lines.append(f"  {info.status}: {info.message}")
     return info

@@ -225,16 +225,19 @@ class System:
 
     def simulate(self, t_span: tuple[float, float], y0: Any, yd0: Any,
                  parameters: Mapping[str, float] | None = None,
-                 inputs: Mapping[str, Any] | None = None, method: str = "DOP853",
-                 rtol: float = 1e-6, atol: Any = 1e-8, t_eval: Any = None,
+                 inputs: Mapping[str, Any] | None = None, method: str | None = None,
+                 rtol: float | None = None, atol: Any = None, t_eval: Any = None,
                  **options: Any) -> Any:
         """Integrate the equations of motion from ``y0, ẏ0`` over ``t_span``; returns a
         :class:`jourdain.results.Results` (see :func:`jourdain.simulate.simulate` for the
-        methods, inputs, events and options)."""
-        from ..simulate import simulate
+        methods, inputs, events and options). ``method``, ``rtol``, ``atol`` left out: the
+        defaults of :mod:`jourdain.simulate` (DOP853, 1e-8, 1e-10), the same as model files'."""
+        from ..simulate import DEFAULT_ATOL, DEFAULT_METHOD, DEFAULT_RTOL, simulate
 
         return simulate(self, t_span, y0, yd0, parameters=parameters, inputs=inputs,
-                        method=method, rtol=rtol, atol=atol, t_eval=t_eval, **options)
+                        method=DEFAULT_METHOD if method is None else method,
+                        rtol=DEFAULT_RTOL if rtol is None else rtol,
+                        atol=DEFAULT_ATOL if atol is None else atol, t_eval=t_eval, **options)
 
     def __repr__(self) -> str:
         return (f"System({self.name!r}: {len(self.bodies)} bodies, f={self.f}, "
