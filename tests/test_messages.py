@@ -50,3 +50,14 @@ def test_python_messages_name_the_joint_and_the_element_using_a_symbol():
                    inertia=jd.point_mass())
     with pytest.raises(jd.ModelError, match=r'force "gravity": undeclared symbol\(s\) \[\'g\'\]'):
         jd.System([q], [body], [jd.Gravity((0, -g, 0))])
+
+
+def test_parameters_given_to_evaluate_are_checked_like_the_defaults():
+    """A negative mass given at evaluation time is refused (it would give an indefinite M)."""
+    from jourdain.models import double_pendulum
+
+    s = double_pendulum()
+    assert s.evaluate([0.1, 0.2], [0.0, 0.0], parameters={"m2": 0.8})["M"][0, 0] > 0
+    with pytest.raises(jd.EvaluationError, match=r'with the parameters m2=-1: body "rod2": mass '
+                                                 r"must be a non-negative number"):
+        s.evaluate([0.1, 0.2], [0.0, 0.0], parameters={"m2": -1})

@@ -26,7 +26,8 @@ import numpy as np
 import symengine as se
 
 from ..cse import count_nodes
-from ..errors import EvaluationError, JourdainError, SingularMassMatrix
+from ..errors import EvaluationError, JourdainError, ModelError, SingularMassMatrix
+from ..model.bodies import check_values
 from ..reactions import joint_directions
 from ..symbolic import SymMatrix
 from .ccode import HEADER, argument_names, function_source
@@ -482,6 +483,13 @@ def parameter_vector(system: System, parameters: Mapping[str, float] | None) -> 
             if not math.isfinite(fv):
                 raise EvaluationError(f'parameter "{k}" = {v!r} is not finite')
             values[k] = fv
+        # the model's numbers must stay physical at the new values, as at the defaults (a
+        # negative mass would give a negative definite M without a word)
+        try:
+            check_values(system.bodies, values)
+        except ModelError as exc:
+            given = ", ".join(f"{k}={v}" for k, v in parameters.items())
+            raise EvaluationError(f"with the parameters {given}: {exc}") from None
     return np.array(list(values.values()), dtype=float)
 
 
