@@ -25,7 +25,7 @@ $(BIN)/.installed: pyproject.toml | $(BIN)/python
 	touch $@ $(BIN)/.installed-run
 
 run: $(BIN)/.installed-run
-	$(BIN)/jourdain run examples/double_pendulum.toml --out report/
+	$(BIN)/jourdain run examples/double_pendulum.toml --out report/ --force
 
 lint: $(BIN)/.installed
 	$(BIN)/ruff check src tests benchmarks

@@ -11,7 +11,7 @@ import numpy as np
 import symengine as se
 
 from ..errors import ModelError
-from .bodies import WORLD, Body
+from .bodies import WORLD, Body, check_values
 from .expressions import as_expr, free_names, t
 from .forces import (
     RESERVED,
@@ -307,6 +307,7 @@ def _validate(sys: System) -> None:
     driven_by: dict[str, str] = {}
     used_coords: set[str] = set()
     allowed_kin = set(y_names) | set(p_names) | {"t"}
+    defaults = dict(sys.parameters)
     for b in sys.bodies:
         j = b.joint
         if j.name in joint_names:
@@ -340,7 +341,8 @@ def _validate(sys: System) -> None:
         bad = mass_names - set(p_names)
         if bad:
             raise ModelError(f'body "{b.name}": mass data use undeclared symbol(s) {sorted(bad)}')
-        _check_mass(sys, b)
+        # mass data a rigid body can have, and joint frames and axes, at the default values
+        check_values([b], defaults)
     unused = [n for n in y_names if n not in used_coords]
     if unused:
         raise ModelError(f"coordinate(s) {unused} are not used by any joint")
@@ -407,26 +409,3 @@ def _check_axes(sys: System, b: Body) -> None:
             raise ModelError(f"{where} is the zero vector at the default parameter values")
 
 
-def _check_mass(sys: System, b: Body) -> None:
-    """Mass ≥ 0 and inertia symmetric positive semi-definite at the default parameter values."""
-    subs = {se.Symbol(k): v for k, v in sys.parameters}
-    try:
-        # one substitution for all ten numbers (each subs call converts the whole dict)
-        vals = se.DenseMatrix(10, 1, [b.mass, *(x for row in b.inertia for x in row)]).subs(subs)
-        m = float(vals[0])
-        I = np.array([float(vals[1 + k]) for k in range(9)]).reshape(3, 3)
-    except (RuntimeError, TypeError, ValueError) as exc:
-        raise ModelError(f'body "{b.name}": mass data do not evaluate to numbers: {exc}') from None
-    if not math.isfinite(m) or m < 0:
-        raise ModelError(f'body "{b.name}": mass must be a non-negative number, got {m}')
-    if not np.all(np.isfinite(I)):
-        raise ModelError(f'body "{b.name}": inertia tensor has non-finite entries')
-    ev = np.linalg.eigvalsh(0.5 * (I + I.T))
-    scale = max(1.0, float(np.abs(I).max()))
-    if ev.min() < -1e-12 * scale:
-        raise ModelError(
-            f'body "{b.name}": inertia tensor is not positive semi-definite '
-            f"(eigenvalues {np.array2string(ev, precision=4)})"
-        )
-    if m == 0 and np.abs(I).max() > 0:
-        raise ModelError(f'body "{b.name}": a massless body cannot have rotational inertia')
