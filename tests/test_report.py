@@ -127,3 +127,15 @@ def test_heavy_upright_equilibrium_is_not_reported_with_h_nonzero(tmp_path):
     html = (tmp_path / "out" / "report.html").read_text()
     assert "h ≠ 0" not in html
     assert "does not solve the equations of motion" not in html
+
+
+def test_report_equations_tex_is_the_compilable_fragment(report):
+    """equations.tex holds displayed equations with the column count of the widest matrix
+    (M̄ of two bodies has 12 columns), like ``jourdain eom --format latex``."""
+    from tests.test_display_output import _balanced
+
+    tex = (report / "equations.tex").read_text()
+    _balanced(tex)
+    body = [line for line in tex.splitlines() if line and not line.startswith("%")]
+    assert body[0] == "\\setcounter{MaxMatrixCols}{12}"
+    assert all(line.startswith("\\[ ") and line.endswith(" \\]") for line in body[1:])

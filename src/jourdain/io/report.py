@@ -504,12 +504,14 @@ def _sections(model: ModelFile, out: Path, params: dict[str, float], t_end: floa
     s.append("<p class='meta'>Operation counts after common-subexpression elimination: "
              + ", ".join(f"{k} {v}" for k, v in ops.items()) + ".</p>")
     sections.append("".join(s))
-    tex = [export.latex_comment(f"{system.name}: jourdain, {_dt.date.today().isoformat()}")]
+    # the same compilable fragment as jourdain eom --format latex (math delimiters, the
+    # column count of wide matrices); the model's name only in the comment line
     latex_names = {"M_bar": r"\bar{M}", "J_bar": r"\bar{J}", "q_c": r"\bar{q}^{c}",
                    "q_e": r"\bar{q}^{e}", "M": "M", "k": "k", "q": "q"}
-    for k, m in mats.items():
-        tex.append(f"{latex_names[k]} = {export.matrix_latex(m, system, max_ops, deadline)}\n")
-    (out / "equations.tex").write_text("\n".join(tex) + "\n", encoding="utf-8")
+    (out / "equations.tex").write_text(
+        export.latex_fragment(mats, latex_names, system,
+                              f"{system.name}: {_dt.date.today().isoformat()}", max_ops,
+                              deadline), encoding="utf-8")
     eqj = {"format": "jourdain-eom/1", "model": system.name,
            "coordinates": system.coordinate_names,
            "rates": [f"{c}_d" for c in system.coordinate_names],
