@@ -28,7 +28,7 @@ import symengine as se
 from ..cse import count_nodes
 from ..errors import EvaluationError, JourdainError, ModelError, SingularMassMatrix
 from ..model.bodies import check_values
-from ..reactions import joint_directions
+from ..reactions import joint_directions, reactions
 from ..symbolic import SymMatrix
 from .ccode import HEADER, argument_names, function_source
 from .diagnose import nonfinite_message
@@ -335,12 +335,10 @@ def _recursive(system: System, full: bool, extra_source: str = "",
             ne = eom.newton_euler
             mats = {"M_bar": ne.M_bar, "J_bar": ne.J_bar, "q_c": ne.q_c, "q_e": ne.q_e, **mats}
         if directions is not None:
-            from ..reactions import reactions
-
             mats["Q_bar"] = reactions(eom.newton_euler).Q_bar
         return lambdify(system, mats, extra_source)
-    template = ACCEL_TEMPLATE.replace("JD_F_VALUE", str(f)) if accel else None
-    units = recursive_units(system, full, directions, extra_source, template)
+    units = recursive_units(system, full, directions, extra_source,
+                            _accel_source(f) if accel else None)
     return _load(system, names, shapes, units, n_bodies=p)
 
 
@@ -373,22 +371,28 @@ def mkq_function(system: System) -> CompiledFunction:
     with ``jd_accel`` (ÿ = M⁻¹(q − k)) when f ≤ ACCEL_MAX_F: the symbolic projection's code
     with LDLᵀ for small graphs (:data:`SYMBOLIC_NODES`), else the recursion (its
     articulated-body ÿ where every coordinate belongs to one joint)."""
-    extra = (ACCEL_TEMPLATE.replace("JD_F_VALUE", str(system.f))
-             if system.f <= ACCEL_MAX_F else "")
     if system.f <= SYMBOLIC_MAX_F:
         eom = system.equations_of_motion()
         exprs = [*eom.M.entries(), *eom.k.entries(), *eom.q.entries()]
         if count_nodes(exprs, SYMBOLIC_NODES) <= SYMBOLIC_NODES:
-            return lambdify(system, {"M": eom.M, "k": eom.k, "q": eom.q}, extra_source=extra)
-    # the recursion's jd_accel: articulated bodies where they apply (O(f)), else LDLᵀ of M
-    return _recursive(system, full=False, accel=system.f <= ACCEL_MAX_F)
+            return lambdify(system, {"M": eom.M, "k": eom.k, "q": eom.q},
+                            extra_source=_accel_source(system.f))
+    return dynamics_function(system)
 
 
 @lru_cache(maxsize=32)
 def dynamics_function(system: System) -> CompiledFunction:
-    """Compiled recursion with ``M, k, q`` and :meth:`CompiledFunction.dynamics` (ÿ and every
-    joint wrench for a batch of states), memoized per system."""
-    return _recursive(system, full=False)
+    """Compiled recursion with ``M, k, q``, :meth:`CompiledFunction.dynamics` (ÿ and every
+    joint wrench for a batch of states) and the integrator's ``jd_accel`` (articulated bodies
+    where they apply, O(f), else LDLᵀ of M), memoized per system: one library serves
+    :func:`mkq_function` where it takes the recursion."""
+    return _recursive(system, full=False, accel=True)
+
+
+def _accel_source(f: int) -> str:
+    """The integrator's ``jd_accel`` by LDLᵀ of M for ``f`` coordinates ("" above ACCEL_MAX_F:
+    its work arrays live on the stack)."""
+    return ACCEL_TEMPLATE.replace("JD_F_VALUE", str(f)) if f <= ACCEL_MAX_F else ""
 
 
 # ÿ = M⁻¹(q − k) with the size known to the compiler, which unrolls the small loops and
