@@ -54,15 +54,6 @@ class IdentityMap(Generic[V]):
         _, rec = self._find(self._objects(key))
         return default if rec is None else rec[1]
 
-    def __contains__(self, key: Any) -> bool:
-        return self._find(self._objects(key))[1] is not None
-
-    def __getitem__(self, key: Any) -> V:
-        _, rec = self._find(self._objects(key))
-        if rec is None:
-            raise KeyError("object not in this IdentityMap")
-        return rec[1]
-
     def __setitem__(self, key: Any, value: V) -> None:
         objs = self._objects(key)
         self._items[tuple(map(id, objs))] = (objs, value)
@@ -87,10 +78,3 @@ class IdentityMap(Generic[V]):
 
     def values(self) -> Iterator[V]:
         return (v for _, v in self._items.values())
-
-    def items(self) -> Iterator[tuple[tuple[Any, ...], V]]:
-        """(objects of the key, value) in insertion order."""
-        return iter(self._items.values())
-
-    def __len__(self) -> int:
-        return len(self._items)

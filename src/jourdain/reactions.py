@@ -47,10 +47,10 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import symengine as se
 
-from .differentiate import evaluate_float
 from .errors import EvaluationError, JourdainError, ModelError
 from .kinematics import Z3, _add, _cross, _dot, _mm, _mtv, _mv, _scale
 from .model.bodies import WORLD
+from .model.expressions import values_at
 from .model.joints import IDENTITY, Joint, Mat3, Rot, Vec3, rotation_matrix
 from .newton_euler import NewtonEuler, joint_transform
 from .symbolic import SymMatrix
@@ -557,15 +557,12 @@ def _singular_rows(system: System) -> tuple[tuple[int, ...], dict[str, tuple[lis
     p = len(system.bodies)
     values = dict(system.parameters)
 
-    def num(x: se.Basic) -> float:  # the default value (only the symbols it has: O(1), not O(p))
-        return evaluate_float([x], values)[0]
-
     singular: list[int] = []
     inv: dict[str, tuple[list[int], Any]] = {}
     for i, b in enumerate(system.bodies):
         if b.mass == 0:
             singular.extend(range(3 * i, 3 * i + 3))
-        elif abs(num(b.mass)) == 0.0:
+        elif abs(values_at([b.mass], values)[0]) == 0.0:
             raise ModelError(f'body "{b.name}": its mass is zero at the default parameters but '
                              "not identically zero; write mass=0 for a massless body")
         I = b.inertia
@@ -574,7 +571,7 @@ def _singular_rows(system: System) -> tuple[tuple[int, ...], dict[str, tuple[lis
         singular.extend(3 * p + 3 * i + a for a in range(3) if a not in regular)
         if regular:
             sub = [[I[a][c] for c in regular] for a in regular]
-            Ir = np.array([[num(x) for x in r] for r in sub])
+            Ir = np.array(values_at([x for r in sub for x in r], values)).reshape(len(sub), -1)
             # |det| <= 1e-12·s^n, s = max(1, max|I|), tested as det(I/s): s^n overflows for
             # inertias above 1e102 (a mass of 1e300)
             s = max(1.0, float(np.abs(Ir).max()))
@@ -1005,6 +1002,13 @@ def _reactions_function(system: System) -> tuple[ReactionLayout, Any]:
     return lay, fn
 
 
+def check_reactions(system: System) -> None:
+    """The checks made before reaction forces are given in numbers: constrained directions
+    that can be formed, the joint-by-joint and the assembled orthogonality ``J̄ᵀ·Q̄ = 0``;
+    :class:`ModelError` naming the joint otherwise (no symbolic N̂ is formed)."""
+    _reactions_function(system)
+
+
 def projected_reactions(lay: ReactionLayout, M_bar: np.ndarray, Q_bar: np.ndarray,
                         q_c: np.ndarray, q_e: np.ndarray
                         ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -1035,7 +1039,8 @@ def projected_reactions(lay: ReactionLayout, M_bar: np.ndarray, Q_bar: np.ndarra
             B = np.linalg.solve(C, Q_bar[..., rows, :][..., :, cols])
             bc = np.linalg.solve(C, q_c[..., rows, None])[..., 0]
             be = np.linalg.solve(C, q_e[..., rows, None])[..., 0]
-            N[..., np.ix_(cols, cols)[0], np.ix_(cols, cols)[1]] += np.swapaxes(B, -1, -2) @ B
+            ix = np.ix_(cols, cols)
+            N[..., ix[0], ix[1]] += np.swapaxes(B, -1, -2) @ B
             kh[..., cols] += np.einsum("...rc,...r->...c", B, bc)
             qh[..., cols] += np.einsum("...rc,...r->...c", B, be)
     return 0.5 * (N + np.swapaxes(N, -1, -2)), kh, qh

@@ -41,7 +41,9 @@ from typing import TYPE_CHECKING
 
 import symengine as se
 
-from ..kinematics import joint_motions
+from ..kinematics import joint_motions, kinematics
+from ..model.forces import Gravity
+from ..newton_euler import applied_forces
 from .ccode import HEADER, argument_names, function_source
 
 if TYPE_CHECKING:
@@ -64,19 +66,11 @@ class RecursiveLayout:
     #: number of constrained directions of each joint (their wrenches follow the columns)
     directions: tuple[int, ...] = ()
 
-    @property
-    def n_columns(self) -> int:
-        return sum(len(c) for c in self.columns)
-
 
 def layout(system: System, directions: tuple | None = None) -> RecursiveLayout:
     """The local expressions of every joint and body, in the order of the C arrays;
     ``directions``: per body the unit wrenches of its joint's constrained directions
     (:func:`jourdain.reactions.joint_directions`), for Q̄."""
-    from ..kinematics import kinematics
-    from ..model.forces import Gravity
-    from ..newton_euler import applied_forces
-
     motions = joint_motions(system)
     index = {b.name: i for i, b in enumerate(system.bodies)}
     # the symbolic kinematics of every body is needed only for loads that depend on it
@@ -168,7 +162,8 @@ def recursive_source(system: System, full: bool = False, directions: tuple | Non
     size = ((36 * p * p + 6 * p * f + 12 * p if full else 0) + f * f + 2 * f
             + (6 * p * n_q if lay.directions else 0))
     head = (f"#define JD_P {p}\n#define JD_F {f}\n#define JD_NC {max(len(col_coord), 1)}\n"
-            f"#define JD_NL {len(lay.exprs)}\n#define JD_COLS {p * BODY_BLOCK}\n"
+            f"#define JD_NL {len(lay.exprs)}\n#define JD_BODY {BODY_BLOCK}\n"
+            f"#define JD_COLS {p * BODY_BLOCK}\n"
             f"#define JD_DIRS {p * BODY_BLOCK + COLUMN_BLOCK * len(col_coord)}\n"
             f"#define JD_SIZE {size}\n#define JD_FULL {1 if full else 0}\n"
             f"#define JD_Q {n_q}\n#define JD_QBAR {1 if lay.directions else 0}\n"
@@ -271,7 +266,7 @@ typedef struct {
 static void jd_recursion(const double *L, const double *yd, jd_work *W) {
     static const double I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, Z[3] = {0, 0, 0};
     for (int i = 0; i < JD_P; ++i) {
-        const double *b = L + i * 40;
+        const double *b = L + i * JD_BODY;
         const double *A = b, *d = b + 9, *wb = b + 12, *vb = b + 15, *abr = b + 18, *abl = b + 21;
         const double m = b[24], *com = b + 25, *In = b + 28, *fe = b + 34, *le = b + 37;
         int lam = jd_parent[i];
@@ -410,7 +405,7 @@ static void jd_newton_euler(const double *L, const jd_work *W, double *out) {
     for (long a = 0; a < n * n; ++a) Mb[a] = 0.0;
     for (long a = 0; a < n * JD_F; ++a) Jb[a] = 0.0;
     for (int i = 0; i < JD_P; ++i) {
-        const double *b = L + i * 40, *In = b + 28;
+        const double *b = L + i * JD_BODY, *In = b + 28;
         const double Is[9] = {In[0], In[1], In[2], In[1], In[3], In[4], In[2], In[4], In[5]};
         for (int a = 0; a < 3; ++a) {
             long rT = 3 * i + a, rR = 3 * JD_P + 3 * i + a;
@@ -449,7 +444,7 @@ static void jd_distribution(const double *L, const jd_work *W, double *Q) {
     const long n = 6 * JD_P;
     for (long a = 0; a < n * JD_Q; ++a) Q[a] = 0.0;
     for (int i = 0; i < JD_P; ++i) {
-        const double *b = L + i * 40, *A = b, *d = b + 9, *com = b + 25, *R = W->fr[i].R;
+        const double *b = L + i * JD_BODY, *A = b, *d = b + 9, *com = b + 25, *R = W->fr[i].R;
         int lam = jd_parent[i];
         for (int k = jd_dir_start[i]; k < jd_dir_start[i + 1]; ++k) {
             const double *F = L + JD_DIRS + 6 * k, *T = F + 3;
@@ -461,7 +456,7 @@ static void jd_distribution(const double *L, const jd_work *W, double *Q) {
                 Q[(3 * JD_P + 3 * i + a) * JD_Q + k] = T[a] - cF[a];
             }
             if (lam < 0) continue;
-            const double *comp = L + lam * 40 + 25;
+            const double *comp = L + lam * JD_BODY + 25;
             jd_mv(A, F, AF);
             jd_mv(A, T, AT);
             for (int a = 0; a < 3; ++a) arm[a] = d[a] - comp[a];
