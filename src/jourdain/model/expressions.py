@@ -21,17 +21,78 @@ Expr = se.Basic
 t = se.Symbol("t")
 
 
-def symbols(names: str) -> tuple[se.Symbol, ...] | se.Symbol:
-    """Create SymEngine symbols from a space- or comma-separated string of names.
+def symbols(names: str | Sequence[str], *, seq: bool = False
+            ) -> se.Symbol | tuple[se.Symbol, ...] | list[se.Symbol]:
+    """SymEngine symbols from a string of names, by SymPy's rules for ``sympy.symbols``.
+
+    Names are separated by commas and/or white space. The result is
+
+    - one ``Symbol`` for a string with exactly one name (``symbols("x")``, ``" x "``),
+    - a tuple for several names (``"x y"``, ``"x, y"``), for a trailing comma (``"x,"`` gives
+      ``(x,)``), for a range, and always with ``seq=True``;
+    - for a list or tuple of strings, a list or tuple of the results of each string.
+
+    Ranges: ``"x0:3"`` or ``"x:3"`` give ``(x0, x1, x2)`` (end excluded, start 0 by default);
+    ``"a:d"`` gives ``(a, b, c, d)`` (single letters, end included, as SymPy).
 
     >>> phi1, phi2 = symbols("phi1 phi2")
+    >>> m = symbols("m")
+    >>> (x,) = symbols("x", seq=True)
+
+    Raises
+    ------
+    ModelError
+        No name at all, a name that is not a Python identifier, or a range jourdain does not
+        read (several colons, ``"x(:2)"``).
     """
-    parts = [p for p in names.replace(",", " ").split() if p]
-    for p in parts:
-        if not p.isidentifier():
-            raise ModelError(f"symbol name {p!r} is not a valid identifier")
-    syms = tuple(se.Symbol(p) for p in parts)
-    return syms[0] if len(syms) == 1 else syms
+    if isinstance(names, (list, tuple)):
+        out = [symbols(n, seq=seq) for n in names]
+        return tuple(out) if isinstance(names, tuple) else out  # type: ignore[return-value]
+    if not isinstance(names, str):
+        raise ModelError(f"symbols: expected a string of names, got {type(names).__name__}")
+    text = names.strip()
+    if not text:
+        raise ModelError("symbols: no symbol names given")
+    many = seq or text.endswith(",")
+    parts = [p for chunk in text.split(",") for p in chunk.split()]
+    syms: list[se.Symbol] = []
+    for part in parts:
+        if ":" in part:
+            many = True
+            syms.extend(se.Symbol(n) for n in _range(part))
+            continue
+        _identifier(part, part)
+        syms.append(se.Symbol(part))
+    if not many and len(syms) == 1:
+        return syms[0]
+    return tuple(syms)
+
+
+def _identifier(name: str, where: str) -> None:
+    if not name.isidentifier():
+        raise ModelError(f"symbols: name {name!r} in {where!r} is not a valid identifier")
+
+
+def _range(part: str) -> list[str]:
+    """The names of a range ``prefix[start]:end`` (numbers, end excluded) or ``a:d`` (letters,
+    end included), as in SymPy."""
+    head, _, end = part.partition(":")
+    if ":" in end or "(" in part or ")" in part:
+        raise ModelError(f"symbols: range {part!r} is not supported; write one range such as "
+                         "'x0:3' or 'a:d' per name")
+    if (len(head) == 1 and len(end) == 1 and head.isalpha() and end.isalpha()
+            and head.isascii() and end.isascii()):
+        names = [chr(c) for c in range(ord(head), ord(end) + 1)]
+    else:
+        digits = len(head) - len(head.rstrip("0123456789"))
+        prefix, start = (head[:-digits], head[-digits:]) if digits else (head, "0")
+        if not prefix or not end.isdigit():
+            raise ModelError(f"symbols: range {part!r} must read 'name:end', "
+                             "'name<start>:<end>' with whole numbers, or 'a:d' (letters)")
+        names = [f"{prefix}{i}" for i in range(int(start), int(end))]
+    for n in names:
+        _identifier(n, part)
+    return names
 
 
 def as_expr(value: object, where: str) -> Expr:
