@@ -17,8 +17,10 @@ from .analysis import (
     modes,
     stability,
     stability_boundary,
+    state_feedback,
     state_space,
     sweep,
+    to_control,
 )
 from .energy import Energy, energy
 from .equilibrium import Equilibrium, NoEquilibrium, find_equilibria, find_equilibrium
@@ -96,7 +98,8 @@ __all__ = [
     "NominalMotionWarning", "NumericLinearization",
     "TimeVariantError", "linearization", "linearization_general", "linearize_numeric",
     "FrequencyResponse", "Modes", "Stability", "StateSpace", "Sweep", "frequency_response",
-    "modes", "stability", "stability_boundary", "state_space", "sweep",
+    "modes", "stability", "stability_boundary", "state_space", "sweep", "state_feedback",
+    "to_control",
     "Equilibrium", "NoEquilibrium", "find_equilibria", "find_equilibrium",
     "JointReactions", "Reactions", "evaluate_reactions", "joint_reactions", "reactions",
     "Results", "Event", "IntegrationError", "simulate", "Energy", "energy",

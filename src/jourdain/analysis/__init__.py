@@ -1,5 +1,6 @@
 """Analysis of linearized systems: state space, eigenvalues and modes, stability, frequency
-response, parameter sweeps (METHOD.md §6)."""
+response, parameter sweeps (METHOD.md §6); python-control systems and state feedback
+(:mod:`.python_control`)."""
 
 from .frequency import FrequencyResponse, frequency_response
 from .modes import (
@@ -11,11 +12,13 @@ from .modes import (
     modes,
     stability,
 )
+from .python_control import MissingDependency, state_feedback, to_control
 from .state_space import StateSpace, state_space
 from .sweep import Sweep, stability_boundary, sweep
 
 __all__ = [
-    "ASYMPTOTICALLY_STABLE", "MARGINALLY_STABLE", "UNSTABLE", "FrequencyResponse", "Modes",
-    "Stability", "StateSpace", "Sweep", "frequency_response", "modes", "stability",
-    "stability_boundary", "state_space", "sweep",
+    "ASYMPTOTICALLY_STABLE", "MARGINALLY_STABLE", "UNSTABLE", "FrequencyResponse",
+    "MissingDependency", "Modes", "Stability", "StateSpace", "Sweep", "frequency_response",
+    "modes", "stability", "stability_boundary", "state_feedback", "state_space", "sweep",
+    "to_control",
 ]

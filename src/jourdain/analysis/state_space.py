@@ -9,7 +9,7 @@ M̃ is factored numerically (Cholesky), never inverted symbolically.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -74,6 +74,13 @@ class StateSpace:
     @property
     def f(self) -> int:
         return len(self.coordinate_names)
+
+    def to_control(self, outputs: Sequence[str] | None = None, name: str | None = None) -> Any:
+        """This system as a named ``control.StateSpace`` (python-control, the extra
+        ``jourdain[control]``); see :func:`jourdain.analysis.python_control.to_control`."""
+        from .python_control import to_control
+
+        return to_control(self, outputs=outputs, name=name)
 
 
 def numbers(lin: AnyLinearization, t: float | None = None,
