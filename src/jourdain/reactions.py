@@ -572,9 +572,10 @@ def _singular_rows(system: System) -> tuple[tuple[int, ...], dict[str, tuple[lis
         if regular:
             sub = [[I[a][c] for c in regular] for a in regular]
             Ir = np.array(values_at([x for r in sub for x in r], values)).reshape(len(sub), -1)
-            # |det| <= 1e-12·s^n, s = max(1, max|I|), tested as det(I/s): s^n overflows for
-            # inertias above 1e102 (a mass of 1e300)
-            s = max(1.0, float(np.abs(Ir).max()))
+            # |det| <= 1e-12·s^n, s = max|I|, tested as det(I/s): s^n overflows for inertias
+            # above 1e102 (a mass of 1e300), and a floor of 1 on s made the small, regular
+            # inertias of real robot links (1e-6 kg m², det 1e-18) count as singular
+            s = float(np.abs(Ir).max()) or 1.0
             if abs(np.linalg.det(Ir / s)) <= 1e-12:
                 raise ModelError(
                     f'body "{b.name}": its inertia tensor is singular, but not along body axes '
