@@ -602,7 +602,7 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
     f = system.f
     n = 2 * f + 1
     nev = len(setup.events)
-    st = np.array([t0, 0.0, 0.0])  # t, step size, last trial rejected (1.0)
+    st = np.array([t0, 0.0, 0.0, 0.0])  # t, step size, last trial rejected, last error
     x = x0.copy()
     k0 = np.zeros(n)
     g_old = np.zeros(max(nev, 1))
