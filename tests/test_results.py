@@ -95,22 +95,23 @@ def test_csv_round_trip_readable_by_csv_module(tmp_path):
 def test_plots_have_labelled_axes(run):
     _, res = run
     ax = res.plot()
-    assert ax.get_xlabel() == "t [s]" and ax.get_ylabel() == "coordinates [rad]"
-    assert ax.get_legend().get_texts()[0].get_text() == "phi [rad]"
+    assert ax.get_xlabel() == "t / s" and ax.get_ylabel() == "phi / rad"
+    assert ax.get_legend().get_texts()[0].get_text() == "phi / rad"
     ax = res.plot("yd")
-    assert ax.get_ylabel() == "rates [rad/s]"
+    assert ax.get_ylabel() == "phi_d / (rad/s)"
     ax = res.plot("energy")
-    assert ax.get_ylabel() == "energy [J]"
+    assert ax.get_ylabel() == "energy / J"
     ax = res.plot_phase("phi")
-    assert ax.get_xlabel() == "phi [rad]" and ax.get_ylabel() == "phi_d [rad/s]"
+    assert ax.get_xlabel() == "phi / rad" and ax.get_ylabel() == "phi_d / (rad/s)"
     with pytest.raises(jd.EvaluationError, match="unknown coordinate"):
         res.plot_phase("theta")
     ax = res.plot("g")
-    assert [t.get_text() for t in ax.get_legend().get_texts()][:2] == ["pivot.F_x", "pivot.F_y"]
+    assert [t.get_text() for t in ax.get_legend().get_texts()][:2] == ["pivot.F_x / N",
+                                                                       "pivot.F_y / N"]
     ax = res.plot_path("bob", "xy", point="com")
     x, y = ax.get_lines()[0].get_data()
     np.testing.assert_allclose(np.hypot(x, y), 0.8, rtol=1e-12)  # on the circle of radius l
-    assert ax.get_xlabel() == "x [m]"
+    assert ax.get_xlabel() == "x / m"
 
 
 def test_conservative_run_reports_drift(run):

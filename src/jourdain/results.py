@@ -5,9 +5,11 @@ HDFView, ...)::
 
     /            attributes: format = "jourdain-results", version = 1, system, method, rtol,
                  status, message, coordinates, inputs (JSON lists of names), parameters,
-                 units (JSON objects), nfev, nsteps, wall_time
+                 units (JSON objects; units: the declared units and the derived ones of the
+                 coordinates and inputs), nfev, nsteps, wall_time
     /t           (N,)    time [s]
-    /y           (N, f)  coordinates, columns named by the attribute "columns"
+    /y           (N, f)  coordinates, columns named by the attribute "columns", their units
+                         by "units" (JSON list; a string on t, W, T, V: jourdain.units)
     /yd, /ydd    (N, f)  rates and accelerations
     /u           (N, nu) inputs
     /W           (N,)    work of the generalized applied forces q since t0
@@ -20,7 +22,8 @@ complete layout replaces it when the run ends, so a crashed run leaves a readabl
 
 CSV (``.csv``): one header line of column names (``t, <y>, <y>_d, <y>_dd, <inputs>, W, T, V``)
 after comment lines starting with ``#`` that hold the metadata (``status``: finished, event,
-interrupted, failed; ``message``: what happened and, for a run cut short, where it ends). A run
+interrupted, failed; ``message``: what happened and, for a run cut short, where it ends;
+``column_units``: a JSON list of the columns' units, ``""`` where unknown). A run
 that writes as it goes appends rows ``t, <y>, <y>_d, W`` under ``status: running``; the complete
 file replaces them when the run ends. Both formats are written to a temporary file beside the
 target and renamed over it: an interruption while saving leaves the previous file whole.
@@ -51,6 +54,15 @@ import numpy as np
 import symengine as se
 
 from .errors import EvaluationError, JourdainError
+from .units import (
+    axis_label,
+    base_units,
+    energy_unit,
+    model_units,
+    per_time,
+    shared_label,
+    unit_of,
+)
 
 if TYPE_CHECKING:
     from .model.system import System
@@ -173,7 +185,9 @@ class Results:
                                      else system.coordinate_names)  # type: ignore[union-attr]
         self.input_names = list(input_names if input_names is not None
                                 else system.input_names)  # type: ignore[union-attr]
-        self.units = dict(units if units is not None else dict(system.units))  # type: ignore[union-attr]
+        # declared units with the derived ones of coordinates and inputs (jourdain.units)
+        self.units = dict(units if units is not None
+                          else model_units(system))  # type: ignore[arg-type]
         self.name = name if name is not None else (system.name if system else "")
         self._energies = dict(energies or {})
 
@@ -466,8 +480,10 @@ class Results:
         try:
             if suffix == ".csv":
                 cols, data = self._columns()
+                meta = {**self._meta(),
+                        "column_units": json.dumps([self.unit(c) for c in cols])}
                 with open(tmp, "w", encoding="utf-8") as fh:
-                    fh.write(_csv_header(self._meta(), cols))
+                    fh.write(_csv_header(meta, cols))
                     np.savetxt(fh, data, delimiter=",", fmt="%.17g")
             else:
                 self._save_h5(tmp)
@@ -490,6 +506,7 @@ class Results:
                                     ("u", self.u, self.input_names)):
                 h[name] = arr
                 h[name].attrs["columns"] = json.dumps(cols)
+                h[name].attrs["units"] = json.dumps([self.unit(c) for c in cols])
             h["W"] = self.W
             if self.system is not None or "T" in self._energies:
                 try:
@@ -497,6 +514,9 @@ class Results:
                     h["V"] = self.potential_energy
                 except JourdainError:
                     pass
+            for name in ("t", "W", "T", "V"):  # one unit for a column of its own
+                if name in h:
+                    h[name].attrs["units"] = self.unit(name)
             grp = h.create_group("events")
             for name, ev in self.events.items():
                 g = grp.create_group(name.replace("/", "_"))
@@ -542,16 +562,21 @@ class Results:
                    energies=energies, name=str(a["system"]))
 
     # --- plots ----------------------------------------------------------------------------
+    def unit(self, name: str) -> str:
+        """The unit of a column: ``t``, a coordinate, ``<coordinate>_d``, ``_dd``, an input,
+        ``T``, ``V``, ``W``, a reaction component ``<joint>.F_x`` / ``.T_x``; ``""`` where
+        unknown (:func:`jourdain.units.unit_of`)."""
+        return unit_of(name, self.units, self.coordinate_names)
+
+    def label(self, name: str) -> str:
+        """``name / unit`` for an axis or a legend (``phi1_d / (rad/s)``)."""
+        return axis_label(name, self.unit(name))
+
     def _unit(self, name: str, order: int = 0) -> str:
-        u = self.units.get(name)
-        if u is None:
-            return ""
-        return u + ("" if order == 0 else "/s" if order == 1 else "/s^2")
+        return per_time(self.units.get(name, ""), order)
 
     def _label(self, name: str, order: int) -> str:
-        sym = name + ("" if order == 0 else "_d" if order == 1 else "_dd")
-        unit = self._unit(name, order)
-        return f"{sym} [{unit}]" if unit else sym
+        return self.label(name + ("" if order == 0 else "_d" if order == 1 else "_dd"))
 
     def plot(self, what: str = "y", coordinates: Sequence[str] | None = None, ax: Any = None
              ) -> Any:
@@ -578,15 +603,14 @@ class Results:
                                           f"{self.coordinate_names}")
                 ax.plot(tp, arr[:, self.coordinate_names.index(n)],
                         label=self._label(n, order))
-            units = {self._unit(n, order) for n in names}
-            ylabel = ["coordinates", "rates", "accelerations"][order]
-            if len(units) == 1 and "" not in units:
-                ylabel += f" [{units.pop()}]"
-            ax.set_ylabel(ylabel)
+            suffix = ("", "_d", "_dd")[order]
+            ax.set_ylabel(shared_label([(n + suffix, self._unit(n, order)) for n in names],
+                                       ["coordinates", "rates", "accelerations"][order]))
         elif what == "u":
             for i, n in enumerate(self.input_names):
-                ax.plot(self.t, self.u[:, i], label=n)
-            ax.set_ylabel("inputs")
+                ax.plot(self.t, self.u[:, i], label=self.label(n))
+            ax.set_ylabel(shared_label([(n, self.unit(n)) for n in self.input_names],
+                                       "inputs"))
         elif what == "energy":
             tp, T, V, W_nc, W_drive = self._energies_to_plot()
             ax.plot(tp, T, label="T (kinetic)")
@@ -595,14 +619,16 @@ class Results:
             ax.plot(tp, W_nc, label="W_nc (non-conservative work)")
             if self.system is not None and self.rheonomic:
                 ax.plot(tp, W_drive, label="W_drive (work of the prescribed motion)")
-            ax.set_ylabel("energy [J]")
+            ax.set_ylabel(axis_label("energy", energy_unit(self.units)))
         elif what == "g":
             for i, n in enumerate(self.g_names):
-                ax.plot(self.t, self.g[:, i], label=n)
-            ax.set_ylabel("reaction forces g [N, N·m]")
+                ax.plot(self.t, self.g[:, i], label=self.label(n))
+            ax.set_ylabel(shared_label(
+                [("forces" if n.rsplit(".", 1)[-1].startswith("F") else "torques", self.unit(n))
+                 for n in self.g_names], "reaction forces g"))
         else:
             raise EvaluationError(f"plot: what must be y, yd, ydd, u, energy or g, got {what!r}")
-        ax.set_xlabel("t [s]")
+        ax.set_xlabel(self.label("t"))
         ax.set_title(self.name)
         ax.legend()
         ax.grid(True)
@@ -646,11 +672,11 @@ class Results:
         i, j = ("xyz".index(plane[0]), "xyz".index(plane[1]))
         if ax is None:
             _, ax = plt.subplots()
-        unit = self.units.get("length", "m")
+        unit = base_units(self.units)[1]
         ax.plot(r[:, i], r[:, j], label=f"{body} ({point})")
         ax.plot(r[:1, i], r[:1, j], "o", label="start")
-        ax.set_xlabel(f"{plane[0]} [{unit}]")
-        ax.set_ylabel(f"{plane[1]} [{unit}]")
+        ax.set_xlabel(axis_label(plane[0], unit))
+        ax.set_ylabel(axis_label(plane[1], unit))
         ax.set_aspect("equal", adjustable="datalim")
         ax.set_title(f"{self.name}: path of {body}")
         ax.legend()
@@ -786,7 +812,7 @@ class _PartialCsv:
                            "(t, y, ẏ, W)",
                 "coordinates": json.dumps(names), "inputs": json.dumps(system.input_names),
                 "parameters": json.dumps(system.parameter_values),
-                "units": json.dumps(dict(system.units)), "nfev": 0, "nsteps": 0,
+                "units": json.dumps(model_units(system)), "nfev": 0, "nsteps": 0,
                 "wall_time": 0.0}
         self.fh = open(path, "w", encoding="utf-8")  # noqa: SIM115 - closed by close()
         self.fh.write(_csv_header(meta, ["t", *names, *(f"{n}_d" for n in names), "W"]))
@@ -817,7 +843,7 @@ def open_incremental(path: str | Path, system: System) -> Any:
     h.attrs["coordinates"] = json.dumps(system.coordinate_names)
     h.attrs["inputs"] = json.dumps(system.input_names)
     h.attrs["parameters"] = json.dumps(system.parameter_values)
-    h.attrs["units"] = json.dumps(dict(system.units))
+    h.attrs["units"] = json.dumps(model_units(system))
     for k, v in (("method", ""), ("rtol", float("nan")), ("nfev", 0), ("nsteps", 0),
                  ("wall_time", 0.0)):
         h.attrs[k] = v
