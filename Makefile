@@ -8,7 +8,7 @@ PYTHON ?= python3
 VENV   ?= .venv
 BIN    := $(VENV)/bin
 
-.PHONY: run test lint clean browser bench
+.PHONY: run test lint clean browser bench viewer-assets
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -61,6 +61,11 @@ bench: $(BIN)/.installed
 	$(BIN)/python benchmarks/crosscheck.py --n 3 --tree 3 --states 1
 	$(BIN)/python benchmarks/scaling.py --quick
 	$(BIN)/python benchmarks/per_state.py --quick
+
+# the 3-D view's three.js bundle (src/jourdain/io/viewer/three_bundle.js, committed): rebuilt from
+# the npm versions pinned in tools/viewer/package-lock.json; needs node and npm, nothing else does
+viewer-assets:
+	tools/build_viewer.sh
 
 clean:
 	rm -rf $(VENV) .pytest_cache .ruff_cache .jourdain-test-cache

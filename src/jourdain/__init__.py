@@ -32,6 +32,7 @@ from .errors import (
     SingularMassMatrix,
 )
 from .io import ModelFile, ModelFileError, load_model
+from .io.viewer import MeshVisual, View, view
 from .kinematics import BodyKinematics, Kinematics, kinematics
 from .linearization import (
     CompiledLinearization,
@@ -91,7 +92,7 @@ __version__ = "0.1.0"
 __all__ = [
     "atan2", "cos", "exp", "log", "pi", "sin", "sqrt", "tan",
     "EvaluationError", "JourdainError", "JourdainWarning", "ModelError", "SingularMassMatrix",
-    "ModelFile", "ModelFileError", "load_model",
+    "ModelFile", "ModelFileError", "load_model", "MeshVisual", "View", "view",
     "BodyKinematics", "Kinematics", "kinematics", "NewtonEuler", "newton_euler",
     "EquationsOfMotion", "projection", "SymMatrix",
     "CompiledLinearization", "GeneralLinearization", "Linearization", "NominalCheck",
