@@ -160,8 +160,11 @@ def test_stability_verdicts():
     cart = jd.Body("cart", "world", jd.Prismatic("slider", x, "x"), mass=m,
                    inertia=jd.point_mass())
     free = jd.System([x], [cart], [], parameters={"m": 1.0})
-    st = jd.stability(free.linearize({"x": 0}))
+    st = jd.stability(free.linearize({"x": 0}), cyclic=())
     assert st.verdict == "unstable" and "linearly" in st.reason
+    # ... but x is cyclic: in Routh's sense (the default) its momentum ẋ is judged, not x
+    st = jd.stability(free.linearize({"x": 0}))
+    assert st.verdict == "marginally stable" and st.cyclic == ("x",), st.reason
     # two identical uncoupled oscillators: a repeated, semisimple pair on the axis
     y1, y2 = jd.symbols("y1 y2")
     b1 = jd.Body("b1", "world", jd.Prismatic("s1", y1, "x"), mass=m, inertia=jd.point_mass())

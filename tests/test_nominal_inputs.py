@@ -40,8 +40,11 @@ def test_steady_rotation_needs_the_motor_torque():
     np.testing.assert_allclose(check.h, [-D * OMEGA], rtol=1e-14)
     assert check.holding_inputs == pytest.approx({"tau": D * OMEGA}, rel=1e-14)
     with pytest.warns(NominalMotionWarning):
-        st = jd.stability(lin)
+        st = jd.stability(lin, cyclic=())
     assert st.verdict == jd.analysis.MARGINALLY_STABLE  # the linear system itself
+    with pytest.warns(NominalMotionWarning):
+        routh = jd.stability(lin)  # phi is cyclic: its rate returns to Omega (λ = −d/J)
+    assert routh.verdict == jd.analysis.ASYMPTOTICALLY_STABLE and routh.cyclic == ("phi",)
     assert st.nominal_is_solution is False and "WARNING" in st.reason and "tau" in st.reason
 
     d = jd.symbols("d")

@@ -209,7 +209,19 @@ def summary(model: Any) -> dict[str, Any]:
         "parameters": system.parameter_values, "inputs": system.input_names,
         "forces": [{"name": f.name, "type": type(f).__name__} for f in system.forces],
         "nominal_motions": [n.name for n in model.nominal],
+        "cyclic_coordinates": list(_cyclic(system)),
     }
+
+
+def _cyclic(system: Any) -> tuple[str, ...]:
+    """The cyclic coordinates (in no equation, only their rates), where the equations of
+    motion can be formed."""
+    from .analysis.cyclic import cyclic_coordinates
+
+    try:
+        return cyclic_coordinates(system)
+    except JourdainError:
+        return ()
 
 
 def _step_exprs(step: Any) -> set[Any]:
@@ -313,6 +325,9 @@ def cmd_check(args: argparse.Namespace) -> int:
           + ", ".join(f"{k} = {v:g}" for k, v in s["parameters"].items()))
     if s["nominal_motions"]:
         print("  nominal motions: " + ", ".join(s["nominal_motions"]))
+    if s["cyclic_coordinates"]:
+        print(f"  cyclic coordinates: {', '.join(s['cyclic_coordinates'])} (in no equation, only "
+              "their rates; stability verdicts are taken in Routh's sense without them)")
     return EXIT_OK
 
 

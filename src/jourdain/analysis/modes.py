@@ -11,6 +11,11 @@ imaginary axis are semisimple (as many independent eigenvectors as their multipl
 flutter) or a repeated eigenvalue on the imaginary axis with too few eigenvectors (secular,
 linearly growing motion, e.g. a free rigid-body coordinate).
 
+Cyclic coordinates (:mod:`jourdain.analysis.cyclic`: they appear in no equation, only their
+rates) drift along a family of steady motions; for a linearization the verdict is taken, in
+Routh's sense, on the reduced system without their positions, and says which coordinates were
+treated so (``Stability.cyclic``; ``cyclic=()`` asks for the full system).
+
 The verdict is about the linear system. Where the nominal motion it came from is an equilibrium
 or a steady motion that does not solve the equations of motion (``h ≠ 0``,
 :class:`jourdain.linearization.NominalCheck`), the reason says so and a
@@ -19,13 +24,14 @@ or a steady motion that does not solve the equations of motion (``h ≠ 0``,
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ..errors import warn
 from ..linearization import NominalMotionWarning
+from .cyclic import check_cyclic, cyclic_coordinates, reduced_matrix
 from .state_space import AnyLinearization, StateSpace, state_space
 
 ASYMPTOTICALLY_STABLE = "asymptotically stable"
@@ -118,7 +124,8 @@ class Stability:
     solution); ``max_real_part`` is the largest real part of the eigenvalues; ``critical`` the
     eigenvalues that decide the verdict; ``nominal_is_solution`` whether the equilibrium or
     steady motion linearized about solves the equations of motion (``h = 0``; None where not
-    known or for other nominal motions).
+    known or for other nominal motions); ``cyclic`` the coordinates treated as cyclic (Routh:
+    the verdict is on the reduced system without their positions; empty for the full system).
     """
 
     verdict: str
@@ -126,6 +133,7 @@ class Stability:
     max_real_part: float
     critical: np.ndarray
     nominal_is_solution: bool | None = None
+    cyclic: tuple[str, ...] = ()
 
     @property
     def is_stable(self) -> bool:
@@ -170,11 +178,22 @@ def modes(system: StateSpace | AnyLinearization, t: float | None = None,
 
 
 def stability(system: StateSpace | AnyLinearization, t: float | None = None,
-              parameters: Mapping[str, float] | None = None, rtol: float = ZERO_RTOL) -> Stability:
+              parameters: Mapping[str, float] | None = None, rtol: float = ZERO_RTOL,
+              cyclic: Sequence[str] | None = None) -> Stability:
     """Stability verdict with its reason (see the module docstring for the definitions).
 
     ``rtol`` is the relative tolerance (to the largest |λ|, at least 1) below which a real part
-    counts as zero.
+    counts as zero. ``cyclic``: the coordinates to treat as cyclic in Routh's sense (the verdict
+    is then on the reduced state matrix, :func:`jourdain.analysis.cyclic.reduced_matrix`);
+    None (the default) finds them for a linearization
+    (:func:`jourdain.analysis.cyclic.cyclic_coordinates`) and treats none for a
+    :class:`StateSpace`; ``()`` judges the full system.
+
+    Raises
+    ------
+    EvaluationError
+        A name in ``cyclic`` that is not a coordinate, or one whose position acts on the motion
+        (its column of A is not zero).
 
     Warns
     -----
@@ -183,20 +202,32 @@ def stability(system: StateSpace | AnyLinearization, t: float | None = None,
         (:attr:`StateSpace.nominal_check`); the reason ends with the same warning.
     """
     ss = _as_state_space(system, t, parameters)
-    st = _verdict(ss, rtol)
+    if cyclic is None:
+        cyclic = () if isinstance(system, StateSpace) else _cyclic_of(system)
+    names = check_cyclic(ss.A, ss.coordinate_names, cyclic)
+    st = _verdict(reduced_matrix(ss.A, ss.coordinate_names, names) if names else ss.A, rtol)
+    if names:
+        st = replace(st, cyclic=names, reason=(
+            f"{st.reason}; in Routh's sense, on the reduced system without the position(s) of "
+            f"the cyclic coordinate(s) {', '.join(names)} (they appear in no equation, only "
+            "their rates: their drift is left out, their rates are judged)"))
     check = ss.nominal_check
     if check is None or check.kind == "nominal motion":
         return st
     if check.is_solution:
-        return Stability(st.verdict, st.reason, st.max_real_part, st.critical, True)
+        return replace(st, nominal_is_solution=True)
     message = check.message()
     warn(message, NominalMotionWarning)
-    return Stability(st.verdict, f"{st.reason}. WARNING: {message}", st.max_real_part,
-                     st.critical, False)
+    return replace(st, reason=f"{st.reason}. WARNING: {message}", nominal_is_solution=False)
 
 
-def _verdict(ss: StateSpace, rtol: float) -> Stability:
-    A = ss.A
+def _cyclic_of(lin: AnyLinearization) -> tuple[str, ...]:
+    base = lin.linearization if hasattr(lin, "linearization") else lin
+    eom = getattr(base, "equations_of_motion", None)
+    return cyclic_coordinates(eom if eom is not None else base.system)
+
+
+def _verdict(A: np.ndarray, rtol: float) -> Stability:
     lam = np.linalg.eigvals(A)
     n = lam.size
     scale = max(1.0, float(np.abs(lam).max(initial=0.0)))

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..errors import EvaluationError
 from ..linearization import CompiledLinearization, Linearization
-from .modes import ASYMPTOTICALLY_STABLE, UNSTABLE, stability
+from .modes import ASYMPTOTICALLY_STABLE, UNSTABLE, _cyclic_of, stability
 from .state_space import _from_numbers, _linearization_of, numbers, state_space
 
 
@@ -60,11 +60,13 @@ def sweep(lin: Linearization | CompiledLinearization, parameter: str,
           values: Sequence[float] | np.ndarray, t: float = 0.0,
           parameters: Mapping[str, float] | None = None) -> Sweep:
     """Eigenvalues and stability verdicts over ``values`` of ``parameter`` (other parameters at
-    their defaults, overridden by ``parameters``)."""
+    their defaults, overridden by ``parameters``); the verdicts in Routh's sense where the
+    system has cyclic coordinates (:func:`jourdain.analysis.stability`)."""
     base = _linearization_of(lin)
     _check_parameter(base, parameter)
     vals = np.asarray(values, dtype=float).reshape(-1)
     state_space(lin, t, parameters)  # refuses time-variant results with a clear message
+    cyclic = _cyclic_of(lin)
     eigs, maxre, verdicts = [], [], []
     for v in vals:
         pars = {**(parameters or {}), parameter: float(v)}
@@ -72,7 +74,7 @@ def sweep(lin: Linearization | CompiledLinearization, parameter: str,
         lam = np.linalg.eigvals(ss.A)
         eigs.append(lam[np.lexsort((lam.real, lam.imag))])
         maxre.append(float(lam.real.max()))
-        verdicts.append(stability(ss).verdict)
+        verdicts.append(stability(ss, cyclic=cyclic).verdict)
     return Sweep(parameter, vals, np.array(eigs), np.array(maxre), tuple(verdicts))
 
 
@@ -96,10 +98,11 @@ def stability_boundary(lin: Linearization | CompiledLinearization, parameter: st
     def analyse(v: float) -> tuple[str, float]:
         pars = {**(parameters or {}), parameter: float(v)}
         ss = _from_numbers(base, numbers(lin, t, pars), float(t), pars)
-        st = stability(ss)
+        st = stability(ss, cyclic=cyclic)
         return st.verdict, st.max_real_part
 
     state_space(lin, t, parameters)
+    cyclic = _cyclic_of(lin)
     a, b = float(lower), float(upper)
     va, vb = analyse(a)[0], analyse(b)[0]
     ua, ub = va == UNSTABLE, vb == UNSTABLE

@@ -108,9 +108,12 @@ def linear_analysis(model: ModelFile, about: str | None,
 
 def _analyse(lin: Any, num: dict[str, np.ndarray], check: Any,
              params: Mapping[str, float] | None, t: float) -> dict[str, Any]:
+    from ..analysis.cyclic import cyclic_coordinates
+
     res: dict[str, Any] = {"linearization": lin, "numbers": num, "nominal_check": check,
                            "time_invariant": lin.is_time_invariant, "t": t,
-                           "h_norm": float(np.abs(num["h"]).max(initial=0.0))}
+                           "h_norm": float(np.abs(num["h"]).max(initial=0.0)),
+                           "cyclic": cyclic_coordinates(lin.equations_of_motion)}
     res["conservative"] = None
     res["modes"] = res["stability"] = None
     res["numerically_time_invariant"] = False
@@ -135,7 +138,7 @@ def _analyse(lin: Any, num: dict[str, np.ndarray], check: Any,
 
             ss = state_space(lin, t, params, allow_time_variant=True)
             res["modes"] = modes(ss)
-            res["stability"] = stability(ss)
+            res["stability"] = stability(ss, cyclic=res["cyclic"])
         except ImportError:
             pass
     return res
@@ -165,6 +168,7 @@ def jsonable(res: Mapping[str, Any]) -> dict[str, Any]:
         "nominal_is_solution": res["nominal_check"].is_solution,
         "h_relative": _finite_list([res["nominal_check"].relative])[0],
         "matrices": {k: np.asarray(v, float).tolist() for k, v in res["numbers"].items()},
+        "cyclic_coordinates": list(res.get("cyclic", ())),
     }
     m = res.get("modes")
     if m is not None:
@@ -174,8 +178,16 @@ def jsonable(res: Mapping[str, Any]) -> dict[str, Any]:
     s = res.get("stability")
     if s is not None:
         out["stability"] = {"verdict": s.verdict, "reason": s.reason,
-                            "max_real_part": float(s.max_real_part)}
+                            "max_real_part": float(s.max_real_part),
+                            "cyclic": list(s.cyclic)}
     return out
+
+
+def cyclic_text(cyclic: Any) -> str:
+    """One sentence naming the cyclic coordinates (for the text output and the report)."""
+    return (f"cyclic coordinates: {', '.join(cyclic)} (they appear in no equation, only their "
+            "rates; the stability verdict is taken in Routh's sense on the reduced system "
+            "without their positions)")
 
 
 def _finite_list(a: np.ndarray) -> list[float | None]:
@@ -217,6 +229,8 @@ def linear_text(res: Mapping[str, Any]) -> str:
                                                                 else "no"))
     if res["modes"] is not None:
         lines.append("\neigenvalues of the state-space system:\n" + str(res["modes"]))
+    if res.get("cyclic"):
+        lines.append("\n" + cyclic_text(res["cyclic"]))
     if res["stability"] is not None:
         lines.append(f"\nstability: {res['stability']}")
     return "\n".join(lines)

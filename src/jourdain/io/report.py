@@ -647,6 +647,8 @@ def _sections(model: ModelFile, out: Path, params: dict[str, float], t_end: floa
                 s.append(_table(rows, ["Re λ [1/s]", "Im λ [rad/s]", "f<sub>n</sub> [Hz]",
                                        "ζ"]))
                 s.append(_eigen_plot(lams, f"eigenvalues about {nominal.name}"))
+            if res.get("cyclic"):
+                s.append(f"<p>{_e(capabilities.cyclic_text(res['cyclic']))}.</p>")
             if st is not None:
                 cls = "ok" if st.is_stable else "bad"
                 s.append(f"<p>Stability: <span class='{cls}'>{_e(st.verdict)}</span> — "

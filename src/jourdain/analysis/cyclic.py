@@ -1,0 +1,122 @@
+"""Cyclic (ignorable) coordinates and the reduced system of Routh.
+
+A coordinate ``y_c`` is *cyclic* when it appears in no equation of motion: ``M``, ``k`` and ``q``
+do not depend on it, only on its rate ``ẏ_c`` (the spin angle of a symmetric top, the
+precession angle about the direction of gravity, the position of a free cart). Its generalized
+momentum is then conserved, and a steady motion in which it turns at a constant rate is a
+member of a family of such motions: ``y_c`` drifts (a double zero eigenvalue with a single
+eigenvector in the linearization), but that drift is no instability of the motion.
+
+Routh's reduction: in the linearization ``M̃·η̈ + P·η̇ + Q·η = h`` the columns of Q that belong
+to cyclic coordinates vanish, so ``η_c`` enters only through ``η̇_c`` and ``η̈_c``. The reduced
+state ``[η_r; η̇]`` (η_r the other coordinates, η̇ all rates) obeys
+
+    ẋ_r = A_r·x_r,   A_r = A with the rows and columns of η_c removed
+
+and ``eig A = eig A_r ∪ {0, ..., 0}`` (one zero per cyclic coordinate). The stability verdict
+in Routh's sense is the verdict on ``A_r``: stability with respect to the non-cyclic
+coordinates and all rates (E. J. Routh, *A Treatise on the Stability of a Given State of
+Motion*, 1877; Schiehlen & Eberhard, *Applied Dynamics*, on steady motions).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..differentiate import Graph, free_symbol_names, jet_float
+
+if TYPE_CHECKING:
+    from ..model.system import System
+    from ..projection import EquationsOfMotion
+
+#: a derivative ``∂e/∂y_c`` counts as zero below this fraction of the largest value or
+#: derivative of M, k, q at the trial state (an identity test: round-off of terms that cancel,
+#: such as ∂(sin²φ + cos²φ)/∂φ, is a few eps of their size)
+CYCLIC_RTOL = 1e-9
+
+
+def cyclic_coordinates(source: System | EquationsOfMotion) -> tuple[str, ...]:
+    """Names of the cyclic coordinates: those on which ``M``, ``k`` and ``q`` do not depend.
+
+    A coordinate whose symbol does not occur in the expressions is cyclic. One that occurs
+    (possibly in terms that cancel, ``A·sin²φ + A·cos²φ``) is tested numerically: the exact
+    derivatives ``∂M/∂y_c``, ``∂k/∂y_c``, ``∂q/∂y_c`` (forward mode,
+    :func:`jourdain.differentiate.jet_float`) at three random states, times and sets of
+    parameter values near the defaults must vanish to :data:`CYCLIC_RTOL` of the largest value
+    or derivative there. The result is a property of the model, for all parameter values.
+    """
+    from ..linearization import _perturbed
+    from ..projection import EquationsOfMotion
+
+    eom = source if isinstance(source, EquationsOfMotion) else source.equations_of_motion()
+    system = eom.system
+    f = system.f
+    exprs = [*eom.k.entries(), *eom.q.entries(),
+             *(eom.M[i, j] for i in range(f) for j in range(i, f))]
+    present = free_symbol_names(exprs)
+    names = system.coordinate_names
+    candidates = [i for i, n in enumerate(names) if str(system.y[i]) in present]
+    cyclic = {i for i in range(f) if i not in candidates}
+    if candidates:
+        graph = Graph(exprs)
+        variables = [system.y[i] for i in candidates]
+        rng = np.random.default_rng(20261123)
+        base = system.parameter_values
+        still = set(candidates)
+        for trial in range(3):
+            values = dict(base) if trial == 0 else _perturbed(base, rng)
+            values["t"] = float(rng.uniform(0.0, 2.0))
+            for syms, lo, hi in ((system.y, -np.pi, np.pi), (system.yd, -1.0, 1.0),
+                                 (system.inputs, -1.0, 1.0)):
+                values.update({str(s): float(rng.uniform(lo, hi)) for s in syms})
+            jet = jet_float(graph, variables, values)
+            scale = max(float(np.abs(jet.values).max(initial=0.0)),
+                        float(np.abs(jet.jacobian).max(initial=0.0)), np.finfo(float).tiny)
+            column = np.abs(jet.jacobian).max(axis=0, initial=0.0)
+            for j, i in enumerate(candidates):
+                if not np.isfinite(column[j]) or column[j] > CYCLIC_RTOL * scale:
+                    still.discard(i)
+            if not still:
+                break
+        cyclic |= still
+    return tuple(names[i] for i in sorted(cyclic))
+
+
+def reduced_matrix(A: np.ndarray, coordinate_names: tuple[str, ...] | list[str],
+                   cyclic: tuple[str, ...] | list[str]) -> np.ndarray:
+    """``A_r``: the state matrix for ``[η_r; η̇]`` with the rows and columns of the cyclic
+    coordinates' positions removed (see the module docstring). ``A`` is (2f, 2f)."""
+    names = list(coordinate_names)
+    f = len(names)
+    drop = {names.index(c) for c in cyclic}
+    keep = [i for i in range(2 * f) if i not in drop]
+    return A[np.ix_(keep, keep)]
+
+
+def check_cyclic(A: np.ndarray, coordinate_names: tuple[str, ...] | list[str],
+                 cyclic: Any) -> tuple[str, ...]:
+    """The names in ``cyclic``, checked: each must be a coordinate, and its position must not
+    act on the motion at this nominal motion (the column of ``A`` of ``η_c`` is zero to
+    round-off of A). Raises :class:`jourdain.errors.EvaluationError` otherwise."""
+    from ..errors import EvaluationError
+    from .modes import ZERO_RTOL
+
+    names = list(coordinate_names)
+    out = []
+    scale = max(1.0, float(np.abs(A).max(initial=0.0)))
+    for c in cyclic:
+        c = str(c)
+        if c not in names:
+            raise EvaluationError(f'cyclic: "{c}" is not a coordinate; coordinates are '
+                                  f"{', '.join(names)}")
+        col = np.abs(A[:, names.index(c)]).max(initial=0.0)
+        if col > ZERO_RTOL * scale:
+            raise EvaluationError(
+                f'cyclic: the coordinate "{c}" is not cyclic here: its deviation acts on the '
+                f"motion (largest entry {col:.3g} in its column of A); a cyclic coordinate "
+                "appears in no equation of motion, only its rate")
+        if c not in out:
+            out.append(c)
+    return tuple(c for c in names if c in out)
