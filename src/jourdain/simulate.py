@@ -346,6 +346,8 @@ def check_rtol(rtol: Any, name: str = "rtol") -> float:
 def check_atol(atol: Any, size: int, name: str = "atol") -> np.ndarray:
     """The absolute tolerance, one number or ``size`` numbers, each in ``(0, ATOL_MAX]``;
     returned as ``size`` numbers."""
+    if type(atol) is float and 0.0 < atol <= ATOL_MAX:  # the common case, without NumPy
+        return np.full(size, atol)
     if isinstance(atol, (str, bytes, bool)) or atol is None:
         raise EvaluationError(f"{name} must be a number or {size} numbers, got {_shown(atol)}")
     try:
