@@ -60,6 +60,7 @@ from .units import (
     energy_unit,
     model_units,
     per_time,
+    reactions_label,
     shared_label,
     unit_of,
 )
@@ -623,9 +624,7 @@ class Results:
         elif what == "g":
             for i, n in enumerate(self.g_names):
                 ax.plot(self.t, self.g[:, i], label=self.label(n))
-            ax.set_ylabel(shared_label(
-                [("forces" if n.rsplit(".", 1)[-1].startswith("F") else "torques", self.unit(n))
-                 for n in self.g_names], "reaction forces g"))
+            ax.set_ylabel(reactions_label(self.g_names, self.units))
         else:
             raise EvaluationError(f"plot: what must be y, yd, ydd, u, energy or g, got {what!r}")
         ax.set_xlabel(self.label("t"))

@@ -228,3 +228,24 @@ def shared_label(series: Iterable[tuple[str, str]], what: str, max_names: int = 
     parts = [axis_label(", ".join(names) if len(names) <= max_names else what, unit)
              for unit, names in groups.items()]
     return "; ".join(parts) if parts else what
+
+
+def reactions_label(names: Iterable[str], units: Mapping[str, str]) -> str:
+    """The label of an axis of reaction components: ``forces / N; torques / (N m)`` (the kinds
+    present, in order)."""
+    return shared_label([("torques" if n.rsplit(".", 1)[-1].startswith("T") else "forces",
+                          reaction_unit(n, units)) for n in names], "reaction forces g")
+
+
+def value_units(system: System, g_names: Iterable[str] = ()) -> dict[str, object]:
+    """The units of the numbers at one state (``jourdain eval --json``, the report's
+    values.json), aligned with their arrays: ``t``; ``y``, ``yd`` per coordinate; ``inputs``
+    by name; ``k``, ``q`` (generalized forces: force on a length, torque on an angle) per
+    coordinate; ``g`` per reaction component; ``""`` where unknown."""
+    units = model_units(system)
+    coords = coordinate_units(system)
+    gen = [generalized_force_unit(coords[c], units) for c in system.coordinate_names]
+    return {"t": TIME, "y": [coords[c] for c in system.coordinate_names],
+            "yd": [per_time(coords[c], 1) for c in system.coordinate_names],
+            "inputs": input_units(system), "k": gen, "q": list(gen),
+            "g": [reaction_unit(n, units) for n in g_names]}

@@ -23,6 +23,7 @@ import numpy as np
 
 from ..errors import JourdainError
 from ..symbolic import to_sympy
+from ..units import axis_label, reactions_label, shared_label, value_units
 from . import export
 from .modelfile import ModelFile
 
@@ -188,7 +189,7 @@ def _time_plot(t: np.ndarray, series: Mapping[str, np.ndarray], ylabel: str,
     fig, ax = plt.subplots(figsize=(7.5, 3.0), layout="constrained")
     for name, v in series.items():
         ax.plot(t, v, label=name, linewidth=1.2)
-    ax.set_xlabel("t [s]")
+    ax.set_xlabel("t / s")
     ax.set_ylabel(ylabel)
     ax.set_title(title, fontsize=10)
     ax.grid(True, alpha=0.3)
@@ -207,8 +208,8 @@ def _eigen_plot(eigenvalues: np.ndarray, title: str) -> str:
     ax.axvline(0, color="0.5", linewidth=0.8)
     ax.axhline(0, color="0.5", linewidth=0.8)
     ax.plot(eigenvalues.real, eigenvalues.imag, "x", markersize=8, color="C3")
-    ax.set_xlabel("Re λ [1/s]")
-    ax.set_ylabel("Im λ [rad/s]")
+    ax.set_xlabel("Re λ / (1/s)")
+    ax.set_ylabel("Im λ / (rad/s)")
     ax.set_title(title, fontsize=10)
     ax.grid(True, alpha=0.3)
     return _svg(fig)
@@ -569,7 +570,8 @@ def _sections(model: ModelFile, out: Path, params: dict[str, float], t_end: floa
               "coordinates": coords, "t": 0.0, "y": y0.tolist(), "yd": yd0.tolist(),
               "parameters": pv, "inputs": u0,
               "values": {k: _json_array(v) for k, v in values.items()},
-              "g_names": list(extra.get("g_names", [])), "not_available": missing}
+              "g_names": list(extra.get("g_names", [])), "not_available": missing,
+              "units": value_units(system, extra.get("g_names", []))}
         (out / "values.json").write_text(json.dumps(vj, indent=1), encoding="utf-8")
         info.files.append(out / "values.json")
     except JourdainError as exc:
@@ -692,16 +694,20 @@ def _sections(model: ModelFile, out: Path, params: dict[str, float], t_end: floa
             s.append(f"<p>t = 0 … {_num(res.t[-1])} s, method {_e(sim.method)}, rtol "
                      f"{sim.rtol:g}, atol {sim.atol:g}; {len(res.t)} output samples; "
                      f"{wall:.2f} s wall time (with compilation). Data: simulation.csv.</p>")
-            s.append(_time_plot(res.t, {c: res.y[:, i] for i, c in enumerate(coords)},
-                                "y", "coordinates"))
-            s.append(_time_plot(res.t, {f"{c}_d": res.yd[:, i] for i, c in enumerate(coords)},
-                                "ẏ", "rates"))
+            # axis labels with units (jourdain.units): "phi1 / rad", "x_d / (m/s)"
+            s.append(_time_plot(res.t, {res.label(c): res.y[:, i] for i, c in enumerate(coords)},
+                                shared_label([(c, res.unit(c)) for c in coords], "y"),
+                                "coordinates"))
+            s.append(_time_plot(res.t, {res.label(f"{c}_d"): res.yd[:, i]
+                                        for i, c in enumerate(coords)},
+                                shared_label([(f"{c}_d", res.unit(f"{c}_d")) for c in coords],
+                                             "ẏ"), "rates"))
             try:
                 Tk, V, W = res.kinetic_energy, res.potential_energy, res.work_nonconservative
                 Wd = res.work_drive
                 s.append(_time_plot(res.t, {"T (kinetic)": Tk, "V (potential)": V,
                                             "T + V − W_nc − W_drive": Tk + V - W - Wd},
-                                    "energy", "energy balance"))
+                                    axis_label("energy", res.unit("T")), "energy balance"))
                 driven = _prescribed_joints(system)
                 why = (f" (with the work W_drive of the prescribed motion of "
                        f"{', '.join(driven)})" if driven else "")
@@ -718,8 +724,9 @@ def _sections(model: ModelFile, out: Path, params: dict[str, float], t_end: floa
                 g = res.g
                 labels = res.g_names
                 keep = list(range(min(12, g.shape[1])))
-                s.append(_time_plot(res.t, {labels[i]: g[:, i] for i in keep},
-                                    "g", "reaction forces along the motion"
+                s.append(_time_plot(res.t, {res.label(labels[i]): g[:, i] for i in keep},
+                                    reactions_label(labels, res.units),
+                                    "reaction forces along the motion"
                                     + ("" if len(keep) == g.shape[1] else
                                        f" (first {len(keep)} of {g.shape[1]})")))
             except (JourdainError, KeyError, AttributeError, ValueError) as exc:
