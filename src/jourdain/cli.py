@@ -440,12 +440,12 @@ def _json_array(v: np.ndarray) -> Any:
 
 
 def cmd_eval(args: argparse.Namespace) -> int:
+    from .units import value_units
+
     model = _load(args.model)
     system = model.system
     params = _overrides(system, args.set)
     y, yd, t, inputs = _state(model, args.at)
-    from .units import value_units
-
     values, extra, missing = evaluate_all(model, y, yd, t, params, inputs)
     pv = system.parameter_values
     pv.update(params)
@@ -458,11 +458,11 @@ def cmd_eval(args: argparse.Namespace) -> int:
             "g_names": list(extra.get("g_names", [])),
             "g_undetermined": list(extra.get("g_undetermined", [])),
             "not_available": missing,
+            "units": value_units(system, extra.get("g_names", [])),
         }
         print(json.dumps(out, indent=1))
         return EXIT_OK
     from .io.export import ROUNDOFF_RTOL, format_array
-            "units": value_units(system, extra.get("g_names", [])),
 
     print(f"{system.name} at {_state_text(system, y, yd, t, inputs)}")
     if params:
@@ -486,11 +486,11 @@ def cmd_reactions(args: argparse.Namespace) -> int:
     y, yd, t, inputs = _state(model, args.at)
     values = _reactions_at(system, y, yd, t, params, inputs)
     from .io import capabilities as integration
+    from .units import value_units
 
     labels = list(values.get("g_names") or integration.reaction_labels(system))
     g = np.asarray(values["g"], float).reshape(-1)
     if args.json:
-    from .units import value_units
         print(json.dumps({"t": t, "y": y.tolist(), "yd": yd.tolist(), "g_names": labels,
                           "g": _json_array(g), "units": value_units(system, labels),
                           "g_undetermined": list(values.get("g_undetermined", []))}, indent=1))
