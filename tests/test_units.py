@@ -212,6 +212,9 @@ def test_report_figures_and_json_carry_the_units(tmp_path, monkeypatch):
     assert ("t / s", "x_d / (m/s); phi_d / (rad/s)") in labels
     assert ("t / s", "energy / J") in labels
     assert ("t / s", "forces / N; torques / (N m)") in labels
+    html = (tmp_path / "out" / "report.html").read_text()
+    for name, unit in (("x", "m"), ("phi", "rad"), ("F", "N")):  # tables of the model
+        assert f"<td>{name}</td><td>{unit}</td>" in html
     values = json.loads((tmp_path / "out" / "values.json").read_text())
     u = values["units"]
     assert (u["t"], u["y"], u["yd"], u["inputs"]) == ("s", ["m", "rad"], ["m/s", "rad/s"],
