@@ -21,8 +21,9 @@ wrenches against RNEA's ``data.f``; tests/reference/test_urdf_pinocchio.py):
   ``R = Rz(yaw)·Ry(pitch)·Rx(roll)`` of URDF's ``rpy``);
 * each body's mass, centre of mass and inertia tensor (about the centre of mass, body frame)
   are parameters ``m_<body>``, ``cx_<body>``, ``cy_<body>``, ``cz_<body>``, ``Ixx_<body>``,
-  ``Ixy_<body>``, ... with the URDF's values (merged) as defaults; gravity ``g`` (default 9.81,
-  Pinocchio's) acts along −z;
+  ``Ixy_<body>``, ... with the URDF's values (merged) as defaults, except the numbers that are
+  exactly 0, which stay literal zeros (a massless link, a point mass, zero products of
+  inertia); gravity ``g`` (default 9.81, Pinocchio's) acts along −z;
 * each one-coordinate joint (revolute, continuous, prismatic) gets an input ``tau_<joint>``:
   a generalized force (torque or force) on its coordinate, zero unless given;
 * joint limits, damping and friction are kept as data (:class:`UrdfJoint`); with
@@ -596,22 +597,24 @@ def _build(robot: Any, src: _Source, *, floating_base: bool, g: float, mimic: st
                             "rigid body has; give its mass or set the inertia to 0", path,
                             src.line("link", urdf_link))
         c, I = md.com_inertia()
-        names = {"m": f"m_{b}", **{f"c{a}": f"c{a}_{b}" for a in "xyz"}}
-        params[names["m"]] = md.m
-        units[names["m"]] = "kg"
-        for k, a in enumerate("xyz"):
-            params[names[f"c{a}"]] = float(c[k])
-            units[names[f"c{a}"]] = "m"
-        Isym = [[None] * 3 for _ in range(3)]
+
+        def param(pname: str, value: float, unit: str) -> se.Basic:
+            # a number that is exactly 0 stays a literal 0: a massless body, a point mass and
+            # the zero products of inertia are then zero for the stages, not only in value
+            if value == 0.0:
+                return se.Integer(0)
+            params[pname], units[pname] = float(value), unit
+            return se.Symbol(pname)
+
+        m_sym = param(f"m_{b}", md.m, "kg")
+        com = tuple(param(f"c{a}_{b}", float(c[k]), "m") for k, a in enumerate("xyz"))
+        Isym: list[list[se.Basic]] = [[se.Integer(0)] * 3 for _ in range(3)]
         for r in range(3):
             for s in range(r, 3):
-                pn = f"I{'xyz'[r]}{'xyz'[s]}_{b}"
-                params[pn] = float(I[r, s])
-                units[pn] = "kg*m^2"
-                Isym[r][s] = Isym[s][r] = se.Symbol(pn)  # type: ignore[call-overload]
+                Isym[r][s] = Isym[s][r] = param(f"I{'xyz'[r]}{'xyz'[s]}_{b}", float(I[r, s]),
+                                                "kg*m^2")
         try:
-            bodies.append(Body(b, spec["parent"], spec["joint"], mass=se.Symbol(names["m"]),
-                               com=tuple(se.Symbol(names[f"c{a}"]) for a in "xyz"),
+            bodies.append(Body(b, spec["parent"], spec["joint"], mass=m_sym, com=com,
                                inertia=Isym))
         except ModelError as exc:
             raise UrdfError(f'link "{urdf_link}": {exc}', path,
