@@ -382,7 +382,7 @@ def _camera(points: np.ndarray, up: np.ndarray) -> tuple[np.ndarray, float, np.n
         n = np.eye(3)[int(np.argmin(spread))]  # planar motion: look at the plane, a bit oblique
         if abs(n @ up) < 0.9:
             side = np.cross(up, n)
-            d = n + 0.35 * side / np.linalg.norm(side) + 0.25 * up
+            d = n + 0.35 * side / np.linalg.norm(side) + 0.15 * up
         else:
             d = up + 0.6 * h1 + 0.3 * h2
     else:
@@ -487,7 +487,7 @@ def scene(results: Results, visuals: Mapping[str, Sequence[MeshVisual]] | None =
             "bodies": bodies, "springs": springs, "up": up.tolist(),
             "center": center.tolist(), "extent": float(L), "view_dir": view_dir.tolist(),
             "distance": float(distance), "ground": ground.tolist(), "notes": notes,
-            "status": results.status}
+            "shape": shape, "status": results.status}
 
 
 def decode_poses(sc: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray]:
@@ -529,8 +529,8 @@ def page(sc: Mapping[str, Any]) -> str:
     bundle, viewer = _scripts()
     data = json.dumps(sc, separators=(",", ":")).replace("</", "<\\/")
     name = html.escape(str(sc.get("name", "")))
-    shape = "equivalent boxes" if any(b["shape"]["kind"] == "box" for b in sc["bodies"]) \
-        else "equivalent ellipsoids"
+    shape = {"box": "equivalent boxes", "ellipsoid": "equivalent ellipsoids"}[
+        sc.get("shape", "box")]
     notes = "".join(f"<div class='jv-help jv-note'>{html.escape(n)}</div>"
                     for n in sc.get("notes", []))
     help_ = (f"<div class='jv-help'>{name}: bodies as {shape} (same mass and principal "

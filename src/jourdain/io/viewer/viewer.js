@@ -1,6 +1,6 @@
 /* jourdain's 3-D view of a simulated motion (src/jourdain/io/viewer/__init__.py writes the page).
  *
- * Reads the scene from <script type="application/json" id="jourdain-scene"> and draws it with
+ * Reads the scene from the JSON script element "jourdain-scene" and draws it with
  * three.js (the global JD3 of three_bundle.js): one group per body, placed at each time by the
  * body frame's inertial position r_O and orientation S (as a quaternion), with the body's
  * equivalent box or ellipsoid (or its meshes) and a triad of the body frame inside it, a triad of
@@ -63,7 +63,7 @@
   world.add(sun, sun.target);
 
   // ground grid perpendicular to "up", below the motion
-  var grid = new T.GridHelper(2 * L, 20, 0xc4c4c4, 0xe4e4e4);
+  var grid = new T.GridHelper(1.5 * L, 15, 0xc4c4c4, 0xe4e4e4);
   grid.quaternion.setFromUnitVectors(new T.Vector3(0, 1, 0), up);
   grid.position.fromArray(scene.ground);
   world.add(grid);
