@@ -458,6 +458,7 @@ def cmd_eval(args: argparse.Namespace) -> int:
             "g_names": list(extra.get("g_names", [])),
             "g_undetermined": list(extra.get("g_undetermined", [])),
             "not_available": missing,
+            "joint_wrenches": {k: w.as_dict() for k, w in extra.get("joint_wrenches", {}).items()},
             "units": value_units(system, extra.get("g_names", [])),
         }
         print(json.dumps(out, indent=1))
@@ -474,9 +475,31 @@ def cmd_eval(args: argparse.Namespace) -> int:
         print(f"\n{k} =\n{format_array(v, scales.get(k))}")
     if extra.get("g_names"):
         print("\ng components: " + ", ".join(extra["g_names"]))
+    if extra.get("joint_wrenches"):
+        print(_wrench_text(system, extra["joint_wrenches"]))
     if missing:
         print("\nnot available yet: " + ", ".join(missing))
     return EXIT_OK
+
+
+def _wrench_text(system: Any, wrenches: dict[str, Any]) -> str:
+    """The joint wrenches as a table: force and torque (about the joint point) on the child
+    body, in the joint frame and in the inertial frame."""
+    from .io.export import chop
+
+    force, torque = reaction_units(system)
+    lines = [f"\njoint wrenches on the child body at the joint point (force [{force}], torque "
+             f"[{torque}]; joint frame = child body frame):"]
+    for name, w in wrenches.items():
+        for label, F, T in (("joint frame", w.force, w.torque),
+                            ("inertial", w.force_inertial, w.torque_inertial)):
+            top = max(float(np.nanmax(np.abs(F), initial=0.0)),
+                      float(np.nanmax(np.abs(T), initial=0.0)))
+            F, T = chop(F, top), chop(T, top)
+            lines.append(f"  {name + ' (' + w.child + ')':<24} {label:<12} F = "
+                         + np.array2string(F, precision=6) + "  T = "
+                         + np.array2string(T, precision=6))
+    return "\n".join(lines)
 
 
 def cmd_reactions(args: argparse.Namespace) -> int:

@@ -1199,7 +1199,8 @@ def joint_reactions(system: System, joints: str | Sequence[str], y: Any, yd: Any
 def evaluate_keys(system: System, y: Any, yd: Any, t: float, parameters: Any, inputs: Any,
                   eom: Mapping[str, np.ndarray]) -> dict[str, Any]:
     """The reaction entries of :meth:`System.evaluate`: ``Q_bar, N_hat, k_hat, q_hat, g,
-    g_names, g_undetermined``.
+    g_names, g_undetermined`` and ``joint_wrenches`` (``{joint: JointWrench}``: force and
+    torque vectors in the joint frame and the inertial frame, :mod:`jourdain.wrenches`).
 
     A model whose reactions cannot be formed (a joint moved by another joint's coordinate, a
     symbolic joint axis, constrained directions that do work), or a state where they have no
@@ -1209,8 +1210,12 @@ def evaluate_keys(system: System, y: Any, yd: Any, t: float, parameters: Any, in
     """
     try:
         _reactions_function(system)
-        return evaluate_reactions(system, y, yd, t, parameters, inputs, eom=eom)
+        out = evaluate_reactions(system, y, yd, t, parameters, inputs, eom=eom)
     except JourdainError as exc:
         return {"reactions_error": str(exc)}
+    from .wrenches import joint_wrenches
+
+    out["joint_wrenches"] = joint_wrenches(system, out["g"], y, yd, t, parameters)
+    return out
 
 

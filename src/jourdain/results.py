@@ -431,6 +431,30 @@ class Results:
         self._energies["g"] = g
         self._energies["g_names"] = list(lay.g_names)
 
+    @property
+    def joint_wrenches(self) -> dict[str, Any]:
+        """The wrench of every joint along the motion, ``{joint: JointWrench}`` with (N, 3)
+        arrays: force and torque (about the joint point) on the child body, in the joint frame
+        and in the inertial frame (:mod:`jourdain.wrenches`; from :attr:`g`)."""
+        if "joint_wrenches" not in self._energies:
+            from .wrenches import joint_wrenches_along
+
+            system = self._need_system("the joint wrenches")
+            p = np.array([self.parameters[k] for k, _ in system.parameters])
+            self._energies["joint_wrenches"] = joint_wrenches_along(system, self.g, self.t,
+                                                                    self.y, self.yd, p)
+        return self._energies["joint_wrenches"]
+
+    def joint_wrench_table(self, joint: str) -> tuple[list[str], np.ndarray]:
+        """One joint's wrench along the motion as a table: column names and an (N, 13) array
+        (t; ``<joint>.F_x`` … ``<joint>.T_z`` in the joint frame; the same with ``_inertial``)."""
+        from .wrenches import wrench_table
+
+        wrenches = self.joint_wrenches
+        if joint not in wrenches:
+            raise EvaluationError(f'unknown joint "{joint}"; joints are: {", ".join(wrenches)}')
+        return wrench_table(wrenches[joint], self.t)
+
     def positions(self, body: str, point: str = "origin", t: Any = None) -> np.ndarray:
         """Inertial position of a body's frame origin (``point="origin"``) or centre of mass
         (``"com"``) along the motion, (N, 3) — for plots and animations; at the times ``t``

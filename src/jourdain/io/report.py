@@ -54,7 +54,7 @@ def report_files(model: ModelFile) -> list[str]:
     refuses to overwrite them without ``--force``)."""
     return ["report.html", "run.json", "model.toml", "equations.tex", "equations.json",
             "values.json", *(f"linearization-{n.name}.json" for n in model.nominal),
-            "simulation.csv"]
+            "simulation.csv", *(f"wrench-{b.joint.name}.csv" for b in model.system.bodies)]
 
 
 # ------------------------------------------------------------------------------------------
@@ -569,7 +569,9 @@ def _sections(model: ModelFile, out: Path, params: dict[str, float], t_end: floa
               "parameters": pv, "inputs": u0,
               "values": {k: _json_array(v) for k, v in values.items()},
               "g_names": list(extra.get("g_names", [])), "not_available": missing,
-              "units": value_units(system, extra.get("g_names", []))}
+              "units": value_units(system, extra.get("g_names", [])),
+              "joint_wrenches": {k: w.as_dict()
+                                 for k, w in extra.get("joint_wrenches", {}).items()}}
         (out / "values.json").write_text(json.dumps(vj, indent=1), encoding="utf-8")
         info.files.append(out / "values.json")
     except JourdainError as exc:
@@ -730,6 +732,10 @@ def _sections(model: ModelFile, out: Path, params: dict[str, float], t_end: floa
             except (JourdainError, KeyError, AttributeError, ValueError) as exc:
                 s.append(_note(f"reaction forces along the motion not available: {exc}"))
             try:
+                s.append(_wrench_section(res, out, info))
+            except (JourdainError, KeyError, AttributeError, ValueError) as exc:
+                s.append(_note(f"joint wrenches along the motion not available: {exc}"))
+            try:
                 mo = _motion(model, res, params)
                 s.append("<h3>Snapshots of the motion</h3>" + _snapshot_strip(mo, model.view))
                 s.append("<h3>Animation</h3>" + _animation(mo, model.view)
@@ -745,6 +751,29 @@ def _sections(model: ModelFile, out: Path, params: dict[str, float], t_end: floa
             if csv.is_file():  # the initial state, where the run failed at once
                 info.files.append(csv)
     sections.append("".join(s))
+
+
+def _wrench_section(res: Any, out: Path, info: ReportInfo) -> str:
+    """The magnitudes of each joint's force and torque along the motion (a plot; the vectors
+    in the joint and the inertial frame in ``wrench-<joint>.csv``, one table per joint)."""
+    wrenches = res.joint_wrenches
+    series: dict[str, np.ndarray] = {}
+    files = []
+    for name, w in wrenches.items():
+        series[f"|F| {name}"] = np.linalg.norm(w.force, axis=1)
+        series[f"|T| {name}"] = np.linalg.norm(w.torque, axis=1)
+        cols, data = res.joint_wrench_table(name)
+        fn = out / f"wrench-{name}.csv"
+        np.savetxt(fn, data, delimiter=",", header=",".join(cols), comments="")
+        info.files.append(fn)
+        files.append(fn.name)
+    keep = dict(list(series.items())[:12])
+    return (_time_plot(res.t, keep, reactions_label(res.g_names, res.units),
+                       "joint wrenches along the motion (on the child body at the joint point)"
+                       + ("" if len(keep) == len(series) else
+                          f" (first {len(keep)} of {len(series)})"))
+            + "<p class='meta'>Force and torque vectors per joint, in the joint frame and in "
+              f"the inertial frame: {_e(', '.join(files))}.</p>")
 
 
 def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | None = None,
