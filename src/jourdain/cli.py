@@ -846,6 +846,31 @@ def cmd_run(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def cmd_fmu(args: argparse.Namespace) -> int:
+    """``jourdain fmu MODEL --out model.fmu``: an FMI 2.0 FMU (docs/fmu.md)."""
+    from .io.fmu import export_fmu
+
+    out = Path(args.out)
+    if out.suffix.lower() != ".fmu":
+        raise UsageError(f"--out: expected a file name ending in .fmu, got {args.out!r}")
+    if out.is_dir():
+        raise UsageError(f"--out: {args.out} is a folder; expected a .fmu file")
+    if out.exists() and not args.force:
+        raise UsageError(f"--out: {args.out} exists; --force replaces it")
+    model = _load(args.model)
+    params = _overrides(model.system, args.set)
+    names = [n.strip() for r in args.reaction for n in r.split(",") if n.strip()]
+    info = export_fmu(model, out, reactions="all" if names == ["all"] else names,
+                      parameters=params, model_identifier=args.identifier,
+                      binary=not args.sources_only)
+    f = model.system.f
+    print(f"{info.path}: FMI 2.0 model exchange and co-simulation, modelIdentifier "
+          f"{info.model_identifier}; {2 * f} states, {len(model.system.parameters)} parameters, "
+          f"{len(model.system.inputs)} inputs, {len(info.reactions)} reaction outputs; "
+          + (f"binary {info.binary}" if info.binary else "sources only"))
+    return EXIT_OK
+
+
 # ------------------------------------------------------------------------------------------
 # parser
 # ------------------------------------------------------------------------------------------
@@ -968,6 +993,22 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", help=set_help)
     p.add_argument("--max-ops", type=_operations, default=600, metavar="N",
                    help="summarize matrices needing more than N operations")
+
+    p = _sub(subs, "fmu", "export an FMI 2.0 FMU (model exchange and co-simulation, C sources "
+             "and a binary for this machine; docs/fmu.md)",
+             "jourdain fmu examples/double_pendulum.toml --out double_pendulum.fmu "
+             "--reaction hinge1.F_x,hinge1.F_y", cmd_fmu)
+    p.add_argument("--out", required=True, metavar="FILE", help="the .fmu file to write")
+    p.add_argument("--force", action="store_true", help="replace an existing --out file")
+    p.add_argument("--reaction", action="append", default=[], metavar="NAME",
+                   help='reaction components as outputs: --reaction hinge1.F_x (repeatable, or '
+                        'comma-separated; "all" for every one)')
+    p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                   help="a parameter's start value in the FMU: --set m1=2.0 (repeatable)")
+    p.add_argument("--identifier", metavar="NAME",
+                   help="FMI modelIdentifier, the binary's name (default: from the model's name)")
+    p.add_argument("--sources-only", action="store_true",
+                   help="no binary: the FMU holds the C sources only")
     return parser
 
 
