@@ -494,81 +494,86 @@ def _build(robot: Any, src: _Source, *, floating_base: bool, g: float, mimic: st
     else:
         body_of[root], pose_of[root] = "world", np.eye(4)
 
-    stack = [root]
+    def visit(ln: str) -> None:
+        """The link's own mass data into its body; its joints next on the stack (depth-first,
+        children in file order, as Pinocchio adds them)."""
+        if body_of[ln] != "world":
+            _add_inertial(mass[body_of[ln]], links[ln], pose_of[ln], src)
+        stack.extend(reversed(children[ln]))
+
+    stack: list[Any] = []
+    visit(root)
     while stack:
-        ln = stack.pop()
-        lk = links[ln]
+        j = stack.pop()
+        ln = j.parent
         b = body_of[ln]
-        if b != "world":
-            _add_inertial(mass[b], lk, pose_of[ln], src)
-        for j in reversed(children[ln]):
-            stack.append(j.child)
-        for j in children[ln]:
-            jline = src.line("joint", j.name)
-            origin = _matrix(j.origin, f'joint "{j.name}" <origin>', path, jline)
-            X = pose_of[ln] @ origin  # joint frame in the parent body's frame
-            axis = _axis(j, path, jline)
-            common = {"name": j.name, "type": j.type, "parent": j.parent, "child": j.child,
-                      "axis": tuple(float(a) for a in axis), "origin": _pose(origin),
-                      **_limits(j, path, jline)}
-            if j.mimic is not None:
-                common["mimic"] = (str(j.mimic.joint),
-                                   float(_float(j.mimic.multiplier, f'joint "{j.name}" mimic '
-                                                "multiplier", path, jline, 1.0)),
-                                   float(_float(j.mimic.offset, f'joint "{j.name}" mimic offset',
-                                                path, jline, 0.0)))
-            if j.type == "fixed":
-                body_of[j.child], pose_of[j.child] = b, X
-                info[j.name] = UrdfJoint(**common, body=b, joint=None, coordinates=())
-                continue
-            cb = body_names(j.child)
-            jn = joint_names(j.name)
-            body_of[j.child], pose_of[j.child] = cb, np.eye(4)
-            mass[cb] = _Mass()
-            order.append(cb)
-            pos = tuple(float(x) for x in X[:3, 3])
-            R = X[:3, :3]
-            ori = None if np.array_equal(R, np.eye(3)) else [[float(x) for x in r] for r in R]
-            ax = _AXIS_NAMES.get(tuple(float(a) for a in axis)) or tuple(float(a) for a in axis)
-            try:
-                if j.type in ("revolute", "continuous", "prismatic"):
-                    q = jn
-                    make = Prismatic if j.type == "prismatic" else Revolute
-                    joint = make(jn, se.Symbol(q), ax, position=pos, orientation=ori)
-                    qs: tuple[str, ...] = (q,)
-                elif j.type == "floating":
-                    qs = tuple(f"{jn}_{s}" for s in ("x", "y", "z", "yaw", "pitch", "roll"))
-                    joint = Free(jn, _symbols(qs), "zyx", position=pos, orientation=ori)
-                else:  # planar: the plane normal to the axis, which must be a frame axis
-                    normal = _AXIS_NAMES.get(tuple(float(a) for a in axis))
-                    if normal is None or normal.startswith("-"):
-                        raise UrdfError(
-                            f'joint "{j.name}": a planar joint is read only with its axis '
-                            "along +x, +y or +z of the joint frame (the plane's normal), got "
-                            f"{' '.join(f'{a:g}' for a in axis)}", path, jline)
-                    a1, a2 = {"x": "yz", "y": "zx", "z": "xy"}[normal]
-                    qs = (f"{jn}_{a1}", f"{jn}_{a2}", f"{jn}_rot")
-                    joint = Planar(jn, _symbols(qs), normal, position=pos, orientation=ori)
-            except UrdfError:
-                raise
-            except ModelError as exc:
-                raise UrdfError(f'joint "{j.name}": {exc}', path, jline) from None
-            coords.extend(qs)
-            coord_units.update({c: "m" if (j.type == "prismatic" or k < (
-                3 if j.type == "floating" else 2 if j.type == "planar" else 0)) else "rad"
-                for k, c in enumerate(qs)})
-            body_spec[cb] = {"parent": b, "joint": joint}
-            tau = None
-            if actuated and len(qs) == 1:
-                tau = f"tau_{qs[0]}"
-                inputs.append(tau)
-                forces.append(GeneralizedForce(f"actuator_{qs[0]}", se.Symbol(qs[0]),
-                                               se.Symbol(tau)))
-            lim = common
-            if joint_damping and len(qs) == 1 and lim.get("damping"):
-                forces.append(RotationalSpringDamper(f"damping_{qs[0]}", se.Symbol(qs[0]),
-                                                     damping=se.Symbol(f"d_{qs[0]}")))
-            info[j.name] = UrdfJoint(**common, body=cb, joint=jn, coordinates=qs, input=tau)
+        jline = src.line("joint", j.name)
+        origin = _matrix(j.origin, f'joint "{j.name}" <origin>', path, jline)
+        X = pose_of[ln] @ origin  # joint frame in the parent body's frame
+        axis = _axis(j, path, jline)
+        common = {"name": j.name, "type": j.type, "parent": j.parent, "child": j.child,
+                  "axis": tuple(float(a) for a in axis), "origin": _pose(origin),
+                  **_limits(j, path, jline)}
+        if j.mimic is not None:
+            common["mimic"] = (str(j.mimic.joint),
+                               float(_float(j.mimic.multiplier, f'joint "{j.name}" mimic '
+                                            "multiplier", path, jline, 1.0)),
+                               float(_float(j.mimic.offset, f'joint "{j.name}" mimic offset',
+                                            path, jline, 0.0)))
+        if j.type == "fixed":
+            body_of[j.child], pose_of[j.child] = b, X
+            info[j.name] = UrdfJoint(**common, body=b, joint=None, coordinates=())
+            visit(j.child)
+            continue
+        cb = body_names(j.child)
+        jn = joint_names(j.name)
+        body_of[j.child], pose_of[j.child] = cb, np.eye(4)
+        mass[cb] = _Mass()
+        order.append(cb)
+        pos = tuple(float(x) for x in X[:3, 3])
+        R = X[:3, :3]
+        ori = None if np.array_equal(R, np.eye(3)) else [[float(x) for x in r] for r in R]
+        ax = _AXIS_NAMES.get(tuple(float(a) for a in axis)) or tuple(float(a) for a in axis)
+        try:
+            if j.type in ("revolute", "continuous", "prismatic"):
+                q = jn
+                make = Prismatic if j.type == "prismatic" else Revolute
+                joint = make(jn, se.Symbol(q), ax, position=pos, orientation=ori)
+                qs: tuple[str, ...] = (q,)
+            elif j.type == "floating":
+                qs = tuple(f"{jn}_{s}" for s in ("x", "y", "z", "yaw", "pitch", "roll"))
+                joint = Free(jn, _symbols(qs), "zyx", position=pos, orientation=ori)
+            else:  # planar: the plane normal to the axis, which must be a frame axis
+                normal = _AXIS_NAMES.get(tuple(float(a) for a in axis))
+                if normal is None or normal.startswith("-"):
+                    raise UrdfError(
+                        f'joint "{j.name}": a planar joint is read only with its axis '
+                        "along +x, +y or +z of the joint frame (the plane's normal), got "
+                        f"{' '.join(f'{a:g}' for a in axis)}", path, jline)
+                a1, a2 = {"x": "yz", "y": "zx", "z": "xy"}[normal]
+                qs = (f"{jn}_{a1}", f"{jn}_{a2}", f"{jn}_rot")
+                joint = Planar(jn, _symbols(qs), normal, position=pos, orientation=ori)
+        except UrdfError:
+            raise
+        except ModelError as exc:
+            raise UrdfError(f'joint "{j.name}": {exc}', path, jline) from None
+        coords.extend(qs)
+        coord_units.update({c: "m" if (j.type == "prismatic" or k < (
+            3 if j.type == "floating" else 2 if j.type == "planar" else 0)) else "rad"
+            for k, c in enumerate(qs)})
+        body_spec[cb] = {"parent": b, "joint": joint}
+        tau = None
+        if actuated and len(qs) == 1:
+            tau = f"tau_{qs[0]}"
+            inputs.append(tau)
+            forces.append(GeneralizedForce(f"actuator_{qs[0]}", se.Symbol(qs[0]),
+                                           se.Symbol(tau)))
+        lim = common
+        if joint_damping and len(qs) == 1 and lim.get("damping"):
+            forces.append(RotationalSpringDamper(f"damping_{qs[0]}", se.Symbol(qs[0]),
+                                                 damping=se.Symbol(f"d_{qs[0]}")))
+        info[j.name] = UrdfJoint(**common, body=cb, joint=jn, coordinates=qs, input=tau)
+        visit(j.child)
 
     if not coords:
         raise UrdfError("the robot has no moving joint (every joint is fixed and the base is "
