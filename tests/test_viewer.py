@@ -179,6 +179,37 @@ def test_spatial_poses_against_euler_angles(spatial):
                       <= EPS32 + eval_tol(27, 1.0))
 
 
+def test_composed_poses_equal_the_symbolic_kinematics_of_a_random_tree():
+    """body_poses composes the joints' relative motions along the tree in NumPy; the symbolic
+    kinematics composes the same steps as expressions (kinematics().bodies[i].r_O, .S), here
+    compiled separately: both agree at random states of a branching tree with every joint
+    type, to the round-off of one product per level."""
+    from jourdain.io.viewer import body_poses
+    from jourdain.models import random_tree
+    from jourdain.numeric import lambdify
+
+    system = random_tree(7, seed=3)
+    rng = np.random.default_rng(11)
+    n = 5
+    y = rng.uniform(-1.5, 1.5, (n, system.f))
+    res = jd.Results(system, np.linspace(0, 1, n), y, np.zeros_like(y), np.zeros_like(y),
+                     np.zeros((n, 0)), np.zeros(n), system.parameter_values)
+    r, S = body_poses(res, res.t)
+    kin = system.kinematics()
+    fn = lambdify(system, {**{f"r{i}": bk.r_O for i, bk in enumerate(kin.bodies)},
+                           **{f"S{i}": bk.S for i, bk in enumerate(kin.bodies)}})
+    p = np.array([system.parameter_values[k] for k, _ in system.parameters])
+    ref = fn.batch(y, np.zeros_like(y), res.t, p, None)
+    depth = {}
+    for b in system.bodies:
+        depth[b.name] = 1 if b.parent == "world" else depth[b.parent] + 1
+    scale = float(np.abs(r).max())
+    for i, b in enumerate(system.bodies):
+        tol = eval_tol(3 * depth[b.name], scale)
+        assert np.abs(r[:, i] - ref[f"r{i}"][:, :, 0]).max() <= tol, b.name
+        assert np.abs(S[:, i] - ref[f"S{i}"]).max() <= eval_tol(3 * depth[b.name], 1.0), b.name
+
+
 @pytest.mark.parametrize("shape", ["box", "ellipsoid"])
 def test_equivalent_shape_has_the_bodys_mass_and_inertia(spatial, shape):
     """The homogeneous box (ellipsoid) drawn for the body has its inertia tensor: with sides

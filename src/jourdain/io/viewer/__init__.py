@@ -26,9 +26,10 @@ What is drawn
 The motion
 ----------
 Per frame and body, the inertial position ``r_O`` of the body frame's origin and its rotation
-``S`` (body → inertial) as a quaternion, from the compiled kinematics (:func:`pose_function`,
-one machine-code function of the state, evaluated for all frames in one call) at evenly spaced
-times on :meth:`~jourdain.results.Results.interpolate`'s motion; stored as float32 (base64).
+``S`` (body → inertial) as a quaternion, at evenly spaced times on
+:meth:`~jourdain.results.Results.interpolate`'s motion: each joint's relative rotation and
+position compiled (:func:`pose_function`, evaluated for all frames in one call) and composed
+along the tree (:func:`body_poses`); stored as float32 (base64).
 
 three.js (MIT license) is bundled into ``three_bundle.js`` by ``tools/build_viewer.sh`` from
 the npm versions pinned in ``tools/viewer/package-lock.json`` and inlined into every page.
@@ -137,15 +138,20 @@ class View:
 
 @lru_cache(maxsize=32)
 def pose_function(system: System) -> Any:
-    """Compiled ``r_O`` (3×1, inertial) and ``S`` (3×3, body → inertial) of every body, named
-    ``"<body>.r_O"`` and ``"<body>.S"``, as functions of (y, ẏ, t, parameters, inputs)."""
+    """Compiled relative motion of every joint (:func:`jourdain.kinematics.joint_motions`):
+    ``"A<i>"`` (3×3, the child axes in the parent frame) and ``"d<i>"`` (3×1, the child origin in
+    the parent frame) of body ``i``, as functions of (y, ẏ, t, parameters, inputs). Short
+    expressions, one joint each: cheap to compile however deep the tree (composing the poses
+    symbolically, as ``kinematics().bodies[i].S`` does, costs seconds of compilation for a chain
+    of 60 bodies)."""
+    from ...kinematics import joint_motions
     from ...numeric import lambdify
+    from ...symbolic import SymMatrix
 
-    kin = system.kinematics()
     mats = {}
-    for bk in kin.bodies:
-        mats[f"{bk.name}.r_O"] = bk.r_O
-        mats[f"{bk.name}.S"] = bk.S
+    for i, jm in enumerate(joint_motions(system)):
+        mats[f"A{i}"] = SymMatrix.from_rows([list(row) for row in jm.A])
+        mats[f"d{i}"] = SymMatrix.column(list(jm.d))
     return lambdify(system, mats)
 
 
@@ -193,7 +199,8 @@ def frame_times(results: Results, max_frames: int | None = None) -> np.ndarray:
 
 def body_poses(results: Results, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Positions ``r_O`` (n, p, 3) and rotation matrices ``S`` (n, p, 3, 3) of every body frame
-    at ``times`` (within the run) on the interpolated motion."""
+    at ``times`` (within the run) on the interpolated motion: the joints' relative motions
+    composed parents first, ``S_i = S_λ·A_i``, ``r_O,i = r_O,λ + S_λ·d_i`` (METHOD.md §1)."""
     system = _system(results)
     fn = pose_function(system)
     p = np.array([results.parameters[k] for k, _ in system.parameters])
@@ -203,8 +210,18 @@ def body_poses(results: Results, times: np.ndarray) -> tuple[np.ndarray, np.ndar
         m = results.interpolate(times)
         y, yd = m["y"], m["yd"]
     out = fn.batch(y, yd, times, p, None)  # positions do not depend on inputs
-    r = np.stack([out[f"{b.name}.r_O"][:, :, 0] for b in system.bodies], axis=1)
-    S = np.stack([out[f"{b.name}.S"] for b in system.bodies], axis=1)
+    n, nb = len(times), len(system.bodies)
+    r = np.zeros((n, nb, 3))
+    S = np.zeros((n, nb, 3, 3))
+    index = {b.name: i for i, b in enumerate(system.bodies)}
+    for i, b in enumerate(system.bodies):  # parents come first
+        A, d = out[f"A{i}"], out[f"d{i}"][:, :, 0]
+        if b.parent == "world":
+            S[:, i], r[:, i] = A, d
+        else:
+            k = index[b.parent]
+            S[:, i] = S[:, k] @ A
+            r[:, i] = r[:, k] + np.einsum("nij,nj->ni", S[:, k], d)
     if not (np.all(np.isfinite(r)) and np.all(np.isfinite(S))):
         raise EvaluationError("3-D view: the body positions are not finite along the motion")
     return r, S
