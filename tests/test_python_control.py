@@ -20,8 +20,10 @@ UPRIGHT2 = {"q0": 0, "q1": 0, "q2": 0}
 
 def _rhs(system, x, u, parameters):
     """The nonlinear right-hand side ẋ = [ẏ; M⁻¹(q − k)] at x = [y; ẏ] and inputs u."""
+    from jourdain.numeric import evaluate
+
     f = system.f
-    out = system.evaluate(x[:f], x[f:], parameters=parameters, inputs=list(u))
+    out = evaluate(system, x[:f], x[f:], parameters=parameters, inputs=list(u))
     return np.concatenate([x[f:], np.linalg.solve(out["M"], out["q"] - out["k"]).ravel()])
 
 
