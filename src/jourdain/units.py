@@ -27,6 +27,7 @@ Axis labels follow ISO 80000-1 (quantity / unit): ``phi1 / rad``, ``phi1_d / (ra
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
+from functools import lru_cache
 from typing import TYPE_CHECKING
 
 import symengine as se
@@ -167,11 +168,17 @@ def input_units(system: System) -> dict[str, str]:
 def model_units(system: System) -> dict[str, str]:
     """The declared units with the derived units of coordinates and inputs added (``""``
     left out): what results store in their ``units``."""
+    return dict(_model_units(system))
+
+
+@lru_cache(maxsize=32)
+def _model_units(system: System) -> tuple[tuple[str, str], ...]:
+    # a System is immutable (and hashed by its content): every Results of a model asks
     out = dict(system.units)
     for name, u in {**coordinate_units(system), **input_units(system)}.items():
         if u and name not in out:
             out[name] = u
-    return out
+    return tuple(out.items())
 
 
 def reaction_unit(name: str, units: Mapping[str, str]) -> str:
