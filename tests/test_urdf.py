@@ -81,18 +81,23 @@ def test_joints_links_and_geometry_kept_as_data():
     np.testing.assert_allclose(links["tool"].pose, _T([0.05, 0, 0.3], [0, np.pi / 2, 0.2]),
                                atol=4 * EPS)
     np.testing.assert_allclose(links["link2"].pose, np.eye(4), atol=0)
-    kinds = [(g.link, g.kind) for g in model.visuals]
+    kinds = [(g.link, g.kind) for g in model.visual_geometry]
     assert kinds == [("base", "cylinder"), ("link1", "box"), ("tool", "mesh"),
                      ("hand", "sphere")]
-    mesh = model.visuals[2]
+    mesh = model.visual_geometry[2]
     assert mesh.filename == "meshes/tool.stl" and mesh.path is None  # not shipped
     assert mesh.scale == (0.001, 0.001, 0.001) and mesh.body == "link1"
     np.testing.assert_allclose(mesh.pose, links["tool"].pose, atol=0)
-    assert model.visuals[0].size == (0.1, 0.1) and model.visuals[0].rgba == (0.5, 0.5, 0.5, 1.0)
-    assert model.visuals[3].size == (0.04,)
-    np.testing.assert_allclose(model.visuals[3].pose, _T([0.05, 0, 0], [0, np.pi / 2, 0]),
+    assert model.visual_geometry[0].size == (0.1, 0.1) and model.visual_geometry[0].rgba == (0.5, 0.5, 0.5, 1.0)
+    assert model.visual_geometry[3].size == (0.04,)
+    np.testing.assert_allclose(model.visual_geometry[3].pose, _T([0.05, 0, 0], [0, np.pi / 2, 0]),
                                atol=4 * EPS)
-    assert model.collisions == ()
+    assert model.collision_geometry == ()
+    # the meshes as the 3-D view takes them: per moving body, pose in the body frame
+    (mv,) = model.visuals["link1"]
+    assert list(model.visuals) == ["link1"] and mv.scale == (0.001, 0.001, 0.001)
+    np.testing.assert_allclose(mv.rotation, np.asarray(links["tool"].pose)[:3, :3], atol=0)
+    np.testing.assert_allclose(mv.position, np.asarray(links["tool"].pose)[:3, 3], atol=0)
 
 
 def test_actuators_and_joint_damping_act_on_their_coordinates(rng):

@@ -32,7 +32,8 @@ wrenches against RNEA's ``data.f``; tests/reference/test_urdf_pinocchio.py):
 Names: URDF names that are not identifiers (``arm/link-1``) are made identifiers (``arm_link_1``)
 and the map is kept (:attr:`UrdfJoint.coordinates`, :attr:`UrdfLink.body`). Geometry is kept
 as references for viewers (:class:`UrdfGeometry`: mesh file names and scales, boxes,
-cylinders, spheres, each with its pose in the body frame), never loaded.
+cylinders, spheres, each with its pose in the body frame; :attr:`UrdfModel.visuals` gives the
+meshes in the form of the 3-D view), never loaded.
 
 Not supported, each a :class:`UrdfError` naming the link or joint and the file: ``mimic``
 joints (unless ``mimic="independent"``, which makes them ordinary joints as Pinocchio does by
@@ -68,7 +69,13 @@ from ..model import (
     System,
 )
 from .expressions import RESERVED_NAMES
-from .modelfile import MAX_FILE_BYTES, ModelFile, ModelFileError, NominalMotion
+from .modelfile import (
+    MAX_FILE_BYTES,
+    ModelFile,
+    ModelFileError,
+    NominalMotion,
+    SimulationSettings,
+)
 
 __all__ = ["UrdfError", "UrdfGeometry", "UrdfJoint", "UrdfLink", "UrdfModel", "load_urdf",
            "ROOT_JOINT", "ROOT_COORDINATES"]
@@ -198,15 +205,37 @@ class UrdfModel(ModelFile):
     floating_base : whether the root link hangs from the world by a free joint
     joints : every URDF joint, in file order (:class:`UrdfJoint`)
     links : every URDF link, in file order (:class:`UrdfLink`)
-    visuals, collisions : the geometry of the links (:class:`UrdfGeometry`), in file order
+    visual_geometry, collision_geometry : the ``<visual>`` and ``<collision>`` elements of the
+        links (:class:`UrdfGeometry`), in file order
+    visuals : the meshes of :attr:`visual_geometry` as the 3-D view takes them
+        (:func:`jourdain.io.viewer.view`): ``{body: [MeshVisual, ...]}``
     """
 
     robot: str = ""
     floating_base: bool = False
     joints: tuple[UrdfJoint, ...] = ()
     links: tuple[UrdfLink, ...] = ()
-    visuals: tuple[UrdfGeometry, ...] = ()
-    collisions: tuple[UrdfGeometry, ...] = ()
+    visual_geometry: tuple[UrdfGeometry, ...] = ()
+    collision_geometry: tuple[UrdfGeometry, ...] = ()
+
+    @property
+    def visuals(self) -> dict[str, list[Any]]:
+        """The visual meshes of the moving bodies, ``{body: [MeshVisual, ...]}`` (file, scale,
+        pose in the body frame, colour), for :func:`jourdain.io.viewer.view` and the report.
+        Boxes, cylinders, spheres and the links welded to a fixed base are not in it."""
+        from .viewer import MeshVisual
+
+        out: dict[str, list[Any]] = {}
+        for g in self.visual_geometry:
+            if g.kind != "mesh" or g.body == "world":
+                continue
+            T = np.asarray(g.pose)
+            out.setdefault(g.body, []).append(MeshVisual(
+                file=g.path or g.filename or "", scale=g.scale,
+                position=tuple(float(x) for x in T[:3, 3]),
+                rotation=tuple(tuple(float(x) for x in r) for r in T[:3, :3]),
+                color=None if g.rgba is None else g.rgba[:3]))
+        return out
 
     def error(self, message: str) -> ModelFileError:
         """A :class:`UrdfError` for a problem a later stage found (the message names the body
@@ -661,9 +690,10 @@ def _build(robot: Any, src: _Source, *, floating_base: bool, g: float, mimic: st
         description=f'URDF robot "{robot.name}" ({Path(path).name})'
                     + (", floating base" if floating_base else ""),
         nominal=(zero,) if not floating_base else (),
+        simulation=SimulationSettings(y0=(0.0,) * system.f, yd0=(0.0,) * system.f),
         robot=str(robot.name), floating_base=floating_base,
         joints=tuple(info[j.name] for j in robot.joints), links=link_data,
-        visuals=tuple(visuals), collisions=tuple(collisions))
+        visual_geometry=tuple(visuals), collision_geometry=tuple(collisions))
 
 
 def _symbols(names: Sequence[str]) -> tuple[se.Symbol, ...]:
