@@ -161,6 +161,10 @@ def _load(path: str) -> Any:
         raise UsageError(f"{path}: is a folder; expected a model file (.toml)") from None
     except OSError as exc:
         raise UsageError(f"{path}: cannot read the model file: {exc.strerror}") from None
+    if path.lower().endswith(".urdf"):  # a robot description (docs/urdf.md)
+        from .io.urdf import load_urdf
+
+        return load_urdf(path)
     return load_model(path)
 
 
