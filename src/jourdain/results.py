@@ -829,16 +829,19 @@ class _PartialCsv:
 
     def __init__(self, path: str | Path, system: System) -> None:
         names = system.coordinate_names
+        units = model_units(system)
+        cols = ["t", *names, *(f"{n}_d" for n in names), "W"]
         meta = {"format": FORMAT, "version": VERSION, "system": system.name, "method": "",
                 "rtol": float("nan"), "status": "running",
                 "message": "run in progress (or killed): the rows hold the accepted steps "
                            "(t, y, ẏ, W)",
                 "coordinates": json.dumps(names), "inputs": json.dumps(system.input_names),
                 "parameters": json.dumps(system.parameter_values),
-                "units": json.dumps(model_units(system)), "nfev": 0, "nsteps": 0,
-                "wall_time": 0.0}
+                "units": json.dumps(units), "nfev": 0, "nsteps": 0,
+                "wall_time": 0.0,
+                "column_units": json.dumps([unit_of(c, units, names) for c in cols])}
         self.fh = open(path, "w", encoding="utf-8")  # noqa: SIM115 - closed by close()
-        self.fh.write(_csv_header(meta, ["t", *names, *(f"{n}_d" for n in names), "W"]))
+        self.fh.write(_csv_header(meta, cols))
         self.fh.flush()
 
     def append(self, t: np.ndarray, x: np.ndarray) -> None:
