@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -129,6 +129,26 @@ class System:
     def yd(self) -> tuple[se.Symbol, ...]:
         """Symbols of the rates ẏ (``<name>_d``)."""
         return tuple(rate(c) for c in self.coordinates)
+    def __hash__(self) -> int:
+        """The hash of the fields, computed once: the memoized stages (``mkq_function(system)``
+        and the like) look a system up on every call, and hashing its bodies and expressions
+        anew took 10 µs each time. The fields never change (frozen), so neither does the hash;
+        equality stays the dataclass's field-by-field comparison."""
+        h = self.__dict__.get("_hash")
+        if h is None:
+            h = hash(tuple(getattr(self, f.name) for f in fields(self)))
+            object.__setattr__(self, "_hash", h)
+        return h
+
+    def __getstate__(self) -> dict:
+        # the cached hash belongs to this process (hashes of expressions differ between
+        # processes): a copy sent to another one computes its own
+        return {k: v for k, v in self.__dict__.items() if k != "_hash"}
+
+    def __setstate__(self, state: dict) -> None:
+        for k, v in state.items():
+            object.__setattr__(self, k, v)
+
 
     @property
     def ydd(self) -> tuple[se.Symbol, ...]:
