@@ -4,6 +4,7 @@ right-hand side; an LQR design on pendula on a cart whose loop, closed in a jour
 simulation, follows the linear closed loop that python-control predicts."""
 
 import sys
+from pathlib import Path
 
 import control
 import numpy as np
@@ -164,3 +165,40 @@ def test_errors_name_what_is_wrong(monkeypatch):
     monkeypatch.setitem(sys.modules, "control", None)  # as if python-control were missing
     with pytest.raises(MissingDependency, match=r"jourdain\[control\]"):
         to_control(lin)
+
+
+def test_lqr_holds_a_urdf_arm_in_a_pose_against_gravity():
+    """The same loop on a robot read from URDF (tests/data/urdf/two_link_arm.urdf: joint
+    torques tau_<joint> as inputs): about a pose held by the gravity torques u_s (the nominal
+    check's holding inputs), u = u_s − K·(x − x_s). No symmetry here, so the deviation from the
+    linear closed loop, relative to the motion, is O(ε): doubling ε doubles it, to the next
+    term of the expansion (bounded by 10 times the deviation)."""
+    pytest.importorskip("yourdfpy", reason="URDF import needs yourdfpy (jourdain[urdf])")
+    import warnings
+
+    from jourdain.io.urdf import load_urdf
+
+    s = load_urdf(Path(__file__).parent / "data" / "urdf" / "two_link_arm.urdf").system
+    pose = {"shoulder": 0.3, "elbow": 0.5, "wrist": -0.2}
+    with warnings.catch_warnings():  # without its holding torques the pose is no equilibrium
+        warnings.simplefilter("ignore", jd.NominalMotionWarning)
+        hold = jd.linearize_numeric(s, pose).nominal_check.holding_inputs
+    lin = s.linearize(pose, inputs=hold)
+    assert lin.check_nominal().is_solution
+    plant = to_control(lin)
+    assert plant.input_labels == ["tau_shoulder", "tau_elbow", "tau_wrist"]
+    K, _, E = control.lqr(plant, np.eye(6), np.eye(3))
+    assert np.real(E).max() < 0
+    closed = control.ss(plant.A - plant.B @ K, plant.B, np.eye(6), np.zeros((6, 3)))
+    law = state_feedback(s, K, lin)
+    y_s = np.array(list(pose.values()))
+    t = np.linspace(0.0, 5.0, 251)
+    dev = []
+    for eps in (1e-3, 2e-3):
+        dx = np.array([eps, -eps, 0.5 * eps, 0.0, 0.0, 0.0])
+        res = s.simulate((0.0, 5.0), y_s + dx[:3], dx[3:], inputs=law, rtol=1e-11, atol=1e-13,
+                         t_eval=t)
+        ref = control.initial_response(closed, T=t, X0=dx).states.T
+        sim = np.hstack([res.y - y_s, res.yd])
+        dev.append(np.abs(sim - ref).max() / np.abs(ref).max())
+    assert abs(dev[1] / dev[0] / 2.0 - 1.0) <= 10 * dev[1], dev
