@@ -23,7 +23,15 @@ import numpy as np
 
 from ..errors import JourdainError
 from ..symbolic import to_sympy
-from ..units import axis_label, model_units, reactions_label, shared_label, value_units
+from ..units import (
+    axis_label,
+    force_unit,
+    model_units,
+    reactions_label,
+    shared_label,
+    torque_unit,
+    value_units,
+)
 from . import export
 from .modelfile import ModelFile
 
@@ -437,7 +445,7 @@ def _sections(model: ModelFile, out: Path, params: dict[str, float], t_end: floa
     p = len(system.bodies)
 
     # --- the model ------------------------------------------------------------------------
-    units = dict(system.units)
+    units = model_units(system)  # declared, and derived for coordinates and inputs
     desc = dict(model.descriptions)
     pv = system.parameter_values
     pv.update(params)
@@ -560,7 +568,8 @@ def _sections(model: ModelFile, out: Path, params: dict[str, float], t_end: floa
             labels = list(extra.get("g_names", [str(i) for i in range(g.size)]))
             s.append("<h3>Reaction forces g (N̂·g = k̂ − q̂)</h3>"
                      "<p class='meta'>Components in the child body frame at the joint point; "
-                     "forces in N, torques in N·m (in the model's units).</p>")
+                     f"forces in {_e(force_unit(units))}, torques in {_e(torque_unit(units))} "
+                     "(in the model's units).</p>")
             s.append(_matrix_table(g[None, :], None, labels))
             if extra.get("g_undetermined"):
                 s.append(_note("undetermined components (statically indeterminate): "
@@ -652,7 +661,7 @@ def _sections(model: ModelFile, out: Path, params: dict[str, float], t_end: floa
                 zetas = _snap(m.damping_ratios, 1e-9)
                 for lam, fn, z in zip(lams, m.frequencies_hz, zetas, strict=True):
                     rows.append((_num(lam.real), _num(lam.imag), _num(fn), _num(z)))
-                s.append(_table(rows, ["Re λ [1/s]", "Im λ [rad/s]", "f<sub>n</sub> [Hz]",
+                s.append(_table(rows, ["Re λ / (1/s)", "Im λ / (rad/s)", "f<sub>n</sub> / Hz",
                                        "ζ"]))
                 s.append(_eigen_plot(lams, f"eigenvalues about {nominal.name}"))
             if res.get("cyclic"):
