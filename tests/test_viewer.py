@@ -26,6 +26,7 @@ import jourdain as jd
 from jourdain.io import capabilities, load_model
 from jourdain.io.viewer import (
     MeshVisual,
+    Visual,
     decode_poses,
     equivalent_shape,
     frame_times,
@@ -284,8 +285,8 @@ def test_meshes_are_embedded_and_bad_ones_noted(spatial, tmp_path):
                    MeshVisual(tmp_path / "missing.stl"), MeshVisual("package://robot/a.dae")],
            "bob": [MeshVisual(tmp_path / "part.dae")]}
     v = view(res, visuals=vis, max_frames=5)
-    meshes = v.scene["bodies"][0]["meshes"]
-    assert len(meshes) == 3
+    meshes = v.scene["bodies"][0]["visuals"]
+    assert len(meshes) == 3 and {m["kind"] for m in meshes} == {"mesh"}
     got = [np.frombuffer(__import__("base64").b64decode(m["triangles"]), "<f4").reshape(-1, 3, 3)
            for m in meshes]
     np.testing.assert_array_equal(got[0], tet.astype(np.float32))
@@ -299,12 +300,16 @@ def test_meshes_are_embedded_and_bad_ones_noted(spatial, tmp_path):
     assert "missing.stl" in notes and "cannot be read" in notes
     assert "package://robot/a.dae" in notes and "resolve package://" in notes
     assert "part.dae" in notes and "only STL and OBJ" in notes
-    assert v.scene["bodies"][1]["meshes"] == []  # the bob keeps its sphere
+    assert v.scene["bodies"][1]["visuals"] == []  # the bob keeps its sphere
     assert "missing.stl" in v.html  # the notes are shown in the page
     with pytest.raises(jd.ModelError, match="'wheel', which is not a body of 'spatial'"):
         view(res, visuals={"wheel": [MeshVisual(tmp_path / "tet.stl")]})
     with pytest.raises(jd.ModelError, match="visual 0 of body 'box': rotation is not a rotation"):
         view(res, visuals={"box": [MeshVisual(tmp_path / "tet.stl", rotation=np.eye(3) * 2)]})
+    with pytest.raises(jd.ModelError, match="visual 0 of body 'box': size must be \\(3,\\)"):
+        view(res, visuals={"box": [Visual("box", size=(1.0, 2.0))]})
+    with pytest.raises(jd.ModelError, match="kind must be one of mesh, box, cylinder, sphere"):
+        view(res, visuals={"box": [Visual("cone", size=(1.0,))]})
     (tmp_path / "bad.obj").write_text("v 0 0 0\nf 1 2 3\n")
     with pytest.raises(jd.ModelError, match="bad.obj.*a face refers to a vertex"):
         jd.io.viewer.read_mesh(tmp_path / "bad.obj")
@@ -431,3 +436,51 @@ def test_view_screenshots_differ_between_two_times(pendulum, tmp_path):
     print("pixels of rod1's colour at the two times:", body_px, "; pixels changed:", changed)
     assert min(body_px) > 100, body_px
     assert changed > 500, changed
+
+
+def test_primitive_visuals_and_a_urdf_models_geometry(spatial):
+    """Boxes, cylinders and spheres are drawn with their size and origin; "world" visuals stand
+    still. A URDF model's <visual> elements (jourdain.io.urdf) are taken as they are: each at
+    the pose the import gives in its body frame, the base's cylinder in the world, the mesh
+    that is not on this machine noted."""
+    system, _, res = spatial
+    R = rpy_matrix([0.2, 0.0, 0.0])
+    vis = {"box": [Visual("box", size=(0.1, 0.2, 0.3), position=(0, 0, 0.1),
+                          rotation=R.tolist(), color=(1, 0, 0, 1))],
+           "world": [Visual("cylinder", size=(0.05, 0.5))],
+           "bob": [Visual("sphere", size=(0.03,))]}
+    sc = view(res, visuals=vis, max_frames=5).scene
+    box = sc["bodies"][0]["visuals"][0]
+    assert (box["kind"], box["size"], box["position"], box["color"]) == (
+        "box", [0.1, 0.2, 0.3], [0.0, 0.0, 0.1], [1.0, 0.0, 0.0])
+    assert _same_rotation(np.array(box["quaternion"]),
+                          Rotation.from_matrix(R).as_quat()) <= eval_tol(9, 1.0)
+    assert [(w["kind"], w["size"]) for w in sc["world_visuals"]] == [("cylinder", [0.05, 0.5])]
+    assert sc["bodies"][1]["visuals"][0]["size"] == [0.03]
+
+    pytest.importorskip("yourdfpy", reason="URDF import needs yourdfpy (jourdain[urdf])")
+    from jourdain.io.urdf import load_urdf
+    from jourdain.io.viewer import model_visuals
+
+    model = load_urdf(ROOT / "tests" / "data" / "urdf" / "two_link_arm.urdf")
+    s = model.system
+    n = 5
+    t = np.linspace(0, 1, n)
+    y = np.outer(t, np.arange(1, s.f + 1) * 0.3)
+    urdf_res = jd.Results(s, t, y, np.zeros_like(y), np.zeros_like(y),
+                          np.zeros((n, len(s.inputs))), np.zeros(n), s.parameter_values)
+    v = view(urdf_res, visuals=model_visuals(model))
+    drawn = {b["name"]: b["visuals"] for b in v.scene["bodies"]}
+    geo = {(g.body, g.kind): g for g in model.visual_geometry}
+    for body, specs in [*drawn.items(), ("world", v.scene["world_visuals"])]:
+        for spec in specs:
+            g = geo[(body, spec["kind"])]
+            T = np.asarray(g.pose)
+            assert spec["position"] == pytest.approx(T[:3, 3], abs=eval_tol(3, 1.0))
+            assert _same_rotation(np.array(spec["quaternion"]),
+                                  Rotation.from_matrix(T[:3, :3]).as_quat()) <= eval_tol(9, 1.0)
+            assert spec["size"] == list(g.size)
+    kinds = sorted((b, s_["kind"]) for b, specs in drawn.items() for s_ in specs)
+    kinds += [("world", w["kind"]) for w in v.scene["world_visuals"]]
+    assert sorted(kinds) == sorted(k for k, g in geo.items() if g.kind != "mesh")
+    assert any("tool.stl" in n_ and "not found" in n_ for n_ in v.notes), v.notes

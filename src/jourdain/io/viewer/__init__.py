@@ -16,12 +16,14 @@ What is drawn
 * a triad at each body frame (x red, y green, z blue) and a fainter one at each joint frame,
   fixed in the parent body's frame (or the inertial one);
 * spring-dampers as lines between their two points;
-* meshes where given (:class:`MeshVisual`, the ``visuals`` hook: a list per body of mesh file,
-  scale and origin in the body frame, e.g. from a URDF's ``<visual>``): STL (binary or ASCII) and
-  OBJ files are read here and embedded, so the page needs no file beside it. A body with meshes
-  is drawn by them instead of its equivalent shape; a mesh that cannot be read (missing file,
-  another format such as COLLADA ``.dae``, an unresolved ``package://`` address) is left out
-  with a note, and the body keeps its equivalent shape if none of its meshes could be read.
+* the visuals of a body where given (:class:`Visual`, the ``visuals`` hook: per body a list
+  of meshes — file, scale — and boxes, cylinders, spheres, each with its origin in the body
+  frame; a URDF model's ``<visual>`` elements, :attr:`jourdain.io.urdf.UrdfModel.visuals`, are
+  taken as they are). STL (binary or ASCII) and OBJ files are read here and embedded, so the
+  page needs no file beside it. A body with visuals is drawn by them instead of its equivalent
+  shape; a mesh that cannot be read (missing file, another format such as COLLADA ``.dae``, an
+  unresolved ``package://`` address) is left out with a note, and the body keeps its
+  equivalent shape if none of its visuals could be drawn. Visuals of ``"world"`` stand still.
 
 The motion
 ----------
@@ -75,25 +77,56 @@ _COLORS = ("#4e79a7", "#f28e2b", "#59a14f", "#e15759", "#76b7b2", "#edc948", "#b
            "#ff9da7", "#9c755f", "#bab0ac")
 
 
+#: the kinds of :class:`Visual` and the numbers of their ``size``
+VISUAL_KINDS = {"mesh": 0, "box": 3, "cylinder": 2, "sphere": 1}
+
+
 @dataclass(frozen=True)
-class MeshVisual:
-    """A mesh drawn for a body (the data hook for URDF ``<visual>`` meshes and the like).
+class Visual:
+    """A shape drawn for a body instead of its equivalent box: the data hook for URDF
+    ``<visual>`` elements and the like (the URDF import's :class:`~jourdain.io.urdf.UrdfGeometry`
+    carries the same data and is accepted as it is).
 
     Parameters
     ----------
-    file : path of an STL or OBJ file (relative paths: to the working directory)
-    scale : 3 factors applied to the mesh's vertex coordinates
-    position : the mesh origin in the body frame
-    rotation : 3×3 rotation matrix, the mesh axes in the body frame (``x_body = R·x_mesh +
-        position``); :func:`rpy_matrix` turns a URDF ``rpy`` into one
-    color : RGB in [0, 1], or None for the body's colour
+    kind : "mesh", "box", "cylinder" or "sphere"
+    file : for a mesh, the path of an STL or OBJ file (relative: to the working directory)
+    size : box: edge lengths (x, y, z); cylinder: (radius, length), along its z axis; sphere:
+        (radius,); empty for a mesh
+    scale : 3 factors applied to a mesh's vertex coordinates
+    position : the visual's origin in the body frame
+    rotation : 3×3 rotation matrix, the visual's axes in the body frame (``x_body = R·x + p``);
+        :func:`rpy_matrix` turns a URDF ``rpy`` into one
+    color : RGB (or RGBA, the A ignored) in [0, 1], or None for the body's colour
     """
 
-    file: str | Path
+    kind: str = "mesh"
+    file: str | Path | None = None
+    size: tuple[float, ...] = ()
     scale: tuple[float, float, float] = (1.0, 1.0, 1.0)
     position: tuple[float, float, float] = (0.0, 0.0, 0.0)
     rotation: tuple[tuple[float, ...], ...] = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
-    color: tuple[float, float, float] | None = None
+    color: tuple[float, ...] | None = None
+
+
+class MeshVisual(Visual):
+    """A mesh :class:`Visual`: ``MeshVisual(file, scale, position, rotation, color)``."""
+
+    def __init__(self, file: str | Path, scale: Sequence[float] = (1.0, 1.0, 1.0),
+                 position: Sequence[float] = (0.0, 0.0, 0.0), rotation: Any = None,
+                 color: Sequence[float] | None = None) -> None:
+        R = np.eye(3) if rotation is None else rotation
+        super().__init__("mesh", file, (), _floats(scale), _floats(position),  # type: ignore[arg-type]
+                         tuple(_floats(r) for r in R), None if color is None else _floats(color))
+
+
+def _floats(v: Any) -> tuple:
+    """A tuple of floats where ``v`` is a sequence of numbers (else ``v`` as given, for
+    :func:`_check_visuals` to report)."""
+    try:
+        return tuple(float(x) for x in v)
+    except (TypeError, ValueError):
+        return v
 
 
 def rpy_matrix(rpy: Sequence[float]) -> np.ndarray:
@@ -328,24 +361,101 @@ def read_mesh(path: str | Path) -> np.ndarray:
     return tri
 
 
-def _check_visuals(visuals: Mapping[str, Sequence[MeshVisual]], system: System) -> None:
-    names = set(system.body_names)
+def _from_geometry(g: Any) -> Visual:
+    """A :class:`Visual` from a URDF import's geometry record (``kind``, ``pose`` 4×4 in the
+    body frame, ``path``/``filename``, ``scale``, ``size``, ``rgba``)."""
+    T = np.asarray(g.pose, float)
+    if T.shape != (4, 4):
+        raise ModelError(f"3-D view: the pose of a visual of {g.body!r} is not a 4×4 matrix")
+    file = getattr(g, "path", None) or getattr(g, "filename", None)
+    rgba = getattr(g, "rgba", None)
+    return Visual(str(g.kind), file, tuple(getattr(g, "size", ()) or ()),
+                  tuple(getattr(g, "scale", (1.0, 1.0, 1.0))),  # type: ignore[arg-type]
+                  tuple(T[:3, 3]), tuple(map(tuple, T[:3, :3])),  # type: ignore[arg-type]
+                  None if rgba is None else tuple(float(x) for x in rgba))
+
+
+def visuals_by_body(visuals: Any, notes: list[str] | None = None) -> dict[str, list[Visual]]:
+    """The ``visuals`` hook as ``{body: [Visual, ...]}``: a mapping of that form, or a sequence
+    of records with a ``body`` attribute (a URDF model's ``visuals``; collision geometry,
+    ``collision=True``, is left out, and so are meshes the import did not find, ``path`` None,
+    with a note in ``notes``)."""
+    if visuals is None:
+        return {}
+    if isinstance(visuals, Mapping):
+        return {str(k): list(v) for k, v in visuals.items()}
+    out: dict[str, list[Visual]] = {}
+    for g in visuals:
+        if getattr(g, "collision", False):
+            continue
+        if not hasattr(g, "body"):
+            raise ModelError("3-D view: visuals must map body names to lists of Visual, or be "
+                             f"records with a body (got {type(g).__name__})")
+        if getattr(g, "kind", None) == "mesh" and hasattr(g, "path") and not g.path:
+            if notes is not None:
+                notes.append(f"body {g.body}: mesh {getattr(g, 'filename', '')!r} not found on "
+                             "this machine; drawn without it")
+            continue
+        out.setdefault(str(g.body), []).append(g if isinstance(g, Visual) else _from_geometry(g))
+    return out
+
+
+def _check_visuals(visuals: Mapping[str, Sequence[Visual]], system: System) -> None:
+    names = set(system.body_names) | {"world"}
     for body, items in visuals.items():
         if body not in names:
             raise ModelError(f"3-D view: visuals for {body!r}, which is not a body of "
-                             f"{system.name!r} (bodies: {', '.join(system.body_names)})")
+                             f"{system.name!r} (bodies: {', '.join(system.body_names)}, world)")
         for k, v in enumerate(items):
             where = f"3-D view: visual {k} of body {body!r}"
-            if not isinstance(v, MeshVisual):
-                raise ModelError(f"{where}: expected a MeshVisual, got {type(v).__name__}")
-            for what, val, shape in (("scale", v.scale, (3,)), ("position", v.position, (3,)),
-                                     ("rotation", v.rotation, (3, 3))):
+            if not isinstance(v, Visual):
+                raise ModelError(f"{where}: expected a Visual, got {type(v).__name__}")
+            if v.kind not in VISUAL_KINDS:
+                raise ModelError(f"{where}: kind must be one of {', '.join(VISUAL_KINDS)}, "
+                                 f"got {v.kind!r}")
+            checks = [("scale", v.scale, (3,)), ("position", v.position, (3,)),
+                      ("rotation", v.rotation, (3, 3)), ("size", v.size, (VISUAL_KINDS[v.kind],))]
+            if v.color is not None:
+                checks.append(("color", tuple(v.color)[:3], (3,)))
+            for what, val, shape in checks:
                 a = np.asarray(val, float) if _numeric(val) else None
                 if a is None or a.shape != shape or not np.all(np.isfinite(a)):
                     raise ModelError(f"{where}: {what} must be {shape} finite numbers")
+            if v.kind != "mesh" and min(v.size) <= 0:
+                raise ModelError(f"{where}: the {v.kind}'s size must be positive")
+            if v.kind == "mesh" and not v.file:
+                raise ModelError(f"{where}: a mesh needs a file")
             R = np.asarray(v.rotation, float)
             if np.abs(R.T @ R - np.eye(3)).max() > 1e-6 or np.linalg.det(R) < 0:
                 raise ModelError(f"{where}: rotation is not a rotation matrix")
+
+
+def _visual_specs(owner: str, items: Sequence[Visual], notes: list[str],
+                  budget: list[int]) -> list[dict[str, Any]]:
+    """The scene entries of one body's visuals; meshes read and embedded (``budget[0]``: the
+    triangles the page may still take)."""
+    out = []
+    for k, v in enumerate(items):
+        spec: dict[str, Any] = {
+            "kind": v.kind, "size": [float(x) for x in v.size],
+            "scale": [float(x) for x in v.scale], "position": [float(x) for x in v.position],
+            "quaternion": quaternions(np.asarray(v.rotation, float)).tolist(),
+            "color": None if v.color is None else [float(x) for x in tuple(v.color)[:3]]}
+        if v.kind == "mesh":
+            try:
+                tri = read_mesh(v.file)  # type: ignore[arg-type]
+            except ModelError as exc:
+                notes.append(f"{owner}: {exc}; drawn without it")
+                continue
+            if len(tri) > budget[0]:
+                notes.append(f"{owner}: mesh {k} ({len(tri)} triangles) left out, more than "
+                             f"{MAX_TRIANGLES} triangles in the page")
+                continue
+            budget[0] -= len(tri)
+            spec["file"] = str(v.file)
+            spec["triangles"] = _b64(tri.reshape(-1), "<f4")
+        out.append(spec)
+    return out
 
 
 def _numeric(val: Any) -> bool:
@@ -409,7 +519,7 @@ def _camera(points: np.ndarray, up: np.ndarray) -> tuple[np.ndarray, float, np.n
     return center, extent, d, extent, ground
 
 
-def scene(results: Results, visuals: Mapping[str, Sequence[MeshVisual]] | None = None,
+def scene(results: Results, visuals: Any = None,
           shape: str = "box", max_frames: int | None = None) -> dict[str, Any]:
     """The scene of the page as a JSON-ready dict (``"format": "jourdain-view/1"``): bodies
     with their shapes, meshes and joint frames, spring-dampers, the camera, the frame times
@@ -418,11 +528,11 @@ def scene(results: Results, visuals: Mapping[str, Sequence[MeshVisual]] | None =
     system = _system(results)
     if shape not in SHAPES:
         raise ModelError(f"3-D view: shape must be one of {', '.join(SHAPES)}, got {shape!r}")
-    visuals = dict(visuals or {})
+    notes: list[str] = []
+    visuals = visuals_by_body(visuals, notes)
     _check_visuals(visuals, system)
     values = dict(system.parameter_values)
     values.update(results.parameters)
-    notes: list[str] = []
 
     times = frame_times(results, max_frames)
     r, S = body_poses(results, times)
@@ -449,7 +559,7 @@ def scene(results: Results, visuals: Mapping[str, Sequence[MeshVisual]] | None =
     distance = max(distance, 1.2 * L) * 1.5
     mmax = max((m for m, _, _, _ in raw), default=0.0)
 
-    triangles_left = MAX_TRIANGLES
+    budget = [MAX_TRIANGLES]
     for i, (b, (m, com, sides, V)) in enumerate(zip(system.bodies, raw, strict=True)):
         if m <= 0:
             kind, size = "none", np.zeros(3)
@@ -462,23 +572,7 @@ def scene(results: Results, visuals: Mapping[str, Sequence[MeshVisual]] | None =
         jpos = _vec(b.joint.position, values, f'the position of joint "{b.joint.name}"')
         jrot = _vec([x for row in b.joint.orientation for x in row], values,
                     f'the orientation of joint "{b.joint.name}"').reshape(3, 3)
-        meshes = []
-        for k, v in enumerate(visuals.get(b.name, [])):
-            try:
-                tri = read_mesh(v.file)
-            except ModelError as exc:
-                notes.append(f"body {b.name}: {exc}; drawn without it")
-                continue
-            if len(tri) > triangles_left:
-                notes.append(f"body {b.name}: mesh {k} ({len(tri)} triangles) left out, more "
-                             f"than {MAX_TRIANGLES} triangles in the page")
-                continue
-            triangles_left -= len(tri)
-            meshes.append({"file": str(v.file), "triangles": _b64(tri.reshape(-1), "<f4"),
-                           "scale": [float(x) for x in v.scale],
-                           "position": [float(x) for x in v.position],
-                           "quaternion": quaternions(np.asarray(v.rotation, float)).tolist(),
-                           "color": None if v.color is None else [float(x) for x in v.color]})
+        drawn = _visual_specs(f"body {b.name}", visuals.get(b.name, []), notes, budget)
         bodies.append({
             "name": b.name, "parent": b.parent, "mass": float(m),
             "color": _COLORS[i % len(_COLORS)],
@@ -486,7 +580,8 @@ def scene(results: Results, visuals: Mapping[str, Sequence[MeshVisual]] | None =
                       "quaternion": quaternions(V).tolist()},
             "joint": {"name": b.joint.name, "position": jpos.tolist(),
                       "quaternion": quaternions(jrot).tolist()},
-            "meshes": meshes})
+            "visuals": drawn})
+    world_visuals = _visual_specs("world", visuals.get("world", []), notes, budget)
 
     springs = []
     from ...model.forces import SpringDamper
@@ -501,7 +596,8 @@ def scene(results: Results, visuals: Mapping[str, Sequence[MeshVisual]] | None =
     poses = np.concatenate([r, quaternions(S)], axis=-1)  # (n, p, 7)
     return {"format": SCENE_FORMAT, "name": system.name, "n_frames": int(len(times)),
             "times": _b64(times, "<f8"), "poses": _b64(poses.reshape(-1), "<f4"),
-            "bodies": bodies, "springs": springs, "up": up.tolist(),
+            "bodies": bodies, "world_visuals": world_visuals, "springs": springs,
+            "up": up.tolist(),
             "center": center.tolist(), "extent": float(L), "view_dir": view_dir.tolist(),
             "distance": float(distance), "ground": ground.tolist(), "notes": notes,
             "shape": shape, "status": results.status}
@@ -576,16 +672,17 @@ def embed(page_html: str, height: int = 480) -> str:
             "border:1px solid #ccc'></iframe>")
 
 
-def view(results: Results, *, visuals: Mapping[str, Sequence[MeshVisual]] | None = None,
+def view(results: Results, *, visuals: Any = None,
          shape: str = "box", max_frames: int | None = None, height: int = 480) -> View:
     """The 3-D view of a simulation's motion (``jd.view(results)``).
 
     Parameters
     ----------
     results : the :class:`~jourdain.results.Results` of a simulation (with its system)
-    visuals : meshes per body name (:class:`MeshVisual`); default: the system's ``visuals``
-        attribute where it has one (a model imported with meshes), else none
-    shape : "box" or "ellipsoid", the equivalent solid drawn for a body without meshes
+    visuals : per body name a list of :class:`Visual` (meshes, boxes, cylinders, spheres), or
+        a URDF model's ``visuals`` (``view(res, visuals=model.visuals)``); default: the
+        system's ``visuals`` attribute where it has one, else none
+    shape : "box" or "ellipsoid", the equivalent solid drawn for a body without visuals
     max_frames : at most this many frames (default :data:`MAX_FRAMES`)
     height : pixels of the view in a notebook
     """
@@ -595,15 +692,24 @@ def view(results: Results, *, visuals: Mapping[str, Sequence[MeshVisual]] | None
     return View(page(sc), tuple(sc["notes"]), int(height), sc)
 
 
-def report_section(results: Results, visuals: Mapping[str, Sequence[MeshVisual]] | None = None
-                   ) -> str:
-    """The report's "3-D view" section (HTML); a note instead where it cannot be drawn."""
+def model_visuals(model: Any) -> Any:
+    """The visuals of a model for the ``visuals`` hook: its ``visual_geometry`` (a URDF model's
+    ``<visual>`` elements, every kind) where it has them, else its ``visuals``, else None."""
+    return getattr(model, "visual_geometry", None) or getattr(model, "visuals", None)
+
+
+def report_section(results: Results, model: Any = None) -> str:
+    """The report's "3-D view" section (HTML) for the results of ``model`` (a
+    :class:`~jourdain.io.ModelFile`; its visuals are drawn where it has any, see
+    :func:`model_visuals`); a note instead where the view cannot be drawn."""
     try:
-        v = view(results, visuals=visuals)
+        v = view(results, visuals=model_visuals(model))
     except JourdainError as exc:
-        return f"<h3>3-D view</h3><p class='note'>{html.escape(f'3-D view not available: {exc}')}</p>"
+        why = html.escape(f"3-D view not available: {exc}")
+        return f"<h3>3-D view</h3><p class='note'>{why}</p>"
     return ("<h3>3-D view</h3>" + v._repr_html_()
             + "<p class='meta'>Bodies as boxes of the same mass and principal inertia (or their "
-              "meshes), body and joint frames as triads, spring-dampers as lines; play, pause "
+              "visuals), body and joint frames as triads, spring-dampers as lines; play, pause "
               "and drag the slider; drag to turn the view. Needs JavaScript and WebGL; the SVG "
               "animation above needs neither.</p>")
+

@@ -3,7 +3,7 @@
  * Reads the scene from the JSON script element "jourdain-scene" and draws it with
  * three.js (the global JD3 of three_bundle.js): one group per body, placed at each time by the
  * body frame's inertial position r_O and orientation S (as a quaternion), with the body's
- * equivalent box or ellipsoid (or its meshes) and a triad of the body frame inside it, a triad of
+ * equivalent box or ellipsoid (or its visuals) and a triad of the body frame inside it, a triad of
  * each joint frame fixed to the parent, and the spring-dampers as lines between their points.
  *
  * Poses: a Float32Array (base64) of n_frames × n_bodies × 7 numbers (x, y, z, qx, qy, qz, qw);
@@ -85,6 +85,28 @@
     if (spec.scale) obj.scale.fromArray(spec.scale);
   }
 
+  // a visual: a mesh (triangles), box, cylinder (radius, length along z) or sphere (radius)
+  function visual(v, colour) {
+    var geo;
+    if (v.kind === "mesh") {
+      geo = new T.BufferGeometry();
+      geo.setAttribute("position", new T.BufferAttribute(decode(v.triangles, Float32Array), 3));
+      geo.computeVertexNormals();
+    } else if (v.kind === "box") {
+      geo = new T.BoxGeometry(v.size[0], v.size[1], v.size[2]);
+    } else if (v.kind === "cylinder") {
+      geo = new T.CylinderGeometry(v.size[0], v.size[0], v.size[1], 32);
+      geo.rotateX(Math.PI / 2);  // three.js's cylinders stand along y, URDF's along z
+    } else {
+      geo = new T.SphereGeometry(v.size[0], 32, 16);
+    }
+    var m = new T.Mesh(geo, new T.MeshStandardMaterial({
+      color: v.color ? new T.Color().fromArray(v.color) : colour, roughness: 0.6,
+      metalness: 0.05, side: T.DoubleSide }));
+    place(m, v);
+    return m;
+  }
+
   // --- bodies ------------------------------------------------------------------------------
   var groups = {};
   var coms = {};
@@ -102,17 +124,8 @@
     g.add(c);
     coms[b.name] = c;
     var mat = new T.MeshStandardMaterial({ color: colour, roughness: 0.6, metalness: 0.05 });
-    if (b.meshes.length) {
-      b.meshes.forEach(function (m) {
-        var geo = new T.BufferGeometry();
-        geo.setAttribute("position", new T.BufferAttribute(decode(m.triangles, Float32Array), 3));
-        geo.computeVertexNormals();
-        var mm = new T.Mesh(geo, m.color ? new T.MeshStandardMaterial({
-          color: new T.Color().fromArray(m.color), roughness: 0.6, side: T.DoubleSide })
-          : new T.MeshStandardMaterial({ color: colour, roughness: 0.6, side: T.DoubleSide }));
-        place(mm, m);
-        g.add(mm);
-      });
+    if (b.visuals.length) {
+      b.visuals.forEach(function (v) { g.add(visual(v, colour)); });
     } else if (b.shape.kind === "box") {
       c.add(new T.Mesh(new T.BoxGeometry(b.shape.size[0], b.shape.size[1], b.shape.size[2]), mat));
     } else if (b.shape.kind === "ellipsoid" || b.shape.kind === "sphere") {
@@ -129,6 +142,7 @@
     (b.parent === "world" ? world : groups[b.parent]).add(j);
   });
   world.add(triad(0.1 * L, 0.7));
+  scene.world_visuals.forEach(function (v) { world.add(visual(v, new T.Color(0x9a9a9a))); });
 
   // spring-dampers: one line each between their points
   var springGeo = new T.BufferGeometry();
