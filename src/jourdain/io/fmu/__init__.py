@@ -40,7 +40,7 @@ from typing import TYPE_CHECKING, Any
 from ...errors import EvaluationError, JourdainError, ModelError
 from ...numeric.ccode import argument_names, function_source
 from ...numeric.recursive import recursive_units
-from ...numeric.toolchain import CompilerError, compiler
+from ...numeric.toolchain import CompilerError, compiler, content_key, library_dir, not_private
 from .description import Layout, build_description, layout, model_description
 
 if TYPE_CHECKING:
@@ -255,6 +255,33 @@ def _compile(srcdir: Path, out: Path) -> None:
         o.unlink()
 
 
+def _binary(sources: Mapping[str, bytes], name: str) -> bytes:
+    """The compiled binary of the FMU's sources: from jourdain's cache of compiled code
+    (:func:`jourdain.numeric.cache_dir`, keyed by the sources, the compiler and its flags) when
+    it was built before, else compiled in a temporary folder and kept there."""
+    cc = compiler()
+    h = hashlib.sha256()
+    for k, v in sorted(sources.items()):
+        h.update(k.encode() + b"\0" + v + b"\0")
+    key = "fmu-" + content_key("fmu", cc, *CFLAGS, h.hexdigest())
+    cache = library_dir() / f"{key}{Path(name).suffix}"
+    if cache.is_file() and not_private(cache) is None:
+        return cache.read_bytes()
+    with tempfile.TemporaryDirectory(prefix="jourdain-fmu-") as tmp:
+        src = Path(tmp)
+        for k, data in sources.items():
+            (src / k.split("/", 1)[1]).write_bytes(data)
+        lib = src / name
+        _compile(src, lib)
+        data = lib.read_bytes()
+    fd, tmp_name = tempfile.mkstemp(suffix=".tmp", dir=cache.parent)
+    with os.fdopen(fd, "wb") as fh:
+        fh.write(data)
+    os.chmod(tmp_name, 0o700)
+    os.replace(tmp_name, cache)  # never half-written: a concurrent export sees all or nothing
+    return data
+
+
 def _model_of(model: Any) -> tuple[System, Any]:
     from ...model.system import System
 
@@ -385,15 +412,9 @@ def export_fmu(model: Any, path: str | os.PathLike[str], *,
         files[f"sources/{hname}"] = (headers / hname).read_bytes()
     binary_name = None
     if binary:
-        with tempfile.TemporaryDirectory(prefix="jourdain-fmu-") as tmp:
-            src = Path(tmp)
-            for name, data in files.items():
-                if name.startswith("sources/"):
-                    (src / name[8:]).write_bytes(data)
-            lib = src / f"{ident}{suffix}"
-            _compile(src, lib)
-            binary_name = f"binaries/{folder}/{ident}{suffix}"
-            files[binary_name] = lib.read_bytes()
+        binary_name = f"binaries/{folder}/{ident}{suffix}"
+        files[binary_name] = _binary({k: v for k, v in files.items() if k.startswith("sources/")},
+                                     f"{ident}{suffix}")
     out = Path(path)
     _write_zip(out, files)
     return FmuExport(out, ident, guid, tuple(names), tuple(chosen), binary_name)
