@@ -582,6 +582,23 @@ def _display_scales(values: dict[str, np.ndarray]) -> dict[str, Any]:
     return out
 
 
+def _period(system: Any, text: str | None) -> Any:
+    """``--periodic T``: the period of the nominal motion, a number or an expression in the
+    parameters (``"2*pi/w"``); None when not given."""
+    if text is None:
+        return None
+    from .io import ExpressionError, parse_expression
+
+    try:
+        e = parse_expression(text, names=set(system.parameter_values))
+    except ExpressionError as exc:
+        raise UsageError(f'--periodic: "{text}": {exc} (the period may use the parameters)'
+                         ) from None
+    if not e.free_symbols and not float(e) > 0:
+        raise UsageError(f'--periodic: the period must be positive, got "{text}"')
+    return e
+
+
 def cmd_linearize(args: argparse.Namespace) -> int:
     model = _load(args.model)
     system = model.system
@@ -594,7 +611,8 @@ def cmd_linearize(args: argparse.Namespace) -> int:
                          f"{_suggest(args.about, names)}; the model has: "
                          f"{', '.join(names) or '(none: add a [nominal.<name>] table)'}")
     params = _overrides(system, args.set)
-    result = integration.linear_analysis(model, args.about, params)
+    result = integration.linear_analysis(model, args.about, params,
+                                         period=_period(system, args.periodic))
     if args.json:
         print(json.dumps(integration.jsonable(result), indent=1))
         return EXIT_OK
@@ -941,6 +959,11 @@ def build_parser() -> argparse.ArgumentParser:
              "jourdain linearize examples/double_pendulum.toml --about hanging", cmd_linearize)
     p.add_argument("--about", metavar="NAME",
                    help="nominal motion of the model file ([nominal.NAME]; default: the first)")
+    p.add_argument("--periodic", metavar="T",
+                   help="Floquet analysis of a T-periodic nominal motion: monodromy matrix, "
+                        "multipliers, exponents and verdict (T a number or an expression in "
+                        'the parameters, "2*pi/w"; default: the period = ... of the nominal motion '
+                        "in the model file, if it has one)")
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", help=set_help)
     p.add_argument("--json", action="store_true", help="print JSON")
 

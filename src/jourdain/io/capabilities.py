@@ -78,15 +78,18 @@ def nominal_mapping(system: Any, nominal: NominalMotion) -> dict[str, se.Basic]:
 
 
 def linear_analysis(model: ModelFile, about: str | None,
-                    parameters: Mapping[str, float] | None = None, t: float = 0.0
-                    ) -> dict[str, Any]:
+                    parameters: Mapping[str, float] | None = None, t: float = 0.0,
+                    period: Any = None) -> dict[str, Any]:
     """Linearize about a nominal motion of the model file and analyse it.
 
     Returns a dict: ``nominal`` (the NominalMotion), ``linearization``, ``numbers`` (M_tilde, P,
     Q, h, B and, time-invariant, D, G, K, N at ``t``), ``time_invariant``, ``conservative``
     (None when time-variant), ``modes`` and ``stability`` (None when time-variant or not
     available), ``h_norm``, ``nominal_check`` (:class:`~jourdain.linearization.NominalCheck`
-    at ``t``).
+    at ``t``), ``cyclic`` (the cyclic coordinates) and ``floquet``
+    (:class:`~jourdain.analysis.floquet.Floquet` over one period from ``t`` for a periodic
+    nominal motion: ``period`` given, a number or an expression in the parameters, or the
+    nominal motion's own ``period``; else None).
 
     The warnings of a nominal motion that is not a solution are not issued here: they are in
     ``nominal_check`` and the stability verdict, which the text and the report show.
@@ -103,7 +106,29 @@ def linear_analysis(model: ModelFile, about: str | None,
         check = lin.check_nominal(t, params)
         res = _analyse(lin, num, check, params, t)
     res["nominal"] = nominal
+    res["floquet"] = None
+    if period is None:
+        period = nominal.period
+    if period is not None:
+        from ..analysis.floquet import floquet
+
+        res["floquet"] = floquet(lin, period_value(system, period, params), t0=t,
+                                 parameters=params, cyclic=res["cyclic"])
     return res
+
+
+def period_value(system: Any, period: Any, parameters: Mapping[str, float] | None) -> float:
+    """The number of a period given as a number or an expression in the parameters."""
+    if isinstance(period, (int, float)):
+        return float(period)
+    values = {**system.parameter_values, **dict(parameters or {})}
+    try:
+        v = float(se.sympify(period).subs({se.Symbol(k): x for k, x in values.items()}))
+    except (RuntimeError, TypeError, ValueError) as exc:
+        raise EvaluationError(f"the period {period} has no numeric value: {exc}") from None
+    if not np.isfinite(v) or v <= 0:
+        raise EvaluationError(f"the period {period} must be positive, it is {v:g}")
+    return v
 
 
 def _analyse(lin: Any, num: dict[str, np.ndarray], check: Any,
@@ -170,6 +195,16 @@ def jsonable(res: Mapping[str, Any]) -> dict[str, Any]:
         "matrices": {k: np.asarray(v, float).tolist() for k, v in res["numbers"].items()},
         "cyclic_coordinates": list(res.get("cyclic", ())),
     }
+    fl = res.get("floquet")
+    if fl is not None:
+        out["floquet"] = {
+            "period": fl.period, "t0": fl.t0, "state_names": list(fl.state_names),
+            "monodromy": np.asarray(fl.monodromy, float).tolist(),
+            "multipliers": [[float(z.real), float(z.imag)] for z in fl.multipliers],
+            "exponents": [[float(z.real) if np.isfinite(z.real) else None, float(z.imag)]
+                          for z in fl.exponents],
+            "verdict": fl.verdict, "reason": fl.reason, "tolerance": fl.tolerance,
+            "cyclic": list(fl.cyclic)}
     m = res.get("modes")
     if m is not None:
         out["eigenvalues"] = [[float(z.real), float(z.imag)] for z in m.eigenvalues]
@@ -231,6 +266,8 @@ def linear_text(res: Mapping[str, Any]) -> str:
         lines.append("\neigenvalues of the state-space system:\n" + str(res["modes"]))
     if res.get("cyclic"):
         lines.append("\n" + cyclic_text(res["cyclic"]))
+    if res.get("floquet") is not None:
+        lines.append("\n" + str(res["floquet"]))
     if res["stability"] is not None:
         lines.append(f"\nstability: {res['stability']}")
     return "\n".join(lines)

@@ -104,6 +104,9 @@ class NominalMotion:
     ydd: tuple[se.Basic, ...]
     description: str = ""
     inputs: tuple[tuple[str, se.Basic], ...] = ()
+    #: the period T of a periodic nominal motion (an expression in the parameters; None
+    #: otherwise): the report and ``jourdain linearize`` then give its Floquet analysis
+    period: se.Basic | None = None
 
     @property
     def is_equilibrium(self) -> bool:
@@ -1042,7 +1045,7 @@ class _Loader:
         for nname, spec in tbl.items():
             p = (*path, nname)
             self.name(nname, p, "nominal motion")
-            spec = self.table(spec, p, {"y", "yd", "inputs", "description"})
+            spec = self.table(spec, p, {"y", "yd", "inputs", "description", "period"})
 
             def values(key: str, spec: dict = spec, p: Path = p) -> dict[str, se.Basic]:
                 tb = self.table(spec.get(key, {}), (*p, key),
@@ -1072,7 +1075,15 @@ class _Loader:
                     raise self.fail((*p, "inputs", iname), f'"{iname}" is not a declared input'
                                     f"{self.suggest(iname, self.inputs)}")
                 ins.append((iname, self.expr(v, (*p, "inputs", iname), allowed, ctx)))
-            out.append(NominalMotion(nname, y_full, yd_full, ydd_full, desc, tuple(ins)))
+            period = None
+            if "period" in spec:
+                period = self.expr(spec["period"], (*p, "period"), set(self.params),
+                                   "a period (parameters only)")
+                value = float(period.subs({se.Symbol(k): v for k, v in self.params.items()}))
+                if not value > 0:
+                    raise self.fail((*p, "period"), f"the period must be positive, it is "
+                                    f"{value:g} at the default parameter values")
+            out.append(NominalMotion(nname, y_full, yd_full, ydd_full, desc, tuple(ins), period))
         return tuple(out)
 
     def read_simulation(self, data: dict, system: System) -> SimulationSettings:

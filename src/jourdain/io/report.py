@@ -228,6 +228,27 @@ def _eigen_plot(eigenvalues: np.ndarray, title: str) -> str:
     return _svg(fig)
 
 
+def _multiplier_plot(multipliers: np.ndarray, title: str) -> str:
+    """Floquet multipliers in the complex plane against the unit circle (stable inside)."""
+    fig = _figure(figsize=(4.0, 3.6), layout="constrained")
+    ax = fig.add_subplot()
+    phi = np.linspace(0.0, 2 * np.pi, 361)
+    ax.plot(np.cos(phi), np.sin(phi), color="0.4", linewidth=1.0, label="|μ| = 1")
+    ax.axvline(0, color="0.7", linewidth=0.6)
+    ax.axhline(0, color="0.7", linewidth=0.6)
+    ax.plot(multipliers.real, multipliers.imag, "x", markersize=9, color="C3", label="μ")
+    r = max(1.2, 1.1 * float(np.abs(multipliers).max(initial=0.0)))
+    ax.set_xlim(-r, r)
+    ax.set_ylim(-r, r)
+    ax.set_aspect("equal")
+    ax.set_xlabel("Re μ")
+    ax.set_ylabel("Im μ")
+    ax.set_title(title, fontsize=10)
+    ax.legend(loc="upper right", fontsize=8)
+    ax.grid(True, alpha=0.3)
+    return _svg(fig)
+
+
 # ------------------------------------------------------------------------------------------
 # the motion: snapshots and animation
 # ------------------------------------------------------------------------------------------
@@ -666,6 +687,11 @@ def _sections(model: ModelFile, out: Path, params: dict[str, float], t_end: floa
                 s.append(_eigen_plot(lams, f"eigenvalues about {nominal.name}"))
             if res.get("cyclic"):
                 s.append(f"<p>{_e(capabilities.cyclic_text(res['cyclic']))}.</p>")
+            fl = res.get("floquet")
+            if fl is not None:
+                s.append(_floquet_html(fl, nominal.name))
+                info.summary_lines.append(f"  about {nominal.name} (Floquet, T = "
+                                          f"{fl.period:.6g}): {fl.verdict}")
             if st is not None:
                 cls = "ok" if st.is_stable else "bad"
                 s.append(f"<p>Stability: <span class='{cls}'>{_e(st.verdict)}</span> — "
@@ -766,6 +792,22 @@ def _sections(model: ModelFile, out: Path, params: dict[str, float], t_end: floa
             if csv.is_file():  # the initial state, where the run failed at once
                 info.files.append(csv)
     sections.append("".join(s))
+
+
+def _floquet_html(fl: Any, name: str) -> str:
+    """The Floquet analysis of a periodic nominal motion: multipliers, exponents, the
+    plot against the unit circle and the verdict."""
+    rows = [(_num(mu.real), _num(mu.imag), f"{abs(mu):.8f}",
+             _num(lam.real) if np.isfinite(lam.real) else "−∞", _num(lam.imag))
+            for mu, lam in zip(fl.multipliers, fl.exponents, strict=True)]
+    cls = "ok" if fl.is_stable else "bad"
+    return (f"<h4>Floquet analysis (periodic nominal motion, T = {_num(fl.period)} s)</h4>"
+            "<p>Monodromy matrix Φ(t<sub>0</sub> + T, t<sub>0</sub>) of ẋ = A(t)·x over one "
+            "period; its eigenvalues are the Floquet multipliers μ, the exponents ln(μ)/T.</p>"
+            + _table(rows, ["Re μ", "Im μ", "|μ|", "Re ln(μ)/T [1/s]", "Im ln(μ)/T [rad/s]"])
+            + _multiplier_plot(fl.multipliers, f"Floquet multipliers about {name}")
+            + f"<p>Stability (Floquet): <span class='{cls}'>{_e(fl.verdict)}</span> — "
+              f"{_e(fl.reason)}</p>")
 
 
 def _wrench_section(res: Any, out: Path, info: ReportInfo) -> str:
