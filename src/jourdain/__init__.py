@@ -8,11 +8,14 @@ equations of motion M·ÿ + k = q.
 from symengine import atan2, cos, exp, log, pi, sin, sqrt, tan
 
 from .analysis import (
+    Floquet,
     FrequencyResponse,
     Modes,
     Stability,
     StateSpace,
     Sweep,
+    cyclic_coordinates,
+    floquet,
     frequency_response,
     modes,
     stability,
@@ -86,6 +89,7 @@ from .reactions import JointReactions, Reactions, evaluate_reactions, joint_reac
 from .results import Results
 from .simulate import Event, IntegrationError, simulate
 from .symbolic import SymMatrix
+from .wrenches import JointWrench, joint_wrenches
 
 __version__ = "0.1.0"
 
@@ -103,6 +107,7 @@ __all__ = [
     "to_control",
     "Equilibrium", "NoEquilibrium", "find_equilibria", "find_equilibrium",
     "JointReactions", "Reactions", "evaluate_reactions", "joint_reactions", "reactions",
+    "JointWrench", "joint_wrenches", "Floquet", "floquet", "cyclic_coordinates",
     "Results", "Event", "IntegrationError", "simulate", "Energy", "energy",
     "WORLD", "Body", "Cylindrical", "Fixed", "Force", "Free", "General", "GeneralizedForce",
     "Gravity", "Joint", "Planar", "Prismatic", "Revolute", "Rot", "RotationalSpringDamper",
