@@ -114,6 +114,9 @@ def test_recursion_equals_symbolic_projection(make, rng):
         u = rng.uniform(-1, 1, len(system.inputs))
         a, b = ref(y, yd, t, pv, u), new(y, yd, t, pv, u)
         for name in ref.names:
+            if a[name].size == 0:  # Q̄ of a free body: no constrained direction
+                assert b[name].shape == a[name].shape
+                continue
             # each entry is a sum over at most 6p body rows of products of kinematic terms;
             # the scale is that of the largest entry of the matrix (the terms are not larger
             # than a few times it for these well-scaled models)

@@ -35,6 +35,7 @@ from .errors import (
     SingularMassMatrix,
 )
 from .io import ModelFile, ModelFileError, load_model
+from .io.urdf import load_urdf
 from .io.viewer import MeshVisual, View, view
 from .kinematics import BodyKinematics, Kinematics, kinematics
 from .linearization import (
@@ -52,6 +53,7 @@ from .linearization import (
 from .model import (
     WORLD,
     Body,
+    Bushing,
     Cylindrical,
     Fixed,
     Force,
@@ -62,6 +64,7 @@ from .model import (
     Joint,
     Planar,
     Prismatic,
+    Quantity,
     Revolute,
     Rot,
     RotationalSpringDamper,
@@ -72,16 +75,26 @@ from .model import (
     Trans,
     Universal,
     acceleration,
+    angular_velocity,
     box,
     cylinder,
+    deflection,
+    deflection_d,
     disc,
+    distance,
+    distance_rate,
     elongation,
     elongation_d,
+    point_acceleration,
     point_mass,
+    position,
     rate,
+    relative_position,
+    relative_velocity,
     rod,
     symbols,
     t,
+    velocity,
 )
 from .newton_euler import NewtonEuler, newton_euler
 from .projection import EquationsOfMotion, projection
@@ -96,7 +109,7 @@ __version__ = "0.1.0"
 __all__ = [
     "atan2", "cos", "exp", "log", "pi", "sin", "sqrt", "tan",
     "EvaluationError", "JourdainError", "JourdainWarning", "ModelError", "SingularMassMatrix",
-    "ModelFile", "ModelFileError", "load_model", "MeshVisual", "View", "view",
+    "ModelFile", "ModelFileError", "load_model", "load_urdf", "MeshVisual", "View", "view",
     "BodyKinematics", "Kinematics", "kinematics", "NewtonEuler", "newton_euler",
     "EquationsOfMotion", "projection", "SymMatrix",
     "CompiledLinearization", "GeneralLinearization", "Linearization", "NominalCheck",
@@ -113,4 +126,7 @@ __all__ = [
     "Gravity", "Joint", "Planar", "Prismatic", "Revolute", "Rot", "RotationalSpringDamper",
     "Spherical", "SpringDamper", "System", "Torque", "Trans", "Universal", "acceleration", "box",
     "cylinder", "disc", "elongation", "elongation_d", "point_mass", "rate", "rod", "symbols", "t",
+    "Bushing", "deflection", "deflection_d", "Quantity", "angular_velocity", "distance",
+    "distance_rate", "point_acceleration", "position", "relative_position", "relative_velocity",
+    "velocity",
 ]

@@ -4,8 +4,11 @@
 of mass) and ``ω_i = J_Ri·ẏ + ω̄_i`` (body frame, where ``I_i`` is constant), so rheonomic terms
 are included. ``V`` is the potential of gravity (``-Σ m_i gᵀ r_i``), of linear spring–dampers
 (``½ c (L - L₀)²``) and of generalized forces linear in their own coordinate
-(``Q = a + b·y`` gives ``V = -(a·y + ½ b·y²)``, e.g. rotational springs). Every other applied
-force is non-conservative; its work is what the simulation's energy balance reports.
+(``Q = a + b·y`` gives ``V = -(a·y + ½ b·y²)``, e.g. rotational springs; likewise on an expression
+e of the coordinates, ``Q = a + b·e``), and of bushings without damping and laws whose stiffness
+is symmetric (``V = ½ xᵀK x − w₀ᵀx`` in the deflection x). Every other applied force (and any
+force law with kinematic quantities) is non-conservative; its work is what the simulation's
+energy balance reports.
 
 These expressions are computed independently of ``M`` and ``k``, so the energy along a simulated
 motion checks the equations of motion as well as the integrator.
@@ -18,9 +21,20 @@ from dataclasses import dataclass
 import symengine as se
 
 from .kinematics import Kinematics
+from .measures import Frames, bushing_deflection
 from .model.bodies import WORLD
 from .model.expressions import free_names
-from .model.forces import Force, GeneralizedForce, Gravity, SpringDamper, Torque, rate
+from .model.forces import (
+    Bushing,
+    Force,
+    GeneralizedForce,
+    Gravity,
+    SpringDamper,
+    Torque,
+    deflection,
+    deflection_d,
+    rate,
+)
 
 ZERO = se.Integer(0)
 
@@ -79,6 +93,8 @@ def energy(kin: Kinematics) -> Energy:
             for body in sys.bodies:
                 if body.mass != 0:
                     V_terms.append(-body.mass * _dot(fe.vector, pos[body.name]))
+        elif _has_quantities(fe):
+            noncons.append(fe.name)
         elif isinstance(fe, SpringDamper):
             if fe.law is not None or fe.damping != 0:
                 noncons.append(fe.name)
@@ -90,8 +106,16 @@ def energy(kin: Kinematics) -> Energy:
                 V_terms.append(se.Rational(1, 2) * fe.stiffness * (L - fe.rest_length) ** 2)
         elif isinstance(fe, GeneralizedForce):
             c = fe.coordinate
-            damping = fe.value.diff(rate(c))
-            spring = fe.value.subs({rate(c): 0}) if damping != 0 else fe.value
+            if not fe.on_coordinate:
+                V = _expression_potential(fe, sys, rates | inputs)
+                if V is None:
+                    noncons.append(fe.name)
+                else:
+                    V_terms.append(V)
+                continue
+            value = fe.value.subs({deflection: c, deflection_d: rate(c)})
+            damping = value.diff(rate(c))
+            spring = value.subs({rate(c): 0}) if damping != 0 else value
             b = spring.diff(c)
             names = free_names([spring])
             linear = (not (free_names([b]) & (set(sys.coordinate_names) | rates | inputs | {"t"}))
@@ -102,6 +126,12 @@ def energy(kin: Kinematics) -> Energy:
                 V_terms.append(-(a * c + se.Rational(1, 2) * b * c**2))
             if not linear or damping != 0:
                 noncons.append(fe.name)
+        elif isinstance(fe, Bushing):
+            V = _bushing_potential(kin, fe, sys, rates | inputs)
+            if V is None:
+                noncons.append(fe.name)
+            else:
+                V_terms.append(V)
         elif isinstance(fe, Force | Torque):
             noncons.append(fe.name)
     rheonomic = False
@@ -121,3 +151,50 @@ def _point(kin: Kinematics, body: str, p: tuple) -> tuple:
         return tuple(p)
     r, _, _, _ = kin[body].point(tuple(p))
     return r
+
+
+def _has_quantities(fe: object) -> bool:
+    """True when a force law uses kinematic quantities (treated as non-conservative)."""
+    from .model.system import _force_expressions
+
+    return any(hasattr(s, "quantity") for e in _force_expressions(fe) for s in e.free_symbols)
+
+
+def _constant(e: se.Basic, sys: object, varying: set[str]) -> bool:
+    names = free_names([e])
+    return not names & (set(sys.coordinate_names) | varying | {"t"})  # type: ignore[attr-defined]
+
+
+def _expression_potential(fe: GeneralizedForce, sys: object, varying: set[str]
+                          ) -> se.Basic | None:
+    """``-(a·e + ½ b·e²)`` for a value ``a + b·deflection`` (a, b constant) on an expression e
+    of the coordinates and parameters; None when the force is not of that form."""
+    e = fe.coordinate
+    if "t" in free_names([e]):
+        return None
+    v = fe.value
+    if v.diff(deflection_d) != 0 or not _constant(v.subs({deflection: 0}), sys, varying):
+        return None
+    b = v.diff(deflection)
+    if not _constant(b, sys, varying) or b.diff(deflection) != 0:
+        return None
+    a = v.subs({deflection: 0})
+    return -(a * e + se.Rational(1, 2) * b * e**2)
+
+
+def _bushing_potential(kin: Kinematics, fe: Bushing, sys: object, varying: set[str]
+                       ) -> se.Basic | None:
+    """``½ xᵀK x − w₀ᵀx`` of a bushing without damping and laws, K symmetric and constant;
+    None otherwise (its work is then reported as non-conservative)."""
+    K = fe.stiffness
+    if not fe.linear or any(v != 0 for r in fe.damping for v in r):
+        return None
+    if any(not _constant(v, sys, varying) for v in (*fe.preload, *(v for r in K for v in r))):
+        return None
+    if any(se.expand(K[i][j] - K[j][i]) != 0 for i in range(6) for j in range(i)):
+        return None
+    x, _, _ = bushing_deflection(Frames(kin), fe)
+    terms = [se.Rational(1, 2) * K[i][j] * x[i] * x[j] for i in range(6) for j in range(6)
+             if K[i][j] != 0]
+    terms += [-fe.preload[i] * x[i] for i in range(6) if fe.preload[i] != 0]
+    return se.Add(*terms) if terms else ZERO

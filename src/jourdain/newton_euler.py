@@ -16,8 +16,19 @@ import symengine as se
 
 from .errors import ModelError
 from .kinematics import Z3, BodyKinematics, Kinematics, _add, _cross, _dot, _mm, _mtv, _mv, _scale
+from .measures import Frames, Resolver, bushing_deflection, bushing_loads, bushing_wrench
 from .model.bodies import WORLD, Body
-from .model.forces import Force, GeneralizedForce, Gravity, SpringDamper, Torque
+from .model.forces import (
+    Bushing,
+    Force,
+    GeneralizedForce,
+    Gravity,
+    SpringDamper,
+    Torque,
+    deflection,
+    deflection_d,
+    rate,
+)
 from .model.joints import IDENTITY, Joint, Mat3, Rot, Vec3, rotation_matrix
 from .symbolic import SymMatrix
 
@@ -165,23 +176,40 @@ class _Accumulator:
 def applied_forces(kin: Kinematics, elements: Sequence[object] | None = None
                    ) -> tuple[BodyForces, ...]:
     """Resultant applied force and torque on every body from the model's force elements (or
-    from ``elements`` only, for example one element to trace a fault to it)."""
+    from ``elements`` only, for example one element to trace a fault to it).
+
+    Kinematic quantities in the force laws (:mod:`jourdain.model.quantities`) are replaced by
+    their expressions in y, ẏ, t here (:class:`jourdain.measures.Resolver`)."""
     acc = _Accumulator(kin)
     sys = kin.system
+    res = Resolver(kin)
     for fe in sys.forces if elements is None else elements:
         if isinstance(fe, Gravity):
             acc.gravity = _add(acc.gravity, fe.vector)
         elif isinstance(fe, Force):
-            F_I, F_B = acc.to_body(fe.vector, fe.frame, fe.body)
+            F_I, F_B = acc.to_body(res.resolve_all(fe.vector), fe.frame, fe.body)
             acc.add_force(fe.body, F_I, F_B, fe.point)
         elif isinstance(fe, Torque):
-            _, T_B = acc.to_body(fe.vector, fe.frame, fe.body)
+            _, T_B = acc.to_body(res.resolve_all(fe.vector), fe.frame, fe.body)
             acc.add_torque(fe.body, T_B)
         elif isinstance(fe, SpringDamper):
-            _spring_damper(acc, kin, fe)
+            _spring_damper(acc, kin, fe, res)
         elif isinstance(fe, GeneralizedForce):
-            _generalized_force(acc, sys, fe)
+            _generalized_force(acc, sys, fe, res)
+        elif isinstance(fe, Bushing):
+            _bushing(acc, res.frames, fe, res)
     return acc.result()
+
+
+def _bushing(acc: _Accumulator, frames: Frames, fe: Bushing, res: Resolver) -> None:
+    """A bushing's wrench on its two bodies (see :class:`jourdain.model.forces.Bushing`)."""
+    x, xd, geo = bushing_deflection(frames, fe)
+    w = res.resolve_all(bushing_wrench(fe, x, xd))
+    for body, F_I, vec, point in bushing_loads(frames, fe, w, geo):
+        if F_I is not None:
+            acc.add_force(body, F_I, vec, point)
+        else:
+            acc.add_torque(body, vec)
 
 
 def _point_state(kin: Kinematics, body: str, p: Vec3) -> tuple[Vec3, Vec3]:
@@ -195,14 +223,15 @@ def _point_state(kin: Kinematics, body: str, p: Vec3) -> tuple[Vec3, Vec3]:
     return r, v
 
 
-def _spring_damper(acc: _Accumulator, kin: Kinematics, fe: SpringDamper) -> None:
+def _spring_damper(acc: _Accumulator, kin: Kinematics, fe: SpringDamper,
+                   res: Resolver) -> None:
     ra, va = _point_state(kin, fe.body_a, fe.point_a)
     rb, vb = _point_state(kin, fe.body_b, fe.point_b)
     d = (rb[0] - ra[0], rb[1] - ra[1], rb[2] - ra[2])
     L = se.sqrt(_dot(d, d))
     e = _scale(d, 1 / L)
     L_d = _dot(e, (vb[0] - va[0], vb[1] - va[1], vb[2] - va[2]))
-    T = fe.tension(L, L_d)
+    T = res.resolve(fe.tension(L, L_d))
     F_on_a = _scale(e, T)  # tension pulls a towards b
     F_on_b = _scale(e, -T)
     for body, point, F in ((fe.body_a, fe.point_a, F_on_a), (fe.body_b, fe.point_b, F_on_b)):
@@ -234,16 +263,45 @@ def joint_step_frames(joint: Joint) -> list[tuple[Mat3, Vec3, Mat3]]:
     return out
 
 
-def _generalized_force(acc: _Accumulator, sys: System, fe: GeneralizedForce) -> None:
-    """Realize a generalized force on a coordinate as a torque/force pair on its joint step."""
+def _generalized_force(acc: _Accumulator, sys: System, fe: GeneralizedForce,
+                       res: Resolver) -> None:
+    """Realize a generalized force on a coordinate as a torque/force pair on its joint step; on
+    an expression e(y, t), the shares ``value·∂e/∂y_j`` on each coordinate y_j (virtual work)."""
+    if fe.on_coordinate:
+        c = fe.coordinate
+        value = res.resolve(fe.value.subs({deflection: c, deflection_d: rate(c)}))
+        _coordinate_pair(acc, sys, fe, c, value)
+        return
+    e = res.resolve(fe.coordinate)
+    bad = sorted({str(s) for s in e.free_symbols} & {str(r) for r in res.kin.yd})
+    if bad:
+        raise ModelError(f'generalized force "{fe.name}": its coordinate {fe.coordinate} depends '
+                         f"on the rates {bad}; it must be an expression of the coordinates, the "
+                         "parameters and t (positions, relative positions and distances among "
+                         "the kinematic quantities)")
+    value = res.resolve(fe.value.subs({deflection: e, deflection_d: res.rate(e)}))
+    free = e.free_symbols
+    shares = [(y, se.diff(e, y)) for y in res.kin.y if y in free]
+    if not shares:
+        raise ModelError(f'generalized force "{fe.name}": its coordinate {fe.coordinate} does '
+                         "not depend on any coordinate, so the force does no virtual work")
+    for y, de in shares:
+        if de != 0:
+            _coordinate_pair(acc, sys, fe, y, value * de)
+
+
+def _coordinate_pair(acc: _Accumulator, sys: System, fe: GeneralizedForce, coordinate: se.Basic,
+                     value: se.Basic) -> None:
+    """The generalized force ``value`` on ``coordinate`` as a torque/force pair on the two
+    bodies of the joint step that the coordinate drives."""
     for body in sys.bodies:
         j = body.joint
         for k, step in enumerate(j.steps):
-            if step.parameter is not None and step.parameter == fe.coordinate:
+            if step.parameter is not None and step.parameter == coordinate:
                 Rb, _, Ra = joint_step_frames(j)[k]
                 u = step.axis
-                v_child = _mtv(Ra, _scale(u, fe.value))
-                v_parent = _scale(_mv(Rb, u), -fe.value)
+                v_child = _mtv(Ra, _scale(u, value))
+                v_parent = _scale(_mv(Rb, u), -value)
                 if isinstance(step, Rot):
                     acc.add_torque(body.name, v_child)
                     acc.add_torque(body.parent, v_parent)
@@ -256,7 +314,7 @@ def _generalized_force(acc: _Accumulator, sys: System, fe: GeneralizedForce) -> 
                                       p_child)
                 return
     raise ModelError(
-        f'generalized force "{fe.name}": coordinate "{fe.coordinate}" is not the angle or distance '
+        f'generalized force "{fe.name}": coordinate "{coordinate}" is not the angle or distance '
         "of a single joint step (Rot/Trans with that coordinate alone); apply it as forces or "
         "torques on bodies instead"
     )

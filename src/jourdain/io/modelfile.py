@@ -25,6 +25,7 @@ from ..errors import JourdainError, ModelError
 from ..model import (
     WORLD,
     Body,
+    Bushing,
     Cylindrical,
     Fixed,
     Force,
@@ -50,7 +51,11 @@ from ..model import (
 )
 from ..model.bodies import mass_data_problem
 from ..model.expressions import unit_axis
+from ..model.forces import BUSHING_COMPONENTS
 from ..model.joints import orientation_problem
+from ..model.quantities import KINDS as QUANTITY_KINDS
+from ..model.quantities import declare as declare_quantity
+from ..model.quantities import quantity as make_quantity
 from ..simulate import (
     DEFAULT_ATOL,
     DEFAULT_METHOD,
@@ -180,7 +185,7 @@ class ModelFile:
 # ------------------------------------------------------------------------------------------
 
 _TOP = {"model", "coordinates", "parameters", "inputs", "bodies", "forces", "nominal",
-        "simulation"}
+        "simulation", "quantities"}
 _JOINT_KEYS: dict[str, set[str]] = {
     "revolute": {"coordinate", "axis"},
     "prismatic": {"coordinate", "axis"},
@@ -201,7 +206,12 @@ _FORCE_KEYS: dict[str, set[str]] = {
                       "rest_length", "law"},
     "generalized": {"coordinate", "value"},
     "rotational_spring_damper": {"coordinate", "stiffness", "damping", "rest_angle"},
+    "bushing": {"body_a", "point_a", "body_b", "point_b", "frame", "stiffness", "damping",
+                "preload", "laws"},
 }
+#: keys of a [quantities.<name>] table, by its type (one point, or two points)
+_QUANTITY_KEYS_ONE = {"body", "point", "frame", "point_frame"}
+_QUANTITY_KEYS_TWO = {"body_a", "point_a", "body_b", "point_b", "frame"}
 _SHAPES = {"point": set(), "rod": {"length", "axis"}, "disc": {"radius", "axis"},
            "cylinder": {"radius", "length", "axis"}, "box": {"a", "b", "c"}}
 _IDENT = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
@@ -278,6 +288,8 @@ class _Loader:
         self.body_names: list[str] = []
         self.joint_of_body: dict[str, str] = {}
         self.driven: dict[str, str] = {}
+        #: symbols of the kinematic quantities of [quantities], by name
+        self.quantity_symbols: dict[str, se.Basic] = {}
 
     @property
     def lines(self) -> dict[Path, int]:
@@ -399,12 +411,18 @@ class _Loader:
             raise self.fail(path, f"expected a number or an expression string, got "
                             f"{_type_name(value)}")
         try:
-            e = parse_expression(value, allowed, describe=self.names_hint(allowed, context))
+            e = parse_expression(value, allowed, describe=self.names_hint(allowed, context),
+                                 symbol=self.symbol)
         except ExpressionError as exc:
             col = f" at column {exc.column}" if exc.column else ""
             raise self.fail(path, f'in expression "{_clip(value)}"{col}: {exc}') from None
         self.real_at_defaults(e, value, path)
         return e
+
+    def symbol(self, name: str) -> se.Basic:
+        """The symbol of a name: a kinematic quantity's own symbol, or a plain one."""
+        q = self.quantity_symbols.get(name)
+        return q if q is not None else se.Symbol(name)
 
     def real_at_defaults(self, e: se.Basic, text: str, path: Path) -> None:
         """An expression of the parameters alone must be a finite real number at their default
@@ -506,6 +524,7 @@ class _Loader:
         self.read_inputs(data)
         self.check_names()
         bodies = self.read_bodies(data)
+        self.read_quantities(data)
         forces = self.read_forces(data)
         try:
             system = System(self.coords, bodies, forces, parameters=self.params,
@@ -541,8 +560,10 @@ class _Loader:
             for b, j in self.joint_of_body.items():
                 if j == m.group(1):
                     found.append((m.start(), ("bodies", b, "joint")))
-        for m in re.finditer(r'(?:force|spring-damper|torque) "(\w+)"', message):
+        for m in re.finditer(r'(?:force|spring-damper|torque|bushing) "(\w+)"', message):
             found.append((m.start(), ("forces", m.group(1))))
+        for m in re.finditer(r'quantity "(\w+)"', message):
+            found.append((m.start(), ("quantities", m.group(1))))
         if found:
             return min(found)[1]
         if "coordinate" in message:
@@ -965,8 +986,9 @@ class _Loader:
                             f"{', '.join(_FORCE_KEYS)}")
         self.table(spec, p, _FORCE_KEYS[ftype] | {"type", "description"})
         rates = {f"{c}_d" for c in self.coords}
-        allowed = set(self.coords) | rates | set(self.params) | set(self.inputs) | {"t"}
-        ctx = "forces (coordinates, rates, parameters, inputs and t)"
+        allowed = (set(self.coords) | rates | set(self.params) | set(self.inputs) | {"t"}
+                   | set(self.quantity_symbols))
+        ctx = "forces (coordinates, rates, parameters, inputs, t and kinematic quantities)"
         params = set(self.params)
         pctx = "points (parameters only)"
 
@@ -1019,12 +1041,15 @@ class _Loader:
                     self.vector(spec.get("point_b", [0, 0, 0]), (*p, "point_b"), params, pctx),
                     stiffness=e("stiffness", 0), damping=e("damping", 0),
                     rest_length=e("rest_length", 0), law=law)
+            if ftype == "bushing":
+                return self.bushing(fname, spec, p, body, e, params, pctx, allowed)
+            defl = allowed | {"deflection", "deflection_d"}
+            vctx = ("a generalized force (deflection, deflection_d, coordinates, rates, "
+                    "parameters, inputs, t and kinematic quantities)")
             if ftype == "generalized":
-                c = se.Symbol(self.coordinate(self.require(spec, "coordinate", p),
-                                              (*p, "coordinate")))
-                return GeneralizedForce(fname, c, e("value"))
-            c = se.Symbol(self.coordinate(self.require(spec, "coordinate", p),
-                                          (*p, "coordinate")))
+                c = self.generalized_coordinate(spec, p)
+                return GeneralizedForce(fname, c, e("value", names=defl, context=vctx))
+            c = self.generalized_coordinate(spec, p)
             return RotationalSpringDamper(fname, c, stiffness=e("stiffness", 0),
                                           damping=e("damping", 0),
                                           rest_angle=e("rest_angle", 0, params | {"t"},
@@ -1033,6 +1058,137 @@ class _Loader:
             raise
         except ModelError as exc:
             raise self.fail(p, str(exc)) from None
+
+    def generalized_coordinate(self, spec: dict, p: Path) -> se.Basic:
+        """A generalized force's ``coordinate``: a coordinate's name, or an expression of the
+        coordinates, the parameters, t and the position quantities (``"phi2 - phi1"``)."""
+        value = self.require(spec, "coordinate", p)
+        if isinstance(value, str) and value.strip() in self.coords:
+            return se.Symbol(self.coordinate(value.strip(), (*p, "coordinate")))
+        names = (set(self.coords) | set(self.params) | {"t"}
+                 | {n for n, s in self.quantity_symbols.items()
+                    if not s.quantity.uses_rates})  # type: ignore[attr-defined]
+        e = self.expr(value, (*p, "coordinate"), names,
+                      "a generalized coordinate (coordinates, parameters, t and position "
+                      "quantities)")
+        if not {str(x) for x in e.free_symbols} & (set(self.coords)
+                                                   | set(self.quantity_symbols)):
+            raise self.fail((*p, "coordinate"), f'"{value}" depends on no coordinate')
+        return e
+
+    def bushing(self, fname: str, spec: dict, p: Path, body: Callable, e: Callable,
+                params: set[str], pctx: str, allowed: set[str]) -> Bushing:
+        """A ``type = "bushing"`` force table."""
+        fr = spec.get("frame")
+        if fr is not None:
+            fr = self.string(fr, (*p, "frame"))
+        a, b = body("body_a", True), body("body_b", True)
+        if fr is not None and fr not in (a, b):
+            raise self.fail((*p, "frame"), f'frame "{fr}" must be one of the bushing\'s bodies, '
+                            f'"{a}" or "{b}"')
+
+        def six(key: str, matrix: bool) -> object:
+            v = spec.get(key, 0)
+            kp = (*p, key)
+            if v == 0 and not isinstance(v, bool) and matrix:
+                return 0
+            if not isinstance(v, list) or len(v) != 6:
+                what = "a 6-vector (the diagonal) or 6 rows of 6" if matrix else "a 6-vector"
+                raise self.fail(kp, f"expected {what}, got {_type_name(v)}"
+                                + (f" of {len(v)} entries" if isinstance(v, list) else ""))
+            if matrix and all(isinstance(r, list) for r in v):
+                for i, r in enumerate(v):
+                    if len(r) != 6:
+                        raise self.fail((*kp, i), f"expected a row of 6 entries, got {len(r)}")
+                return [[self.expr(x, (*kp, i, j), allowed, ctx) for j, x in enumerate(r)]
+                        for i, r in enumerate(v)]
+            return [self.expr(x, (*kp, i), allowed, ctx) for i, x in enumerate(v)]
+
+        ctx = "a bushing (coordinates, rates, parameters, inputs, t and kinematic quantities)"
+        laws = {}
+        if "laws" in spec:
+            tbl = self.table(spec["laws"], (*p, "laws"), set(BUSHING_COMPONENTS),
+                             what="a table of laws by component (x, y, z, rx, ry, rz)")
+            for comp, law in tbl.items():
+                laws[comp] = self.expr(law, (*p, "laws", comp),
+                                       allowed | {"deflection", "deflection_d"},
+                                       "a bushing law (deflection, deflection_d, coordinates, "
+                                       "rates, parameters, inputs, t and kinematic quantities)")
+        return Bushing(fname, a, b,
+                       self.vector(spec.get("point_a", [0, 0, 0]), (*p, "point_a"), params, pctx),
+                       self.vector(spec.get("point_b", [0, 0, 0]), (*p, "point_b"), params, pctx),
+                       stiffness=six("stiffness", True), damping=six("damping", True),
+                       preload=six("preload", False) if "preload" in spec else (0,) * 6,
+                       frame=fr, laws=laws)
+
+    # --- kinematic quantities -------------------------------------------------------------
+    def read_quantities(self, data: dict) -> None:
+        """[quantities.<name>]: kinematic quantities for force laws (symbols ``<name>_x``,
+        ``<name>_y``, ``<name>_z`` of a vector, ``<name>`` of a distance)."""
+        path: Path = ("quantities",)
+        tbl = self.table(data.get("quantities", {}), path, what="tables [quantities.<name>]")
+        taken = {*self.coords, *(f"{c}_d" for c in self.coords),
+                 *(f"{c}_dd" for c in self.coords), *self.params, *self.inputs}
+        params = set(self.params)
+        pctx = "points (parameters only)"
+        for qname, spec in tbl.items():
+            p: Path = (*path, qname)
+            self.name(qname, p, "quantity")
+            spec = self.table(spec, p, what='a quantity table with a "type"')
+            kind = self.string(self.require(spec, "type", p), (*p, "type")).lower()
+            if kind not in QUANTITY_KINDS:
+                raise self.fail((*p, "type"), f'unknown quantity type "{kind}"'
+                                f"{self.suggest(kind, list(QUANTITY_KINDS))}; expected one of "
+                                f"{', '.join(QUANTITY_KINDS)}")
+            two = QUANTITY_KINDS[kind][1]
+            self.table(spec, p, (_QUANTITY_KEYS_TWO if two else _QUANTITY_KEYS_ONE)
+                       | {"type", "description"})
+            ok = [WORLD, *self.body_names]
+
+            def frame_name(key: str, default: str | None, spec: dict = spec, p: Path = p,
+                           ok: list = ok) -> str:
+                if default is None:
+                    v = self.string(self.require(spec, key, p), (*p, key))
+                else:
+                    v = self.string(spec.get(key, default), (*p, key))
+                if v not in ok:
+                    raise self.fail((*p, key), f'unknown body "{v}"{self.suggest(v, ok)}; '
+                                    f"expected one of {', '.join(ok)}")
+                return v
+
+            try:
+                if two:
+                    qa = frame_name("body_a", None)
+                    q = make_quantity(
+                        kind, qname, qa,
+                        self.vector(spec.get("point_a", [0, 0, 0]), (*p, "point_a"), params,
+                                    pctx),
+                        frame=frame_name("frame", WORLD), body_b=frame_name("body_b", None),
+                        point_b=self.vector(spec.get("point_b", [0, 0, 0]), (*p, "point_b"),
+                                            params, pctx))
+                else:
+                    qb = frame_name("body", None)
+                    default_frame = qb if kind == "angular_velocity" else WORLD
+                    if kind == "angular_velocity" and ("point" in spec or "point_frame" in spec):
+                        raise self.fail(p, "an angular velocity has no point")
+                    q = make_quantity(
+                        kind, qname, qb,
+                        self.vector(spec.get("point", [0, 0, 0]), (*p, "point"), params, pctx),
+                        frame=frame_name("frame", default_frame),
+                        point_frame=frame_name("point_frame", qb))
+            except ModelFileError:
+                raise
+            except ModelError as exc:
+                raise self.fail(p, str(exc)) from None
+            for sym in declare_quantity(q):
+                n = str(sym)
+                if n in taken or n in RESERVED_NAMES:
+                    raise self.fail(p, f'its symbol "{n}" is already a declared or reserved name; '
+                                    "choose another name for the quantity")
+                taken.add(n)
+                self.quantity_symbols[n] = sym
+            if "description" in spec:
+                self.descriptions[qname] = self.string(spec["description"], (*p, "description"))
 
     # --- nominal motions and simulation ---------------------------------------------------
     def read_nominal(self, data: dict, system: System) -> tuple[NominalMotion, ...]:

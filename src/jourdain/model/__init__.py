@@ -3,6 +3,7 @@
 from .bodies import WORLD, Body, box, cylinder, disc, point_mass, rod
 from .expressions import symbols, t
 from .forces import (
+    Bushing,
     Force,
     GeneralizedForce,
     Gravity,
@@ -10,6 +11,8 @@ from .forces import (
     SpringDamper,
     Torque,
     acceleration,
+    deflection,
+    deflection_d,
     elongation,
     elongation_d,
     rate,
@@ -28,12 +31,25 @@ from .joints import (
     Trans,
     Universal,
 )
+from .quantities import (
+    Quantity,
+    angular_velocity,
+    distance,
+    distance_rate,
+    point_acceleration,
+    position,
+    relative_position,
+    relative_velocity,
+    velocity,
+)
 from .system import System
 
 __all__ = [
     "WORLD", "Body", "box", "cylinder", "disc", "point_mass", "rod", "symbols", "t",
     "Force", "GeneralizedForce", "Gravity", "RotationalSpringDamper", "SpringDamper", "Torque",
-    "acceleration", "elongation", "elongation_d", "rate",
+    "acceleration", "elongation", "elongation_d", "rate", "Bushing", "deflection", "deflection_d",
+    "Quantity", "angular_velocity", "distance", "distance_rate", "point_acceleration", "position",
+    "relative_position", "relative_velocity", "velocity",
     "Cylindrical", "Fixed", "Free", "General", "Joint", "Planar", "Prismatic", "Revolute", "Rot",
     "Spherical", "Trans", "Universal", "System",
 ]

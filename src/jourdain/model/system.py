@@ -15,6 +15,7 @@ from .bodies import WORLD, Body, check_values
 from .expressions import as_expr, free_names, t
 from .forces import (
     RESERVED,
+    Bushing,
     Force,
     ForceElement,
     GeneralizedForce,
@@ -22,10 +23,13 @@ from .forces import (
     SpringDamper,
     Torque,
     acceleration,
+    deflection,
+    deflection_d,
     elongation,
     elongation_d,
     rate,
 )
+from .quantities import Quantity, quantities_in
 
 if TYPE_CHECKING:
     from ..kinematics import Kinematics
@@ -64,7 +68,9 @@ class System:
         is valid for the method); a child listed before its parent raises a ModelError naming
         both and their positions.
     forces : sequence of force elements
-        Gravity, Force, Torque, SpringDamper, GeneralizedForce (RotationalSpringDamper).
+        Gravity, Force, Torque, SpringDamper, GeneralizedForce (RotationalSpringDamper),
+        Bushing. Their laws may use kinematic quantities
+        (:mod:`jourdain.model.quantities`), found from their symbols: :attr:`quantities`.
     parameters : mapping name -> default value
         Every symbol in the model other than coordinates, rates, inputs and ``t``.
     inputs : sequence of symbols or names
@@ -82,6 +88,7 @@ class System:
     inputs: tuple[se.Symbol, ...]
     units: tuple[tuple[str, str], ...]
     name: str
+    quantities: tuple[Quantity, ...]
 
     def __init__(self, coordinates: Sequence[object] | str, bodies: Sequence[Body],
                  forces: Sequence[ForceElement] = (), parameters: Mapping[str, float] | None = None,
@@ -113,22 +120,15 @@ class System:
                 raise ModelError(f"bodies: expected Body objects, got {type(b).__name__} {b!r}")
         forces = list(forces)
         for f in forces:
-            if not isinstance(f, Gravity | Force | Torque | SpringDamper | GeneralizedForce):
+            if not isinstance(f, Gravity | Force | Torque | SpringDamper | GeneralizedForce
+                              | Bushing):
                 raise ModelError(f"forces: expected force elements, got {type(f).__name__} {f!r}")
         set_(self, "bodies", _parents_first(bodies))
         set_(self, "forces", tuple(forces))
+        set_(self, "quantities", tuple(quantities_in(
+            [e for f in forces for e in _force_expressions(f)]).values()))
         _validate(self)
 
-    # --- names and symbols -------------------------------------------------------------------
-    @property
-    def y(self) -> tuple[se.Symbol, ...]:
-        """Generalized coordinates y."""
-        return self.coordinates
-
-    @property
-    def yd(self) -> tuple[se.Symbol, ...]:
-        """Symbols of the rates ẏ (``<name>_d``)."""
-        return tuple(rate(c) for c in self.coordinates)
     def __hash__(self) -> int:
         """The hash of the fields, computed once: the memoized stages (``mkq_function(system)``
         and the like) look a system up on every call, and hashing its bodies and expressions
@@ -149,6 +149,16 @@ class System:
         for k, v in state.items():
             object.__setattr__(self, k, v)
 
+    # --- names and symbols -------------------------------------------------------------------
+    @property
+    def y(self) -> tuple[se.Symbol, ...]:
+        """Generalized coordinates y."""
+        return self.coordinates
+
+    @property
+    def yd(self) -> tuple[se.Symbol, ...]:
+        """Symbols of the rates ẏ (``<name>_d``)."""
+        return tuple(rate(c) for c in self.coordinates)
 
     @property
     def ydd(self) -> tuple[se.Symbol, ...]:
@@ -369,6 +379,8 @@ def _validate(sys: System) -> None:
 
     body_names = {b.name for b in sys.bodies}
     allowed_force = set(y_names) | set(p_names) | set(u_names) | {"t"} | {f"{n}_d" for n in y_names}
+    q_names = _check_quantities(sys, seen, body_names, set(p_names))
+    allowed_force |= q_names
     force_names: set[str] = set()
     for f in sys.forces:
         w = f'force "{f.name}"'
@@ -396,12 +408,88 @@ def _validate(sys: System) -> None:
                 exprs.append(f.law)
                 extra = {str(elongation), str(elongation_d)}
         elif isinstance(f, GeneralizedForce):
-            if str(f.coordinate) not in y_names:
-                raise ModelError(f'{w}: "{f.coordinate}" is not a declared coordinate')
+            if f.on_coordinate:
+                if str(f.coordinate) not in y_names:
+                    raise ModelError(f'{w}: "{f.coordinate}" is not a declared coordinate')
+            else:
+                used = free_names([f.coordinate])
+                bad = used - (set(y_names) | set(p_names) | {"t"} | q_names)
+                if bad:
+                    raise ModelError(f"{w}: its coordinate {f.coordinate} uses {sorted(bad)}; "
+                                     "it may use coordinates, parameters, t and kinematic "
+                                     "quantities of positions")
+                if not used & set(y_names) and not used & q_names:
+                    raise ModelError(f"{w}: its coordinate {f.coordinate} depends on no "
+                                     "coordinate")
             exprs = [f.value]
+            extra = {str(deflection), str(deflection_d)}
+        elif isinstance(f, Bushing):
+            w = f'bushing "{f.name}"'
+            for bn in (f.body_a, f.body_b):
+                if bn != WORLD and bn not in body_names:
+                    raise ModelError(f'{w}: unknown body "{bn}"')
+            if f.body_a == f.body_b:
+                raise ModelError(f'{w}: both ends are on body "{f.body_a}"')
+            points = free_names([*f.point_a, *f.point_b]) - set(p_names)
+            if points:
+                raise ModelError(f"{w}: points use {sorted(points)}; points may use parameters "
+                                 "only")
+            exprs = f.expressions
+            extra = {str(deflection), str(deflection_d)}
         bad = free_names(exprs) - allowed_force - extra
         if bad:
-            raise ModelError(f"{w}: undeclared symbol(s) {sorted(bad)}")
+            hint = ""
+            if isinstance(f, GeneralizedForce | Bushing) and bad & {str(elongation),
+                                                                  str(elongation_d)}:
+                hint = " (use deflection and deflection_d here)"
+            raise ModelError(f"{w}: undeclared symbol(s) {sorted(bad)}{hint}")
+
+
+def _force_expressions(f: object) -> list:
+    """Every expression of a force element (to find the kinematic quantities it uses)."""
+    if isinstance(f, Gravity):
+        return list(f.vector)
+    if isinstance(f, Force):
+        return [*f.vector, *f.point]
+    if isinstance(f, Torque):
+        return list(f.vector)
+    if isinstance(f, SpringDamper):
+        return [f.stiffness, f.damping, f.rest_length, *([f.law] if f.law is not None else [])]
+    if isinstance(f, GeneralizedForce):
+        return [f.coordinate, f.value]
+    if isinstance(f, Bushing):
+        return f.expressions
+    return []
+
+
+def _check_quantities(sys: System, seen: dict[str, str], body_names: set[str],
+                      p_names: set[str]) -> set[str]:
+    """Check the kinematic quantities the forces use; return the names of their symbols."""
+    names: set[str] = set()
+    for q in sys.quantities:
+        w = f'quantity "{q.name}" ({q.kind})'
+        for bn in q.bodies:
+            if bn != WORLD and bn not in body_names:
+                raise ModelError(f'{w}: unknown body or frame "{bn}" (a body name or "world")')
+        bad = free_names(list(q.expressions)) - p_names
+        if bad:
+            raise ModelError(f"{w}: points use {sorted(bad)}; points may use parameters only")
+        for n in q.symbol_names:
+            if n in seen or n in RESERVED:
+                what = seen.get(n, "a reserved name")
+                raise ModelError(f'{w}: its symbol "{n}" is already declared (as {what})')
+            names.add(n)
+    # a generalized force's coordinate must not depend on rates through a quantity
+    for f in sys.forces:
+        if isinstance(f, GeneralizedForce) and not f.on_coordinate:
+            for s in f.coordinate.free_symbols:
+                q = getattr(s, "quantity", None)
+                if q is not None and q.uses_rates:
+                    raise ModelError(
+                        f'force "{f.name}": its coordinate uses {q.describe()}, which depends '
+                        "on the rates; a generalized coordinate may use positions, relative "
+                        "positions and distances only")
+    return names
 
 
 def _check_axes(sys: System, b: Body) -> None:
