@@ -1,0 +1,231 @@
+"""Study results and simulation results as labelled arrays (``xarray.Dataset``), and NetCDF.
+
+A study's dataset has one dimension per grid axis (named after the varied quantity, with its
+values as coordinate) or one ``case`` dimension (list and random designs; the varied values are
+coordinates along it), plus ``coordinate`` (and ``coordinate_j``: the columns of M), ``state``
+(coordinates then rates), ``mode``, ``time`` and ``wrench_component`` where the outputs have
+them. Variables carry ``units`` and ``long_name`` attributes; the dataset carries the model's
+SHA-256 (``model_hash``), the study file and the jourdain version. The ``verdict`` follows the
+CF conventions (``flag_values``, ``flag_meanings``; −1: the case failed). Complex eigenvalues
+are stored as ``eigenvalue_real`` and ``eigenvalue_imag`` (NetCDF has no complex type).
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import JourdainError
+from .compute import VERDICTS, WRENCH_COMPONENTS, Context, output_layout
+from .spec import StudyError
+
+__all__ = ["open_study", "results_dataset", "to_dataset", "write_netcdf"]
+
+
+def xarray() -> Any:
+    """The xarray module, or a clear error naming the extra that installs it."""
+    try:
+        import xarray as xr
+    except ImportError:
+        raise StudyError("labelled results need xarray: pip install 'jourdain[study]'"
+                         ) from None
+    return xr
+
+
+def _units(ctx: Context) -> dict[str, str]:
+    from ..units import model_units, per_time
+
+    units = model_units(ctx.system)
+    for n in ctx.system.coordinate_names:
+        if n in units:
+            units[f"{n}_d"] = per_time(units[n], 1)
+    return units
+
+
+def to_dataset(ctx: Context, blocks: Sequence[dict[str, Any]]) -> Any:
+    """The dataset of a study from its blocks (in case order)."""
+    import jourdain
+
+    xr = xarray()
+    spec, system = ctx.spec, ctx.system
+    layout = output_layout(ctx)
+    units = _units(ctx)
+    f = system.f
+    coords_names = system.coordinate_names
+    grid = spec.design == "grid"
+    lead = spec.names if grid and spec.varied else ("case",)
+    shape = spec.shape if grid and spec.varied else (spec.n_cases,)
+    data_vars: dict[str, Any] = {}
+    for name, (dims, _, _) in layout.items():
+        arr = np.concatenate([b["outputs"][name] for b in blocks], axis=0)
+        arr = arr.reshape(*shape, *arr.shape[1:])
+        data_vars[name] = xr.Variable((*lead, *dims), arr, attrs=_attrs(ctx, name, units))
+    errors = np.array([e for b in blocks for e in b["errors"]], dtype=str).reshape(shape)
+    data_vars["error"] = xr.Variable(lead, errors, attrs={
+        "long_name": "the error of a failed case (empty where the case succeeded)"})
+    coords: dict[str, Any] = {}
+    if grid and spec.varied:
+        for v in spec.varied:
+            coords[v.name] = xr.Variable((v.name,), np.asarray(v.values, dtype=float),
+                                         attrs=_varied_attrs(v, units))
+    else:
+        cases = ctx.cases
+        coords["case"] = np.arange(spec.n_cases)
+        for j, v in enumerate(spec.varied):
+            coords[v.name] = xr.Variable(("case",), cases[:, j], attrs=_varied_attrs(v, units))
+    used = {d for dims, _, _ in layout.values() for d in dims}
+    if "coordinate" in used:
+        coords["coordinate"] = list(coords_names)
+    if "coordinate_j" in used:
+        coords["coordinate_j"] = list(coords_names)
+    if "state" in used:
+        coords["state"] = [*coords_names, *(f"{n}_d" for n in coords_names)]
+    if "mode" in used:
+        coords["mode"] = np.arange(2 * f)
+    if "wrench_component" in used:
+        coords["wrench_component"] = list(WRENCH_COMPONENTS)
+    if "time" in used:
+        s = spec.compute["simulate"]
+        coords["time"] = xr.Variable(("time",), np.linspace(0.0, s["t_end"], s["samples"]),
+                                     attrs={"units": "s", "long_name": "time"})
+    attrs = {"title": f"jourdain study {spec.name}", "study": spec.name,
+             "design": spec.design, "model": system.name, "model_file": spec.model_path,
+             "model_hash": spec.model_hash, "compiled_keys": json.dumps(ctx.keys),
+             "spec_hash": spec.spec_hash, "study_file": spec.source,
+             "computed": json.dumps(sorted(spec.compute)),
+             "jourdain_version": jourdain.__version__, "n_cases": spec.n_cases,
+             "n_failed": int(np.count_nonzero(errors != ""))}
+    if spec.design == "random":
+        attrs["seed"] = int(spec.seed or 0)
+        attrs["distributions"] = json.dumps({v.name: [v.distribution, *v.arguments]
+                                             for v in spec.varied})
+    if "critical" in spec.compute:
+        c = spec.compute["critical"]
+        attrs["critical_bracket"] = json.dumps([c["lower"], c["upper"]])
+    if "linearize" in spec.compute or "critical" in spec.compute:
+        attrs["nominal_motion"] = (spec.compute.get("linearize")
+                                   or spec.compute["critical"])["about"]
+        attrs["cyclic_coordinates"] = ", ".join(ctx.cyclic)
+    return xr.Dataset(data_vars, coords=coords, attrs=attrs)
+
+
+def _varied_attrs(v: Any, units: dict[str, str]) -> dict[str, str]:
+    what = {"parameter": "parameter", "y0": "initial coordinate", "yd0": "initial rate"}[v.kind]
+    out = {"long_name": f"{what} {v.name}", "varied": v.kind}
+    if units.get(v.name):
+        out["units"] = units[v.name]
+    return out
+
+
+def _attrs(ctx: Context, name: str, units: dict[str, str]) -> dict[str, Any]:
+    if name == "verdict":
+        return {"long_name": "stability verdict of the linearization",
+                "flag_values": np.array([-1, 0, 1, 2], dtype=np.int8),
+                "flag_meanings": "failed " + " ".join(v.replace(" ", "_") for v in VERDICTS)}
+    if name in ("eigenvalue_real", "eigenvalue_imag", "max_real_part"):
+        part = {"eigenvalue_real": "real part of the eigenvalues of A",
+                "eigenvalue_imag": "imaginary part of the eigenvalues of A (sorted by it)",
+                "max_real_part": "largest real part of the eigenvalues"}[name]
+        return {"long_name": part, "units": "1/s"}
+    for prefix, what in (("critical_", "critical value of"), ("max_abs_", "largest |·| of"),
+                         ("max_", "largest value of"), ("series_", "")):
+        if name.startswith(prefix):
+            q = name[len(prefix):]
+            out = {"long_name": f"{what} {q}".strip()}
+            if units.get(q):
+                out["units"] = units[q]
+            return out
+    if name.startswith("wrench_"):
+        from ..units import force_unit, torque_unit
+
+        return {"long_name": f"wrench of joint {name[7:]} on its child body, in the joint frame "
+                f"(F_x..F_z in {force_unit(units)}, T_x..T_z in {torque_unit(units)})"}
+    if name == "final":
+        return {"long_name": "state at the end of the run (coordinates, then rates)"}
+    return {"long_name": {"evaluate_M": "mass matrix M", "evaluate_k": "k (M·ÿ + k = q)",
+                          "evaluate_q": "q (applied generalized forces)",
+                          "evaluate_ydd": "ÿ = M⁻¹(q − k)"}.get(name, name)}
+
+
+def write_netcdf(ds: Any, path: str | Path) -> Path:
+    """Write ``ds`` to NetCDF-4 (HDF5) at ``path`` (via a temporary file and a rename).
+
+    Uses h5netcdf, else netCDF4; a missing one is named with the extra that installs it."""
+    import os
+
+    path = Path(path)
+    engine = _engine()
+    tmp = path.with_name(path.name + ".tmp")
+    ds.to_netcdf(tmp, engine=engine)
+    os.replace(tmp, path)
+    return path
+
+
+def open_study(path: str | Path) -> Any:
+    """Open a study (or simulation) written by :func:`write_netcdf` as an ``xarray.Dataset``
+    (loaded into memory, the file closed)."""
+    xr = xarray()
+    with xr.open_dataset(path, engine=_engine()) as ds:
+        return ds.load()
+
+
+def _engine() -> str:
+    import importlib.util
+
+    for engine, module in (("h5netcdf", "h5netcdf"), ("netcdf4", "netCDF4")):
+        if importlib.util.find_spec(module) is not None:
+            return engine
+    raise StudyError("writing NetCDF needs h5netcdf (or netCDF4): pip install 'jourdain[study]'")
+
+
+def results_dataset(results: Any) -> Any:
+    """A simulation's :class:`jourdain.Results` as an ``xarray.Dataset``: ``y``, ``yd``,
+    ``ydd`` over (time, coordinate), ``u`` over (time, input), the energies where the model
+    gives them; units as attributes; ``model_hash``: the content key of the compiled equations
+    of motion (a SHA-256 of their generated C source)."""
+    xr = xarray()
+    from ..units import per_time
+
+    units = dict(results.units)
+    coords = list(results.coordinate_names)
+    data: dict[str, Any] = {}
+    for name, arr, order in (("y", results.y, 0), ("yd", results.yd, 1),
+                             ("ydd", results.ydd, 2)):
+        if arr is None:
+            continue
+        cu = [per_time(units.get(c, ""), order) if units.get(c) else "" for c in coords]
+        attrs = {"long_name": {"y": "coordinates", "yd": "rates",
+                               "ydd": "accelerations"}[name]}
+        if len(set(cu)) == 1 and cu[0]:
+            attrs["units"] = cu[0]
+        else:
+            attrs["coordinate_units"] = json.dumps(cu)
+        data[name] = xr.Variable(("time", "coordinate"), np.asarray(arr, dtype=float), attrs)
+    if results.u is not None and len(results.input_names):
+        data["u"] = xr.Variable(("time", "input"), np.asarray(results.u, dtype=float),
+                                {"long_name": "inputs"})
+    attrs: dict[str, Any] = {"title": f"jourdain simulation {results.name}",
+                             "model": results.name, "method": str(results.method),
+                             "rtol": float(results.rtol), "status": str(results.status),
+                             "parameters": json.dumps(dict(results.parameters or {}))}
+    if results.system is not None:
+        from ..numeric import mkq_function
+        from ..units import energy_unit
+
+        attrs["model_hash"] = mkq_function(results.system).key
+        try:
+            for n in ("kinetic_energy", "potential_energy", "total_energy"):
+                data[n] = xr.Variable(("time",), np.asarray(getattr(results, n), dtype=float),
+                                      {"units": energy_unit(units),
+                                       "long_name": n.replace("_", " ")})
+        except (JourdainError, ArithmeticError, ValueError):  # a model without energies
+            pass
+    c = {"time": xr.Variable(("time",), np.asarray(results.t, dtype=float), {"units": "s"}),
+         "coordinate": coords}
+    if results.u is not None and len(results.input_names):
+        c["input"] = list(results.input_names)
+    return xr.Dataset(data, coords=c, attrs=attrs)

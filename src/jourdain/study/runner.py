@@ -1,0 +1,253 @@
+"""Running a study: serially, on the local machine's cores, or on a Dask cluster.
+
+The cases are cut into blocks of ``spec.block`` cases, the unit of work and of saving.
+Each block is computed by :func:`jourdain.study.compute.compute_block` in a worker that rebuilt
+the model from the study's copy of the model file (its hash checked) and loaded the compiled
+functions from the on-disk cache (their content keys checked against the study's). With an
+output file, every finished block is saved at once (``<out>.parts/``, one ``.npz`` per block,
+written to a temporary name and renamed); a study run again with the same output file resumes
+from the blocks saved, and the assembled results equal those of an uninterrupted run (every
+case's numbers depend on that case alone). The parts are removed once the NetCDF file is
+written.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import sys
+import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .compute import compute_block, context, output_layout
+from .spec import StudyError, StudySpec
+
+__all__ = ["Progress", "run_study"]
+
+_PARTS_FORMAT = "jourdain-study-parts-1"
+
+
+class Progress:
+    """A progress bar on stderr (``[#####-----] 512/1000 cases, 3 failed, 1.2 s``), redrawn at
+    most every ``interval`` seconds; on a stream that is not a terminal, one line at the end.
+    ``quiet``: nothing."""
+
+    def __init__(self, total: int, quiet: bool = False, stream: Any = None,
+                 interval: float = 0.2, label: str = "cases") -> None:
+        self.total = total
+        self.quiet = quiet
+        self.stream = stream if stream is not None else sys.stderr
+        self.interval = interval
+        self.label = label
+        self.done = 0
+        self.failed = 0
+        self.start = time.perf_counter()
+        self._last = -1.0
+        self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
+
+    def update(self, done: int, failed: int = 0) -> None:
+        self.done += done
+        self.failed += failed
+        now = time.perf_counter()
+        if self.quiet or not self.tty or (now - self._last < self.interval
+                                          and self.done < self.total):
+            return
+        self._last = now
+        self.stream.write("\r" + self.line())
+        self.stream.flush()
+
+    def line(self) -> str:
+        width = 30
+        frac = self.done / self.total if self.total else 1.0
+        bar = "#" * int(round(width * frac)) + "-" * (width - int(round(width * frac)))
+        fail = f", {self.failed} failed" if self.failed else ""
+        return (f"[{bar}] {self.done}/{self.total} {self.label}{fail}, "
+                f"{time.perf_counter() - self.start:.1f} s")
+
+    def close(self) -> None:
+        if self.quiet:
+            return
+        self.stream.write(("\r" if self.tty else "") + self.line() + "\n")
+        self.stream.flush()
+
+
+def _blocks(spec: StudySpec) -> list[tuple[int, int]]:
+    n, b = spec.n_cases, spec.block
+    return [(s, min(s + b, n)) for s in range(0, n, b)]
+
+
+class _Parts:
+    """The saved blocks of a study (``<out>.parts/``)."""
+
+    def __init__(self, out: Path, spec: StudySpec, keys: dict[str, str], force: bool) -> None:
+        self.dir = Path(str(out) + ".parts")
+        manifest = {"format": _PARTS_FORMAT, "spec_hash": spec.spec_hash,
+                    "model_hash": spec.model_hash, "n_cases": spec.n_cases,
+                    "block": spec.block, "keys": keys}
+        mfile = self.dir / "manifest.json"
+        if self.dir.exists():
+            try:
+                old = json.loads(mfile.read_text())
+            except (OSError, ValueError):
+                old = None
+            if old != manifest:
+                if not force:
+                    raise StudyError(f"{self.dir} holds the saved parts of another study (or "
+                                     "another model or jourdain); delete it, or pass force=True "
+                                     "(--force) to start afresh", spec.filename)
+                shutil.rmtree(self.dir)
+        self.dir.mkdir(parents=True, exist_ok=True)
+        if not mfile.exists():
+            tmp = mfile.with_suffix(".tmp")
+            tmp.write_text(json.dumps(manifest, indent=1))
+            os.replace(tmp, mfile)
+
+    def path(self, start: int, stop: int) -> Path:
+        return self.dir / f"block-{start:09d}-{stop:09d}.npz"
+
+    def load(self, start: int, stop: int) -> dict[str, Any] | None:
+        p = self.path(start, stop)
+        if not p.exists():
+            return None
+        try:
+            with np.load(p, allow_pickle=False) as z:
+                outputs = {k[4:]: z[k] for k in z.files if k.startswith("out_")}
+                errors = [str(e) for e in z["errors"]]
+        except (OSError, ValueError, KeyError):  # a damaged part: computed again
+            return None
+        return {"start": start, "stop": stop, "outputs": outputs, "errors": errors}
+
+    def save(self, block: dict[str, Any]) -> None:
+        p = self.path(block["start"], block["stop"])
+        tmp = p.with_name(p.name + ".tmp.npz")
+        arrays = {f"out_{k}": v for k, v in block["outputs"].items()}
+        np.savez(tmp, errors=np.array(block["errors"], dtype=str), **arrays)
+        os.replace(tmp, p)
+
+    def remove(self) -> None:
+        shutil.rmtree(self.dir, ignore_errors=True)
+
+
+def _init_worker() -> None:
+    """A fresh worker process: forget what it inherited, so that it rebuilds the model from
+    the study's model text and loads the compiled functions from the disk cache."""
+    from .. import numeric
+    from . import compute
+
+    compute._CONTEXTS.clear()
+    numeric.clear_cache()
+
+
+def _run_local(spec: StudySpec, todo: list[tuple[int, int]], workers: int,
+               keys: dict[str, str]) -> Iterator[dict[str, Any]]:
+    import concurrent.futures as cf
+    import multiprocessing as mp
+
+    method = "fork" if "fork" in mp.get_all_start_methods() else "spawn"
+    with cf.ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context(method),
+                                initializer=_init_worker) as pool:
+        futures = [pool.submit(compute_block, spec, s, e, keys) for s, e in todo]
+        try:
+            for fut in cf.as_completed(futures):
+                yield fut.result()
+        finally:
+            for fut in futures:
+                fut.cancel()
+
+
+def _run_dask(spec: StudySpec, todo: list[tuple[int, int]], scheduler: Any,
+              keys: dict[str, str]) -> Iterator[dict[str, Any]]:
+    try:
+        from distributed import Client, as_completed
+    except ImportError:
+        raise StudyError("running on a Dask cluster needs dask.distributed: pip install "
+                         "'jourdain[study]'") from None
+    own = not isinstance(scheduler, Client)
+    client = Client(scheduler) if own else scheduler
+    try:
+        spec_f = client.scatter(spec, broadcast=True)
+        futures = [client.submit(compute_block, spec_f, s, e, keys, pure=False)
+                   for s, e in todo]
+        try:
+            for fut in as_completed(futures):
+                yield fut.result()
+        finally:
+            client.cancel(futures)
+    finally:
+        if own:
+            client.close()
+
+
+def run_study(spec: StudySpec, out: str | Path | None = None, *, workers: int | None = None,
+              scheduler: Any = None, quiet: bool = True, force: bool = False,
+              on_block: Callable[[dict[str, Any]], None] | None = None) -> Any:
+    """Run ``spec`` and return its results as an ``xarray.Dataset``
+    (:func:`jourdain.study.dataset.to_dataset`).
+
+    Parameters
+    ----------
+    spec : StudySpec (:func:`jourdain.study.load_study`)
+    out : path of the NetCDF file to write (``.nc``); blocks are saved as they finish in
+        ``<out>.parts/`` and a study run again with the same ``out`` resumes from them
+    workers : processes on this machine (None, the default: one per core; 1: in this
+        process; a study of one block always runs in this process)
+    scheduler : address of a ``dask.distributed`` scheduler (``"tcp://host:8786"``) or a
+        ``distributed.Client``: the blocks run on that cluster (``workers`` is then ignored)
+    quiet : no progress bar
+    force : start afresh where ``<out>.parts/`` holds another study's parts, and replace an
+        existing ``out``
+    on_block : called with every block computed in this run (after it was saved)
+
+    Failed cases do not stop the study: their outputs are NaN (verdict −1) and their error is
+    in the ``error`` variable.
+    """
+    from .dataset import to_dataset
+
+    if out is not None:
+        out = Path(out)
+        if out.exists() and not force:
+            raise StudyError(f"{out} exists; pass force=True (--force) to replace it",
+                             spec.filename)
+    ctx = context(spec)  # derives and compiles once here: errors of the model show at once
+    keys = dict(ctx.keys)
+    layout = output_layout(ctx)
+    blocks = _blocks(spec)
+    parts = _Parts(out, spec, keys, force) if out is not None else None
+    results: dict[int, dict[str, Any]] = {}
+    if parts is not None:
+        for s, e in blocks:
+            saved = parts.load(s, e)
+            if saved is not None and set(saved["outputs"]) == set(layout):
+                results[s] = saved
+    todo = [(s, e) for s, e in blocks if s not in results]
+    bar = Progress(spec.n_cases, quiet=quiet)
+    bar.update(sum(b["stop"] - b["start"] for b in results.values()),
+               sum(1 for b in results.values() for e in b["errors"] if e))
+    if scheduler is not None:
+        stream = _run_dask(spec, todo, scheduler, keys)
+    else:
+        n = (os.cpu_count() or 1) if workers is None else int(workers)
+        if n < 1:
+            raise StudyError(f"workers must be ≥ 1, got {workers}", spec.filename)
+        stream = (_run_local(spec, todo, min(n, len(todo)), keys) if n > 1 and len(todo) > 1
+                  else (compute_block(spec, s, e, keys) for s, e in todo))
+    for block in stream:
+        if parts is not None:
+            parts.save(block)
+        results[block["start"]] = block
+        bar.update(block["stop"] - block["start"], sum(1 for e in block["errors"] if e))
+        if on_block is not None:
+            on_block(block)
+    bar.close()
+    ds = to_dataset(ctx, [results[s] for s, _ in blocks])
+    if out is not None:
+        from .dataset import write_netcdf
+
+        write_netcdf(ds, out)
+        parts.remove()
+    return ds

@@ -1,0 +1,465 @@
+"""Study files: which model, which cases, what to compute per case (TOML, read as data).
+
+A study file names a model file, the quantities it varies (parameters, initial coordinates
+``x``, initial rates ``x_d``) and what to compute for every case. The format is described in
+``docs/studies.md``::
+
+    [study]
+    model = "rotor.toml"          # relative to this file
+    design = "grid"               # grid | list | random
+    [vary.Omega]
+    range = { start = 0, stop = 30, num = 61 }
+    [vary.d_i]
+    values = [0.5, 1.0, 2.0]
+    [compute.linearize]
+    about = "centred"
+
+Numbers may be written as constant expressions of jourdain's expression language, and bounds
+as expressions in the model's parameters (their default values), e.g. ``"3*sqrt(k/m)"``; they
+are read by :mod:`jourdain.io.expressions`, never by Python. Every mistake raises
+:class:`StudyError` naming the file, the line and the key.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+import tomllib
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import JourdainError
+from ..io.expressions import ExpressionError, parse_expression
+from ..io.toml_positions import key_lines, line_of
+
+__all__ = ["DESIGNS", "DISTRIBUTIONS", "EVALUATE_OUTPUTS", "StudyError", "StudySpec",
+           "load_study", "loads_study"]
+
+#: How the cases are formed from the varied quantities.
+DESIGNS = ("grid", "list", "random")
+#: Distributions of a random design and their parameters (NumPy's ``Generator`` methods):
+#: uniform on [low, high); normal with mean and standard deviation std; lognormal: ln X is
+#: normal with mean mu and standard deviation sigma (median e^mu).
+DISTRIBUTIONS = {"uniform": ("low", "high"), "normal": ("mean", "std"),
+                 "lognormal": ("mu", "sigma")}
+#: What ``[compute.evaluate]`` can give per case.
+EVALUATE_OUTPUTS = ("M", "k", "q", "ydd")
+#: Largest number of cases of one study (a 10⁷-case grid is 80 MB per scalar output).
+MAX_CASES = 10_000_000
+#: Largest study file read (bytes).
+MAX_FILE_BYTES = 1_000_000
+_COMPUTE_KEYS = {
+    "evaluate": {"outputs", "reactions", "t"},
+    "linearize": {"about"},
+    "simulate": {"t_end", "samples", "method", "rtol", "atol", "series", "final", "max",
+                 "max_abs"},
+    "critical": {"parameter", "lower", "upper", "rtol", "about"},
+}
+
+
+class StudyError(JourdainError, ValueError):
+    """A mistake in a study file or study arguments; ``file`` and ``line`` say where."""
+
+    def __init__(self, message: str, file: str = "<study>", line: int | None = None) -> None:
+        super().__init__(message)
+        self.file = file
+        self.line = line
+
+
+@dataclass(frozen=True)
+class Varied:
+    """One varied quantity: a parameter, an initial coordinate or an initial rate.
+
+    ``kind`` is ``"parameter"``, ``"y0"`` or ``"yd0"``; ``values`` the values of a grid axis or
+    a list (None for a random design); ``distribution`` and ``arguments`` those of a random
+    design."""
+
+    name: str
+    kind: str
+    values: tuple[float, ...] | None = None
+    distribution: str | None = None
+    arguments: tuple[float, ...] = ()
+
+
+@dataclass(frozen=True)
+class StudySpec:
+    """A parsed study: the model file's text, the design and what to compute per case.
+
+    Attributes
+    ----------
+    model_path : the model file (as named, resolved against the study file's folder)
+    model_text : its contents (shipped to workers, which rebuild the model from it)
+    model_hash : SHA-256 of ``model_text`` (every worker checks it)
+    design : "grid", "list" or "random"
+    varied : the varied quantities, in the file's order (a grid's axes in this order, the last
+        varying fastest)
+    samples, seed : number of cases and seed of a random design
+    compute : what to compute, ``{"evaluate": {...}, "linearize": {...}, ...}`` (checked)
+    block : cases per block (the unit of work and of saving)
+    name : the study's name
+    source : the study file's text (kept in the results)
+    """
+
+    model_path: str
+    model_text: str
+    model_hash: str
+    design: str
+    varied: tuple[Varied, ...]
+    compute: Mapping[str, Mapping[str, Any]]
+    samples: int = 0
+    seed: int | None = None
+    block: int = 512
+    name: str = "study"
+    source: str = field(default="", repr=False)
+    filename: str = "<study>"
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        """The grid's shape (one axis per varied quantity), else ``(n_cases,)``."""
+        if self.design == "grid":
+            return tuple(len(v.values or ()) for v in self.varied)
+        if self.design == "list":
+            return (len(self.varied[0].values or ()),) if self.varied else (1,)
+        return (self.samples,)
+
+    @property
+    def n_cases(self) -> int:
+        return int(np.prod(self.shape))
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return tuple(v.name for v in self.varied)
+
+    @property
+    def spec_hash(self) -> str:
+        """SHA-256 of what decides the results (the study text and the model's hash): a saved
+        partial study is resumed only when this matches."""
+        h = hashlib.sha256()
+        for part in (self.source, self.model_hash, self.model_path, str(self.block)):
+            h.update(part.encode())
+            h.update(b"\0")
+        return h.hexdigest()
+
+    def cases(self) -> np.ndarray:
+        """The values of the varied quantities, ``(n_cases, n_varied)``, in case order (a
+        grid in C order; a random design drawn from ``seed``, one quantity after the other in
+        the file's order: the same seed gives the same cases on any machine)."""
+        n = self.n_cases
+        if not self.varied:
+            return np.zeros((n, 0))
+        if self.design == "grid":
+            axes = [np.asarray(v.values, dtype=float) for v in self.varied]
+            mesh = np.meshgrid(*axes, indexing="ij")
+            return np.stack([m.reshape(-1) for m in mesh], axis=1)
+        if self.design == "list":
+            return np.stack([np.asarray(v.values, dtype=float) for v in self.varied], axis=1)
+        rng = np.random.default_rng(self.seed)
+        cols = []
+        for v in self.varied:
+            a, b = v.arguments
+            if v.distribution == "uniform":
+                cols.append(rng.uniform(a, b, n))
+            elif v.distribution == "normal":
+                cols.append(rng.normal(a, b, n))
+            else:
+                cols.append(rng.lognormal(a, b, n))
+        return np.stack(cols, axis=1)
+
+
+def load_study(path: str | Path, model: str | Path | None = None) -> StudySpec:
+    """Read a study file; ``model`` replaces the file's ``[study] model``."""
+    name = str(path)
+    try:
+        raw = Path(path).read_bytes()[:MAX_FILE_BYTES + 1]
+    except OSError as exc:
+        raise StudyError(f"{name}: cannot read the study file: {exc.strerror}", name) from None
+    if len(raw) > MAX_FILE_BYTES:
+        raise StudyError(f"{name}: larger than {MAX_FILE_BYTES} bytes", name)
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError:
+        raise StudyError(f"{name}: not UTF-8 text", name) from None
+    return loads_study(text, name, base=Path(path).resolve().parent, model=model)
+
+
+def loads_study(text: str, filename: str = "<study>", base: str | Path | None = None,
+                model: str | Path | None = None) -> StudySpec:
+    """Read a study from TOML ``text``; a relative model path is taken from ``base`` (default:
+    the working directory); ``model`` replaces the file's ``[study] model``."""
+    return _Reader(text, filename, Path(base) if base is not None else Path.cwd()).read(model)
+
+
+class _Reader:
+    def __init__(self, text: str, filename: str, base: Path) -> None:
+        self.text = text
+        self.file = filename
+        self.base = base
+        try:
+            self.data = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as exc:
+            raise StudyError(f"{filename}: not valid TOML: {exc}", filename) from None
+        self.lines = key_lines(text)
+
+    def error(self, path: tuple[str | int, ...], message: str) -> StudyError:
+        line = line_of(self.lines, path)
+        where = f"{self.file}:{line}" if line else self.file
+        key = " → ".join(str(p) for p in path)
+        return StudyError(f"{where}: {key}: {message}" if key else f"{where}: {message}",
+                          self.file, line)
+
+    def table(self, value: Any, path: tuple[str | int, ...], allowed: set[str]) -> dict:
+        if not isinstance(value, dict):
+            raise self.error(path, f"expected a table, got {_type(value)}")
+        unknown = sorted(set(value) - allowed)
+        if unknown:
+            raise self.error((*path, unknown[0]), f"unknown key; allowed: "
+                             f"{', '.join(sorted(allowed))}")
+        return value
+
+    def number(self, value: Any, path: tuple[str | int, ...], names: Mapping[str, float]
+               | None = None) -> float:
+        """A number, or an expression string in the model's parameters (their defaults)."""
+        if isinstance(value, bool):
+            raise self.error(path, "expected a number, got a boolean")
+        if isinstance(value, int | float):
+            out = float(value)
+        elif isinstance(value, str):
+            try:
+                e = parse_expression(value, names=set(names or ()))
+                out = float(e.subs({k: v for k, v in (names or {}).items()}))
+            except (ExpressionError, RuntimeError, TypeError, ValueError) as exc:
+                raise self.error(path, f'"{value}": {exc}') from None
+        else:
+            raise self.error(path, f"expected a number, got {_type(value)}")
+        if not math.isfinite(out):
+            raise self.error(path, f"{value!r} is not finite")
+        return out
+
+    def read(self, model_override: str | Path | None) -> StudySpec:
+        from ..io.modelfile import loads_model
+
+        top = self.table(self.data, (), {"study", "vary", "compute"})
+        study = self.table(top.get("study", {}), ("study",),
+                           {"model", "name", "design", "samples", "seed", "block"})
+        model_name = model_override if model_override is not None else study.get("model")
+        if model_name is None:
+            raise self.error(("study",), 'no model: give [study] model = "FILE.toml" (or the '
+                             "model on the command line)")
+        if not isinstance(model_name, str | Path):
+            raise self.error(("study", "model"), f"expected a file name, got {_type(model_name)}")
+        mpath = Path(model_name)
+        if not mpath.is_absolute() and model_override is None:
+            mpath = self.base / mpath
+        try:
+            model_text = mpath.read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError) as exc:
+            raise self.error(("study", "model"), f"cannot read the model file {str(mpath)!r}: "
+                             f"{getattr(exc, 'strerror', None) or exc}") from None
+        model = loads_model(model_text, str(mpath))
+        system = model.system
+        defaults = system.parameter_values
+        design = study.get("design", "grid")
+        if design not in DESIGNS:
+            raise self.error(("study", "design"), f'expected one of {", ".join(DESIGNS)}, got '
+                             f"{design!r}")
+        samples, seed = 0, None
+        if design == "random":
+            samples = self.count(study.get("samples"), ("study", "samples"), "samples")
+            seed = study.get("seed")
+            if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+                raise self.error(("study", "seed"), "a random design needs a seed, a whole "
+                                 "number ≥ 0 (the same seed gives the same cases)")
+        else:
+            for key in ("samples", "seed"):
+                if key in study:
+                    raise self.error(("study", key), f'only for design = "random" (this study '
+                                     f'is "{design}")')
+        block = self.count(study.get("block", 512), ("study", "block"), "block")
+        name = study.get("name", Path(self.file).stem)
+        if not isinstance(name, str):
+            raise self.error(("study", "name"), f"expected a string, got {_type(name)}")
+        kinds = {n: "parameter" for n in defaults}
+        kinds.update({n: "y0" for n in system.coordinate_names})
+        kinds.update({f"{n}_d": "yd0" for n in system.coordinate_names})
+        vary = self.table(top.get("vary", {}), ("vary",), set(kinds) | set(top.get("vary", {})))
+        varied = []
+        for vname, entry in vary.items():
+            path = ("vary", vname)
+            if vname not in kinds:
+                raise self.error(path, f'"{vname}" is not a parameter, coordinate or rate of '
+                                 f"the model; parameters: {', '.join(defaults) or '(none)'}; "
+                                 f"coordinates: {', '.join(system.coordinate_names)}")
+            varied.append(self.varied(vname, kinds[vname], entry, path, design, defaults))
+        if design == "list" and varied:
+            lengths = {v.name: len(v.values or ()) for v in varied}
+            if len(set(lengths.values())) > 1:
+                raise self.error(("vary",), f"a list design needs lists of one length, got "
+                                 f"{lengths}")
+        compute = self.compute(top.get("compute"), model, defaults)
+        spec = StudySpec(model_path=str(mpath), model_text=model_text,
+                         model_hash=hashlib.sha256(model_text.encode()).hexdigest(),
+                         design=design, varied=tuple(varied), compute=compute, samples=samples,
+                         seed=seed, block=block, name=name, source=self.text,
+                         filename=self.file)
+        if spec.n_cases > MAX_CASES:
+            raise self.error(("vary",), f"{spec.n_cases} cases; at most {MAX_CASES}")
+        return spec
+
+    def count(self, value: Any, path: tuple[str | int, ...], what: str) -> int:
+        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+            raise self.error(path, f"{what}: expected a whole number ≥ 1, got {value!r}")
+        if value > MAX_CASES:
+            raise self.error(path, f"{what}: at most {MAX_CASES}")
+        return value
+
+    def varied(self, name: str, kind: str, entry: Any, path: tuple[str | int, ...],
+               design: str, defaults: Mapping[str, float]) -> Varied:
+        if design == "random":
+            entry = self.table(entry, path, {"distribution", "low", "high", "mean", "std", "mu",
+                                             "sigma"})
+            dist = entry.get("distribution")
+            if dist not in DISTRIBUTIONS:
+                raise self.error((*path, "distribution"), f"expected one of "
+                                 f"{', '.join(DISTRIBUTIONS)}, got {dist!r}")
+            keys = DISTRIBUTIONS[dist]
+            extra = sorted(set(entry) - {"distribution", *keys})
+            if extra:
+                raise self.error((*path, extra[0]), f'not a parameter of the {dist} '
+                                 f"distribution ({', '.join(keys)})")
+            args = []
+            for k in keys:
+                if k not in entry:
+                    raise self.error(path, f"the {dist} distribution needs {' and '.join(keys)}")
+                args.append(self.number(entry[k], (*path, k), defaults))
+            if dist == "uniform" and not args[0] < args[1]:
+                raise self.error(path, f"uniform: low < high needed, got {args}")
+            if dist != "uniform" and not args[1] >= 0:
+                raise self.error((*path, keys[1]), f"must be ≥ 0, got {args[1]}")
+            return Varied(name, kind, distribution=dist, arguments=tuple(args))
+        allowed = {"values", "range"} if design == "grid" else {"values"}
+        entry = self.table(entry, path, allowed)
+        if ("values" in entry) == ("range" in entry):
+            raise self.error(path, "give values = [...]" + (" or range = { start, stop, num }"
+                                                            if design == "grid" else ""))
+        if "values" in entry:
+            vals = entry["values"]
+            if not isinstance(vals, list) or not vals:
+                raise self.error((*path, "values"), "expected a non-empty list of numbers")
+            values = tuple(self.number(v, (*path, "values", i), defaults)
+                           for i, v in enumerate(vals))
+        else:
+            rng = self.table(entry["range"], (*path, "range"), {"start", "stop", "num"})
+            if set(rng) != {"start", "stop", "num"}:
+                raise self.error((*path, "range"), "needs start, stop and num (evenly spaced, "
+                                 "both ends included)")
+            num = self.count(rng["num"], (*path, "range", "num"), "num")
+            a = self.number(rng["start"], (*path, "range", "start"), defaults)
+            b = self.number(rng["stop"], (*path, "range", "stop"), defaults)
+            values = tuple(float(x) for x in np.linspace(a, b, num))
+        return Varied(name, kind, values=values)
+
+    def compute(self, value: Any, model: Any, defaults: Mapping[str, float]
+                ) -> dict[str, dict[str, Any]]:
+        system = model.system
+        if value is None:
+            raise self.error((), "nothing to compute: add [compute.evaluate], "
+                             "[compute.linearize], [compute.simulate] or [compute.critical]")
+        comp = self.table(value, ("compute",), set(_COMPUTE_KEYS))
+        out: dict[str, dict[str, Any]] = {}
+        nominal_names = [n.name for n in model.nominal]
+        for what, entry in comp.items():
+            path = ("compute", what)
+            entry = self.table(entry, path, _COMPUTE_KEYS[what])
+            if what == "evaluate":
+                outs = entry.get("outputs", ["M", "k", "q"])
+                if not isinstance(outs, list) or any(o not in EVALUATE_OUTPUTS for o in outs):
+                    raise self.error((*path, "outputs"), f"expected a list of "
+                                     f"{', '.join(EVALUATE_OUTPUTS)}, got {outs!r}")
+                joints = [b.joint.name for b in system.bodies]
+                reacts = entry.get("reactions", [])
+                if not isinstance(reacts, list) or any(r not in joints for r in reacts):
+                    raise self.error((*path, "reactions"), f"expected a list of joint names "
+                                     f"({', '.join(joints)}), got {reacts!r}")
+                t = self.number(entry.get("t", 0.0), (*path, "t"))
+                out[what] = {"outputs": tuple(outs), "reactions": tuple(reacts), "t": t}
+            elif what in ("linearize", "critical"):
+                about = entry.get("about", nominal_names[0] if nominal_names else None)
+                if about not in nominal_names:
+                    raise self.error((*path, "about"), f"no nominal motion {about!r} in the "
+                                     f"model; it has: {', '.join(nominal_names) or '(none)'}")
+                d: dict[str, Any] = {"about": about}
+                if what == "critical":
+                    par = entry.get("parameter")
+                    if par not in defaults:
+                        raise self.error((*path, "parameter"), f"expected a parameter of the "
+                                         f"model ({', '.join(defaults)}), got {par!r}")
+                    for k in ("lower", "upper"):
+                        if k not in entry:
+                            raise self.error(path, "needs lower and upper (the bracket)")
+                        v = entry[k]
+                        if isinstance(v, str):
+                            try:
+                                parse_expression(v, names=set(defaults))
+                            except ExpressionError as exc:
+                                raise self.error((*path, k), f'"{v}": {exc}') from None
+                            d[k] = v
+                        else:
+                            d[k] = self.number(v, (*path, k))
+                    rtol = self.number(entry.get("rtol", 1e-12), (*path, "rtol"))
+                    if not 0 < rtol < 1:
+                        raise self.error((*path, "rtol"), f"expected 0 < rtol < 1, got {rtol}")
+                    d.update(parameter=par, rtol=rtol)
+                out[what] = d
+            else:
+                out[what] = self.simulate(entry, path, model)
+        if not out:
+            raise self.error(("compute",), "nothing to compute")
+        return out
+
+    def simulate(self, entry: dict, path: tuple[str | int, ...], model: Any) -> dict[str, Any]:
+        from ..simulate import MAX_SAMPLES, check_atol, check_rtol, check_t_end
+
+        system = model.system
+        settings = model.simulation
+        d: dict[str, Any] = {}
+        try:
+            d["t_end"] = check_t_end(self.number(entry.get("t_end", settings.t_end),
+                                                 (*path, "t_end")), "t_end")
+            d["rtol"] = check_rtol(self.number(entry.get("rtol", settings.rtol),
+                                               (*path, "rtol")), "rtol")
+            d["atol"] = check_atol(self.number(entry.get("atol", settings.atol),
+                                               (*path, "atol")), 1, "atol")[0]
+        except JourdainError as exc:
+            raise self.error(path, str(exc)) from None
+        samples = self.count(entry.get("samples", settings.samples), (*path, "samples"),
+                             "samples")
+        if samples < 2 or samples > MAX_SAMPLES:
+            raise self.error((*path, "samples"), f"expected 2 to {MAX_SAMPLES}")
+        d["samples"] = samples
+        method = entry.get("method", settings.method)
+        from ..io.capabilities import SIM_METHODS
+
+        if method not in SIM_METHODS:
+            raise self.error((*path, "method"), f"expected one of {', '.join(SIM_METHODS)}")
+        d["method"] = method
+        names = [*system.coordinate_names, *(f"{n}_d" for n in system.coordinate_names)]
+        for key in ("series", "max", "max_abs"):
+            vals = entry.get(key, [])
+            if not isinstance(vals, list) or any(v not in names for v in vals):
+                raise self.error((*path, key), f"expected a list of coordinates or rates "
+                                 f"({', '.join(names)}), got {vals!r}")
+            d[key] = tuple(vals)
+        final = entry.get("final", True)
+        if not isinstance(final, bool):
+            raise self.error((*path, "final"), "expected true or false")
+        d["final"] = final
+        return d
+
+
+def _type(v: object) -> str:
+    return {bool: "a boolean", int: "an integer", float: "a number", str: "a string",
+            list: "a list", dict: "a table"}.get(type(v), type(v).__name__)
