@@ -107,7 +107,9 @@ def test_eval_json_matches_the_python_api(capsys):
     assert data["not_available"] == {}
     # the documented contract: these keys, no others (jourdain-eval/1)
     assert set(data) == {"format", "model", "file", "coordinates", "t", "y", "yd", "parameters",
-                         "inputs", "values", "g_names", "g_undetermined", "not_available"}
+                         "inputs", "values", "g_names", "g_undetermined", "not_available",
+                         "joint_wrenches", "units"}
+    assert data["units"]["y"] == ["rad", "rad"] and data["units"]["k"] == ["N m", "N m"]
     assert set(data["values"]) == {"M_bar", "J_bar", "q_c", "q_e", "M", "k", "q", "Q_bar",
                                    "N_hat", "k_hat", "q_hat", "g", "M_tilde", "P", "Q", "h",
                                    "D", "G", "K", "N"}

@@ -127,8 +127,10 @@ def joint_wrenches(system: System, g: Any, y: Any, yd: Any = None, t: float = 0.
     from .numeric import state_vectors
 
     joints, names, mats = _layout(system)
+    # the directions and orientations do not depend on the inputs: zeros stand for them (None
+    # is refused for a model with inputs)
     yv, ydv, tv, pv, _ = state_vectors(system, y, np.zeros(system.f) if yd is None else yd, t,
-                                       parameters, None)
+                                       parameters, np.zeros(len(system.inputs)))
     gv = np.asarray(g, dtype=float).reshape(-1)
     q = sum(len(jr.columns) for jr in joints)
     if gv.size != q:
