@@ -493,9 +493,11 @@ def _up(system: System, values: Mapping[str, float]) -> np.ndarray:
     return np.array([0.0, 0.0, 1.0])
 
 
-def _camera(points: np.ndarray, up: np.ndarray) -> tuple[np.ndarray, float, np.ndarray, float,
-                                                         np.ndarray]:
-    """Centre, extent, viewing direction (centre → camera), distance and ground point."""
+def _camera(motion: np.ndarray, points: np.ndarray, up: np.ndarray
+            ) -> tuple[np.ndarray, float, np.ndarray, np.ndarray]:
+    """Centre, extent (diagonal), viewing direction (centre → camera) and ground point of a
+    scene that holds ``points``; the view looks across the plane of ``motion`` (the frame
+    origins and centres of mass) where that is planar."""
     lo, hi = points.min(axis=0), points.max(axis=0)
     center = (lo + hi) / 2
     extent = float(np.linalg.norm(hi - lo))
@@ -504,7 +506,7 @@ def _camera(points: np.ndarray, up: np.ndarray) -> tuple[np.ndarray, float, np.n
     h1 = np.cross(up, a)
     h1 /= np.linalg.norm(h1)
     h2 = np.cross(up, h1)
-    spread = (points - center).std(axis=0) if len(points) > 1 else np.zeros(3)
+    spread = motion.std(axis=0) if len(motion) > 1 else np.zeros(3)
     if spread.max() > 0 and spread.min() < 1e-6 * spread.max():
         n = np.eye(3)[int(np.argmin(spread))]  # planar motion: look at the plane, a bit oblique
         if abs(n @ up) < 0.9:
@@ -516,7 +518,7 @@ def _camera(points: np.ndarray, up: np.ndarray) -> tuple[np.ndarray, float, np.n
         d = h1 + 0.6 * h2 + 0.5 * up
     d = d / np.linalg.norm(d)
     ground = center - up * float(np.max((center - points) @ up, initial=0.0))
-    return center, extent, d, extent, ground
+    return center, extent, d, ground
 
 
 def scene(results: Results, visuals: Any = None,
@@ -549,14 +551,16 @@ def scene(results: Results, visuals: Any = None,
         raw.append((m, com, sides, V))
     # the extent of the scene: the motion of the frames and centres of mass, and the shapes
     com_world = r + np.einsum("npij,pj->npi", S, np.array([c for _, c, _, _ in raw]))
-    pts = np.concatenate([np.zeros((1, 3)), r.reshape(-1, 3), com_world.reshape(-1, 3)])
+    # each shape as its bounding sphere, by six points around its centre of mass
+    radius = np.array([0.5 * float(np.linalg.norm(s)) for _, _, s, _ in raw])
+    around = com_world[:, :, None, :] + radius[None, :, None, None] * np.concatenate(
+        [np.eye(3), -np.eye(3)])[None, None]
+    pts = np.concatenate([np.zeros((1, 3)), r.reshape(-1, 3), com_world.reshape(-1, 3),
+                          around.reshape(-1, 3)])
     up = _up(system, values)
-    center, extent, view_dir, distance, ground = _camera(pts, up)
-    biggest = max((float(s.max()) for _, _, s, _ in raw), default=0.0)
-    L = max(extent, biggest, 1e-9)
-    if extent < 0.2 * L:  # a body spinning in place: step back to see the whole shape
-        distance = 2.0 * L
-    distance = max(distance, 1.2 * L) * 1.5
+    center, extent, view_dir, ground = _camera(pts[1:1 + 2 * r.shape[0] * r.shape[1]], pts, up)
+    L = max(extent, 1e-9)
+    distance = 1.6 * L  # the whole scene fits the 40° field of view
     mmax = max((m for m, _, _, _ in raw), default=0.0)
 
     budget = [MAX_TRIANGLES]
