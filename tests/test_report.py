@@ -139,3 +139,20 @@ def test_report_equations_tex_is_the_compilable_fragment(report):
     body = [line for line in tex.splitlines() if line and not line.startswith("%")]
     assert body[0] == "\\setcounter{MaxMatrixCols}{12}"
     assert all(line.startswith("\\[ ") and line.endswith(" \\]") for line in body[1:])
+
+
+def test_report_embeds_the_3d_view(report):
+    """The 3-D view (jourdain.io.viewer, tested in tests/test_viewer.py) is its own page in a
+    sandboxed iframe: the report page itself still runs no script; the view holds the bodies
+    of the model."""
+    import html
+
+    from tests.test_viewer import _scene_of
+
+    text = (report / "report.html").read_text()
+    m = re.search(r"<h3>3-D view</h3><iframe class='jourdain-view' srcdoc=\"([^\"]*)\" "
+                  r"sandbox='allow-scripts'", text)
+    assert m, "no 3-D view in the report"
+    sc = _scene_of(html.unescape(m.group(1)))
+    assert [b["name"] for b in sc["bodies"]] == ["rod1", "rod2"]
+    assert sc["n_frames"] > 100

@@ -785,6 +785,11 @@ def _sections(model: ModelFile, out: Path, params: dict[str, float], t_end: floa
                            "inertial origin.</p>")
             except (JourdainError, KeyError, AttributeError, ValueError) as exc:
                 s.append(_note(f"positions along the motion not available: {exc}"))
+            # the 3-D view (jourdain.io.viewer): its own page with three.js, in a sandboxed
+            # iframe, so that this page itself runs no script
+            from .viewer import report_section
+
+            s.append(report_section(res, model))
         except JourdainError as exc:
             s.append(_note(f"the simulation failed: {exc}"))
             info.notes.append(f"simulation: {exc}")
