@@ -1036,6 +1036,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="FMI modelIdentifier, the binary's name (default: from the model's name)")
     p.add_argument("--sources-only", action="store_true",
                    help="no binary: the FMU holds the C sources only")
+
+    from .study.cli import add_study_parser
+
+    add_study_parser(subs, _Parser)
     return parser
 
 

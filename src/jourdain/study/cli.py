@@ -1,0 +1,69 @@
+"""``jourdain study``: run a study file on this machine's cores or on a Dask cluster."""
+
+from __future__ import annotations
+
+import argparse
+import time
+from typing import Any
+
+EXAMPLE = ("jourdain study --spec examples/rotor_stability_map.toml --out map.nc --plots plots/\n"
+           "  jourdain study examples/rotor_internal_damping.toml --spec map.toml "
+           "--scheduler tcp://10.0.0.5:8786")
+
+
+def add_study_parser(subs: Any, parser_class: type) -> Any:
+    """Add the ``study`` subcommand to the CLI's subparsers."""
+    help = ("run a parameter study (grid, list or Monte-Carlo samples; evaluate, linearize, "
+            "simulate, critical values) and write its results to NetCDF (docs/studies.md)")
+    p = subs.add_parser("study", help=help, description=help, epilog=f"example:\n  {EXAMPLE}",
+                        formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("model", metavar="MODEL", nargs="?",
+                   help="model file (default: the study file's [study] model)")
+    p.add_argument("--spec", required=True, metavar="STUDY",
+                   help="the study file (TOML, see docs/studies.md)")
+    p.add_argument("--out", metavar="FILE",
+                   help="NetCDF file of the results (.nc); finished blocks are saved in "
+                        "FILE.parts/ as they come and a run with the same --out resumes")
+    p.add_argument("--workers", type=_workers, metavar="N",
+                   help="processes on this machine (default: one per core; 1: no processes)")
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="run on this dask.distributed scheduler (tcp://host:8786)")
+    p.add_argument("--plots", metavar="DIR",
+                   help="write the study's plots there (stability map, Campbell diagram, "
+                        "histograms) as SVG and PNG")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--force", action="store_true",
+                   help="replace an existing --out file and the saved parts of another study")
+    p.set_defaults(func=cmd_study)
+    return p
+
+
+def _workers(text: str) -> int:
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+    if n < 1:
+        raise argparse.ArgumentTypeError(f"expected 1 or more workers, got {n}")
+    return n
+
+
+def cmd_study(args: argparse.Namespace) -> int:
+    from . import load_study, run_study
+    from .plots import study_plots
+
+    spec = load_study(args.spec, model=args.model)
+    t0 = time.perf_counter()
+    ds = run_study(spec, args.out, workers=args.workers, scheduler=args.scheduler,
+                   quiet=args.quiet, force=args.force)
+    wall = time.perf_counter() - t0
+    failed = int(ds.attrs["n_failed"])
+    where = f" on {args.scheduler}" if args.scheduler else ""
+    print(f"study {spec.name}: {spec.n_cases} cases ({spec.design}{where}) in {wall:.2f} s"
+          + (f", {failed} failed (see the error variable)" if failed else ""))
+    if args.out:
+        print(f"results: {args.out}")
+    if args.plots:
+        for path in study_plots(ds, args.plots):
+            print(f"plot: {path}")
+    return 0
