@@ -488,3 +488,123 @@ def test_quantity_errors_name_what_and_where():
         jd.Bushing("b", "world", "pend", frame="x")
     with pytest.raises(jd.ModelError, match="expected 6 entries"):
         jd.Bushing("b", "world", "pend", stiffness=[1, 2, 3])
+
+
+# --- model files ----------------------------------------------------------------------------
+_FILE = """
+[coordinates]
+phi1 = "rad"
+phi2 = "rad"
+
+[parameters]
+c_t = 3.0
+d_t = 0.4
+k = 50.0
+c3 = 200.0
+
+[bodies.l1]
+parent = "world"
+mass = 1.0
+com = [0.5, 0, 0]
+inertia = { rod = { length = 1.0, axis = "x" } }
+joint = { type = "revolute", coordinate = "phi1" }
+
+[bodies.l2]
+parent = "world"
+mass = 1.0
+com = [0.5, 0, 0]
+inertia = { rod = { length = 1.0, axis = "x" } }
+joint = { type = "revolute", coordinate = "phi2", position = [0, 0, 0.1] }
+
+[quantities.tip]
+type = "velocity"
+body = "l2"
+point = [1, 0, 0]
+
+[quantities.gap]
+type = "distance"
+body_a = "l1"
+point_a = [1, 0, 0]
+body_b = "l2"
+point_b = [1, 0, 0]
+
+[forces.torsion]
+type = "rotational_spring_damper"
+coordinate = "phi2 - phi1"
+stiffness = "c_t"
+damping = "d_t"
+
+[forces.mount]
+type = "bushing"
+body_a = "l1"
+point_a = [1, 0, 0]
+body_b = "l2"
+point_b = [1, 0, 0]
+frame = "l2"
+stiffness = ["k", "k", "k", 0, 0, 0]
+laws = { rz = "c3*deflection^3 + 0.1*deflection_d" }
+
+[forces.drag]
+type = "force"
+body = "l2"
+point = [1, 0, 0]
+vector = ["-0.3*tip_x", "-0.3*tip_y", 0]
+
+[forces.tether]
+type = "generalized"
+coordinate = "gap"
+value = "-k*deflection^2 - deflection_d"
+"""
+
+
+def test_model_file_bushing_quantities_and_expressions_equal_python():
+    """The model file's bushing, quantities and generalized forces on expressions give the q of
+    the same elements built in Python."""
+    from jourdain.io.modelfile import loads_model
+
+    mf = loads_model(_FILE, "m.toml")
+    s_file = mf.system
+    p1, p2 = jd.symbols("phi1 phi2")
+    b1, b2 = s_file.bodies
+    tip = jd.velocity("tip", "l2", (1, 0, 0))
+    gap = jd.distance("gap", "l1", (1, 0, 0), "l2", (1, 0, 0))
+    k, c3 = 50.0, 200.0
+    forces = [
+        jd.RotationalSpringDamper("torsion", p2 - p1, 3.0, 0.4),
+        jd.Bushing("mount", "l1", "l2", (1, 0, 0), (1, 0, 0), stiffness=[k, k, k, 0, 0, 0],
+                   frame="l2", laws={"rz": c3 * jd.deflection**3 + 0.1 * jd.deflection_d}),
+        jd.Force("drag", "l2", (-0.3 * tip[0], -0.3 * tip[1], 0), point=(1, 0, 0)),
+        jd.GeneralizedForce("tether", gap, -k * jd.deflection**2 - jd.deflection_d),
+    ]
+    s_py = jd.System([p1, p2], [b1, b2], forces)
+    assert [q.name for q in s_file.quantities] == ["gap", "tip"]
+    rng = np.random.default_rng(2)
+    for _ in range(3):
+        y, yd = rng.normal(size=2), rng.normal(size=2)
+        a = s_file.evaluate(y, yd)["q"]
+        b = s_py.evaluate(y, yd)["q"]
+        np.testing.assert_array_equal(a, b)
+
+
+@pytest.mark.parametrize("change, message", [
+    ('laws = { rz = "c3*deflection^3 + 0.1*deflection_d" }',
+     'laws = { theta = "c3*deflection" }'),
+    ('stiffness = ["k", "k", "k", 0, 0, 0]', 'stiffness = ["k", "k", "k"]'),
+    ('type = "distance"', 'type = "distanse"'),
+    ('coordinate = "phi2 - phi1"', 'coordinate = "phi2_d - phi1"'),
+    ('frame = "l2"', 'frame = "world"'),
+    ('vector = ["-0.3*tip_x", "-0.3*tip_y", 0]', 'vector = ["-0.3*tip_w", 0, 0]'),
+    ('[quantities.gap]', '[quantities.phi1]'),
+], ids=["law component", "stiffness size", "quantity type", "rate in coordinate",
+        "bushing frame", "unknown symbol", "name clash"])
+def test_model_file_errors_name_line_and_key(change, message):
+    from jourdain.io.modelfile import ModelFileError, loads_model
+
+    text = _FILE.replace(change, message)
+    assert text != _FILE
+    with pytest.raises(ModelFileError) as err:
+        loads_model(text, "m.toml")
+    line = text[:text.index(message)].count("\n") + 1
+    msg = str(err.value)
+    assert msg.startswith("m.toml:"), msg
+    assert err.value.line == line, (msg, line)

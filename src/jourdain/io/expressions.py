@@ -64,7 +64,8 @@ CONSTANTS: dict[str, se.Basic] = {"pi": se.pi}
 
 #: Names a model may not declare (functions, constants and Python words that look like names).
 RESERVED_NAMES = frozenset(FUNCTIONS) | frozenset(CONSTANTS) | frozenset({
-    "t", "world", "elongation", "elongation_d", "lambda", "import", "and", "or", "not", "if",
+    "t", "world", "elongation", "elongation_d", "deflection", "deflection_d",
+    "lambda", "import", "and", "or", "not", "if",
     "else", "for", "in", "is", "None", "True", "False", "def", "class", "return", "exec", "eval",
 })
 

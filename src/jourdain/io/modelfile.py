@@ -251,7 +251,8 @@ def _type_name(v: object) -> str:
 def describe_path(path: Path) -> str:
     """``("bodies", "link2", "joint", "axis")`` → ``body "link2" → joint → axis``."""
     singular = {"bodies": "body", "forces": "force", "parameters": "parameter",
-                "coordinates": "coordinate", "inputs": "input", "nominal": "nominal motion"}
+                "coordinates": "coordinate", "inputs": "input", "nominal": "nominal motion",
+                "quantities": "quantity"}
     parts: list[str] = []
     items = list(path)
     if len(items) >= 2 and items[0] in singular and isinstance(items[1], str):
@@ -391,6 +392,9 @@ class _Loader:
                 return f" (inputs are not allowed in {context})"
             if name in ("elongation", "elongation_d"):
                 return " (elongation and elongation_d are allowed in a spring law only)"
+            if name in ("deflection", "deflection_d"):
+                return (" (deflection and deflection_d are allowed in a generalized force's "
+                        "value and a bushing law only)")
             pool = [n for n in (*self.coords, *self.params, *self.inputs) if n in allowed]
             sugg = self.suggest(name, pool)
             return f"; it is not declared{sugg} — {context} may use {_listing(self, allowed)}"
@@ -1094,8 +1098,7 @@ class _Loader:
                 return 0
             if not isinstance(v, list) or len(v) != 6:
                 what = "a 6-vector (the diagonal) or 6 rows of 6" if matrix else "a 6-vector"
-                raise self.fail(kp, f"expected {what}, got {_type_name(v)}"
-                                + (f" of {len(v)} entries" if isinstance(v, list) else ""))
+                raise self.fail(kp, f"expected {what}, got {_type_name(v)}")
             if matrix and all(isinstance(r, list) for r in v):
                 for i, r in enumerate(v):
                     if len(r) != 6:
@@ -1303,7 +1306,8 @@ def _listing(loader: _Loader, allowed: Container[str]) -> str:
     parts = []
     for label, names in (("coordinates", loader.coords),
                          ("rates", [f"{c}_d" for c in loader.coords]),
-                         ("parameters", list(loader.params)), ("inputs", loader.inputs)):
+                         ("parameters", list(loader.params)), ("inputs", loader.inputs),
+                         ("kinematic quantities", list(loader.quantity_symbols))):
         shown = [n for n in names if n in allowed]
         if shown:
             parts.append(f"{label} {', '.join(shown)}")
