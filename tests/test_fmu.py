@@ -267,6 +267,33 @@ def test_fmu_state_and_serialization(pendulum: tuple) -> None:
 
 
 @needs_cc
+def test_fmi_errors_are_reported(pendulum: tuple, capsys: pytest.CaptureFixture[str]) -> None:
+    """Calls the FMU refuses return fmi2Error with a message to the logger (FMPy's default
+    logger prints it): a computed variable set, masses that make M indefinite."""
+    from fmpy.fmi1 import FMICallException
+
+    _, info = pendulum
+    md = read_model_description(str(info.path))
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    fmu = FMU2Model(guid=md.guid, unzipDirectory=extract(str(info.path)),
+                    modelIdentifier=info.model_identifier, instanceName="err")
+    fmu.instantiate()
+    try:
+        capsys.readouterr()
+        with pytest.raises(FMICallException):
+            fmu.setReal([vr["der(phi1_d)"]], [1.0])
+        assert "[ERROR] fmi2SetReal: the variable is computed" in capsys.readouterr().out
+        fmu.setupExperiment(startTime=0.0)
+        fmu.enterInitializationMode()
+        fmu.setReal([vr["m1"], vr["m2"]], [-1.0, -0.5])
+        with pytest.raises(FMICallException):
+            fmu.exitInitializationMode()
+        assert "M is not positive definite" in capsys.readouterr().out
+    finally:
+        fmu.freeInstance()
+
+
+@needs_cc
 def test_sources_rebuild_the_binary(pendulum: tuple, tmp_path: Path) -> None:
     """The sources/ of the FMU compile on their own into a binary that FMPy runs."""
     _, info = pendulum

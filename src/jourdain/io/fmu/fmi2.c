@@ -216,7 +216,13 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
                               "together", fmuGUID ? fmuGUID : "(none)", JD_GUID);
         return NULL;
     }
-    if (fmuType != fmi2ModelExchange && fmuType != fmi2CoSimulation) return NULL;
+    if (fmuType != fmi2ModelExchange && fmuType != fmi2CoSimulation) {
+        if (functions->logger)
+            functions->logger(functions->componentEnvironment, instanceName, fmi2Error,
+                              "logStatusError", "fmi2Instantiate: unknown fmuType %d",
+                              (int)fmuType);
+        return NULL;
+    }
     c = (jd_instance *)functions->allocateMemory(1, sizeof(jd_instance));
     if (!c) return NULL;
     c->name = (char *)functions->allocateMemory(strlen(instanceName) + 1, 1);
@@ -607,7 +613,7 @@ fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c_, const fmi2ValueReferen
 
 /* ẋ = [ẏ; ÿ] with the inputs u0 + du·(t − t0) */
 static int jd_rhs(const jd_instance *c, double t, const double *x, double t0, double *dx) {
-    double u[JD_NU1], W[6 * JD_NB1];
+    double u[JD_NU1] = {0.0}, W[6 * JD_NB1];
     for (int i = 0; i < JD_NU; ++i) u[i] = c->d.u[i] + c->d.du[i] * (t - t0);
     memcpy(dx, x + JD_NY, sizeof(double) * JD_NY);
     return jd_dynamics(x, x + JD_NY, t, c->d.p, u, dx + JD_NY, W);
