@@ -29,7 +29,7 @@ from fmpy.fmi2 import FMU2Model, FMU2Slave  # noqa: E402
 from fmpy.validation import validate_fmu  # noqa: E402
 
 from jourdain.cli import main  # noqa: E402
-from jourdain.errors import ModelError  # noqa: E402
+from jourdain.errors import EvaluationError, ModelError  # noqa: E402
 from jourdain.io import load_model  # noqa: E402
 from jourdain.io.fmu import export_fmu, fmi_header_dir  # noqa: E402
 from jourdain.numeric.toolchain import CompilerError, compiler  # noqa: E402
@@ -329,6 +329,12 @@ def test_errors_are_named(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> No
         export_fmu(mf, tmp_path / "x.fmu", reactions=["hinge1.Fx"], binary=False)
     with pytest.raises(TypeError):
         export_fmu(mf, tmp_path / "x.fmu", reaction=["hinge1.F_x"])  # type: ignore[call-arg]
+    with pytest.raises(EvaluationError, match='body "rod1": mass must be a non-negative'):
+        export_fmu(mf, tmp_path / "x.fmu", parameters={"m1": -1.0}, binary=False)
+    with pytest.raises(EvaluationError, match="unknown parameter"):
+        export_fmu(mf, tmp_path / "x.fmu", parameters={"mx": 1.0}, binary=False)
+    with pytest.raises(EvaluationError, match="y0: 'psi' is not a coordinate"):
+        export_fmu(mf, tmp_path / "x.fmu", y0={"psi": 1.0}, binary=False)
     monkeypatch.setenv("CC", str(tmp_path / "no-such-cc"))
     with pytest.raises(CompilerError, match="no C compiler found"):
         export_fmu(mf, tmp_path / "x.fmu")

@@ -38,6 +38,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ...errors import EvaluationError, JourdainError, ModelError
+from ...numeric import parameter_vector
 from ...numeric.ccode import argument_names, function_source
 from ...numeric.recursive import recursive_units
 from ...numeric.toolchain import CompilerError, compiler, content_key, library_dir, not_private
@@ -345,12 +346,10 @@ def export_fmu(model: Any, path: str | os.PathLike[str], *,
         raise EvaluationError(f"stop_time must be > 0, got {stop_time}")
     y0v = _state(system, y0, "y0", "")
     yd0v = _state(system, yd0, "yd0", "_d")
-    pvals = system.parameter_values
-    for k, v in (parameters or {}).items():
-        if k not in pvals:
-            raise EvaluationError(f"parameters: unknown parameter {k!r}; parameters are "
-                                  f"{', '.join(pvals)}")
-        pvals[k] = _finite(v, f"parameter {k}")
+    # the start values, checked as every evaluation checks them (known names, finite numbers,
+    # mass data a rigid body can have)
+    pvals = dict(zip(system.parameter_values,
+                     (float(x) for x in parameter_vector(system, parameters)), strict=True))
     ident = model_identifier or model_identifier_of(system.name)
     if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]{0,63}", ident) or ident in _C_KEYWORDS:
         raise ModelError(f"model_identifier {ident!r} must be a C identifier (letters, digits, "
@@ -380,7 +379,7 @@ def export_fmu(model: Any, path: str | os.PathLike[str], *,
                                     system.inputs)
             extra = function_source("jd_dirs", dir_exprs, cnames)
         local, engine = recursive_units(system, full=False, extra_source=extra)
-    except EvaluationError as exc:
+    except JourdainError as exc:  # e.g. a function C has no counterpart for
         raise ModelError(f"{system.name!r} cannot be exported as an FMU: {exc}") from None
     rk = (_HERE.parent.parent / "numeric" / "rk_tables.h").read_text()
     glue = (_HERE / "fmi2.c").read_text()
