@@ -494,6 +494,13 @@ class Results:
                 "nfev": int(self.nfev), "nsteps": int(self.nsteps),
                 "wall_time": float(self.wall_time)}
 
+    def to_xarray(self) -> Any:
+        """These results as an ``xarray.Dataset`` (time, coordinate; units and the model's
+        hash as attributes; ``jourdain[study]``): :func:`jourdain.study.results_dataset`."""
+        from .study.dataset import results_dataset
+
+        return results_dataset(self)
+
     def save(self, path: str | Path) -> Path:
         """Write to ``.h5``/``.hdf5`` (HDF5, see module docs) or ``.csv``, through a temporary
         file renamed over ``path`` (an interruption leaves the previous file whole)."""
