@@ -57,9 +57,9 @@ def _two_body_model():
 
 
 def _sympy_reference(data):
-    """q = Σ (∂x/∂y)ᵀ·w for both bushings, from rotation matrices written out in SymPy."""
+    """q = Σ (∂x/∂y)ᵀ·w for both bushings, from rotation matrices written out in SymPy (x and
+    its Jacobian symbolic, ẋ = (∂x/∂y)·ẏ and w in numbers)."""
     ys = sp.symbols("x y z a b c phi")
-    yds = sp.symbols("x_d y_d z_d a_d b_d c_d phi_d")
     x, y, z, a, b, c, phi = ys
 
     def Rx(q):
@@ -86,17 +86,25 @@ def _sympy_reference(data):
     d2 = S2.T * (r2 + S2 * sp.Matrix([0.2, 0, 0.1]) - (r1 + S1 * sp.Matrix([0.6, 0.2, 0.1])))
     x2 = d2.col_join(vee_skew(S1.T * S2))
     Y = sp.Matrix(ys)
-    Yd = sp.Matrix(yds)
-    q = sp.zeros(7, 1)
-    for X, K, C, pre, law in ((x1, data["K1"], data["C1"], data["pre1"], False),
-                              (x2, data["K2"], data["C2"], data["pre2"], True)):
-        J = X.jacobian(Y)
-        Xd = J * Yd
-        w = sp.Matrix(pre) - sp.Matrix(K) * X - sp.Matrix(C) * Xd
-        if law:
-            w[5] = data["pre2"][5] - (500.0 * X[5] ** 3 + 3 * X[5] + 0.2 * Xd[5])
-        q += J.T * w
-    return sp.lambdify((Y, Yd), q, "numpy")
+    parts = []
+    for X in (x1, x2):
+        parts.append((sp.lambdify([ys], X, "numpy"), sp.lambdify([ys], X.jacobian(Y), "numpy")))
+
+    def q_of(y, yd):
+        q = np.zeros(7)
+        for (fx, fj), (K, C, pre), law in zip(
+                parts, ((data["K1"], data["C1"], data["pre1"]),
+                        (data["K2"], data["C2"], data["pre2"])), (False, True), strict=True):
+            x = np.asarray(fx(y), dtype=float).ravel()
+            J = np.asarray(fj(y), dtype=float)
+            xd = J @ yd
+            w = pre - K @ x - C @ xd
+            if law:
+                w[5] = pre[5] - (500.0 * x[5] ** 3 + 3 * x[5] + 0.2 * xd[5])
+            q += J.T @ w
+        return q
+
+    return q_of
 
 
 def test_bushing_generalized_forces_match_virtual_work():
@@ -608,3 +616,50 @@ def test_model_file_errors_name_line_and_key(change, message):
     msg = str(err.value)
     assert msg.startswith("m.toml:"), msg
     assert err.value.line == line, (msg, line)
+
+
+def test_quantities_in_space_against_sympy_mechanics():
+    """A body on a spherical joint (Cardan xyz) with a viscous drag −c·v_P at a body point P, a
+    drag −c₂·v_Q at P whose law uses the velocity of the material point at a place Q fixed in
+    the ground (point_frame = "world"), and a spin drag torque −c_r·ω (body axes): q against the
+    generalized forces Σ (∂v/∂q̇)·F + (∂ω/∂q̇)·T of sympy.physics.mechanics (v2pt_theory,
+    ang_vel_in)."""
+    import sympy.physics.mechanics as me
+
+    a, b, c = jd.symbols("a b c")
+    P, Q = (0.3, -0.2, 0.5), (0.1, 0.4, -0.3)
+    cd, c2, cr = 0.7, 1.3, 0.2
+    body = jd.Body("body", "world", jd.Spherical("ball", [a, b, c], "xyz"), mass=1.0,
+                   inertia=jd.box(1.0, 0.3, 0.4, 0.5))
+    vP = jd.velocity("vP", "body", P)
+    vQ = jd.velocity("vQ", "body", Q, point_frame="world")
+    w = jd.angular_velocity("w", "body")
+    s = jd.System([a, b, c], [body], [
+        jd.Force("drag", "body", tuple(-cd * v for v in vP), point=P),
+        jd.Force("drag_q", "body", tuple(-c2 * v for v in vQ), point=P),
+        jd.Torque("spin", "body", tuple(-cr * x for x in w), frame="body")])
+
+    qs = me.dynamicsymbols("a b c")
+    qds = [me.dynamicsymbols(f"{n}", 1) for n in "abc"]
+    N = me.ReferenceFrame("N")
+    B = N.orientnew("B", "Body", qs, "123")
+    O = me.Point("O")
+    O.set_vel(N, 0)
+    Pp = O.locatenew("P", P[0] * B.x + P[1] * B.y + P[2] * B.z)
+    Qp = O.locatenew("Q", Q[0] * N.x + Q[1] * N.y + Q[2] * N.z)
+    v_P = Pp.v2pt_theory(O, N, B)
+    omega = B.ang_vel_in(N)
+    v_Q = omega.cross(Qp.pos_from(O))  # the body's material point at Q
+    F = -cd * v_P - c2 * v_Q
+    T = -cr * omega
+    gen = [sp.simplify(0) + v_P.diff(qd, N).dot(F) + omega.diff(qd, N).dot(T) for qd in qds]
+    subs_syms = sp.symbols("a b c a_d b_d c_d")
+    rep = dict(zip([*qds, *qs], [*subs_syms[3:], *subs_syms[:3]], strict=True))
+    ref = sp.lambdify(subs_syms, [g.subs(rep) for g in gen], "numpy")
+    rng = np.random.default_rng(9)
+    for _ in range(3):
+        y, yd = rng.normal(size=3), rng.normal(size=3)
+        out = s.evaluate(y, yd)
+        q_ref = np.array(ref(*y, *yd), dtype=float)
+        scale = float(np.max(np.abs(out["J_bar"]).T @ np.abs(out["q_e"])))
+        assert_close_eval(out["q"], q_ref, n_terms=24, scale=scale)
