@@ -269,6 +269,83 @@ def _binary_stl(tri: np.ndarray) -> bytes:
     return b"".join(out)
 
 
+def _triangles(spec: dict) -> np.ndarray:
+    """The (n, 3, 3) corners of a mesh in the page (float32 vertices, uint32 indices)."""
+    import base64
+
+    v = np.frombuffer(base64.b64decode(spec["vertices"]), "<f4").reshape(-1, 3)
+    i = np.frombuffer(base64.b64decode(spec["indices"]), "<u4").reshape(-1, 3)
+    return v[i]
+
+
+_DAE = """<?xml version="1.0" encoding="utf-8"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+  <asset><unit name="millimeter" meter="0.001"/><up_axis>Z_UP</up_axis></asset>
+  <library_effects>
+    <effect id="red-fx"><profile_COMMON><technique sid="t"><phong>
+      <diffuse><color>0.8 0.1 0.1 1</color></diffuse></phong></technique></profile_COMMON>
+    </effect>
+  </library_effects>
+  <library_materials>
+    <material id="red" name="red"><instance_effect url="#red-fx"/></material>
+  </library_materials>
+  <library_geometries>
+    <geometry id="quad"><mesh>
+      <source id="quad-pos"><float_array id="quad-arr" count="12">0 0 0 10 0 0 10 20 0 0 20 0
+        </float_array><technique_common><accessor source="#quad-arr" count="4" stride="3">
+        <param name="X" type="float"/><param name="Y" type="float"/>
+        <param name="Z" type="float"/></accessor></technique_common></source>
+      <vertices id="quad-vtx"><input semantic="POSITION" source="#quad-pos"/></vertices>
+      <polylist material="mat" count="1"><input semantic="VERTEX" source="#quad-vtx"
+        offset="0"/><input semantic="NORMAL" source="#quad-pos" offset="1"/>
+        <vcount>4</vcount><p>0 0 1 1 2 2 3 3</p></polylist>
+      <triangles count="1"><input semantic="VERTEX" source="#quad-vtx" offset="0"/>
+        <p>0 1 3</p></triangles>
+    </mesh></geometry>
+  </library_geometries>
+  <library_visual_scenes><visual_scene id="scene">
+    <node id="outer"><translate>100 0 0</translate>
+      <node id="inner"><rotate>0 0 1 90</rotate>
+        <instance_geometry url="#quad"><bind_material><technique_common>
+          <instance_material symbol="mat" target="#red"/></technique_common></bind_material>
+        </instance_geometry>
+      </node>
+    </node>
+  </visual_scene></library_visual_scenes>
+  <scene><instance_visual_scene url="#scene"/></scene>
+</COLLADA>
+"""
+
+
+def test_collada_mesh_with_nodes_units_and_colours(tmp_path):
+    """A COLLADA quad (polylist of 4 corners, as a fan of 2 triangles, with a red material)
+    and one more triangle (no material), in millimetres, placed by a node that translates by
+    100 mm along x and a child node that turns 90° about z: the corners land at
+    (0.1, 0, 0) + R_z(90°)·corner/1000."""
+    from jourdain.io.viewer.meshes import read_mesh
+
+    path = tmp_path / "part.dae"
+    path.write_text(_DAE)
+    m = read_mesh(path)
+    corners = np.array([[0, 0, 0], [10, 0, 0], [10, 20, 0], [0, 20, 0]], float) / 1000
+    R = Rotation.from_euler("z", 90, degrees=True).as_matrix()
+    placed = corners @ R.T + [0.1, 0, 0]
+    ref = placed[[[0, 1, 2], [0, 2, 3], [0, 1, 3]]]
+    np.testing.assert_allclose(m.triangles, ref, rtol=0, atol=eval_tol(3, 0.1))
+    assert [(a, n) for a, n, _ in m.groups] == [(0, 2), (2, 1)]
+    assert m.groups[0][2] == pytest.approx((0.8, 0.1, 0.1)) and m.groups[1][2] is None
+    bad = tmp_path / "bad.dae"
+    bad.write_text(_DAE.replace("<p>0 1 3</p>", "<p>0 1 9</p>"))
+    with pytest.raises(jd.ModelError, match="bad.dae.*a face refers to a vertex"):
+        read_mesh(bad)
+    bad.write_text('<?xml version="1.0"?><!DOCTYPE x [<!ENTITY a "b">]>' + _DAE.split("?>", 1)[1])
+    with pytest.raises(jd.ModelError, match="with a DTD"):
+        read_mesh(bad)
+    bad.write_text(_DAE.replace("10 20 0 0 20 0", "10 20 zero 0 20 0"))
+    with pytest.raises(jd.ModelError, match="not a number"):
+        read_mesh(bad)
+
+
 def test_meshes_are_embedded_and_bad_ones_noted(spatial, tmp_path):
     system, _, res = spatial
     tet = np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 0, 0], [0, 1, 0], [0, 0, 1]],
@@ -287,8 +364,7 @@ def test_meshes_are_embedded_and_bad_ones_noted(spatial, tmp_path):
     v = view(res, visuals=vis, max_frames=5)
     meshes = v.scene["bodies"][0]["visuals"]
     assert len(meshes) == 3 and {m["kind"] for m in meshes} == {"mesh"}
-    got = [np.frombuffer(__import__("base64").b64decode(m["triangles"]), "<f4").reshape(-1, 3, 3)
-           for m in meshes]
+    got = [_triangles(m) for m in meshes]
     np.testing.assert_array_equal(got[0], tet.astype(np.float32))
     np.testing.assert_array_equal(got[1], [[[0, 0, 0], [1, 0, 0], [0, 1, 0]]])
     np.testing.assert_array_equal(got[2], [[[0, 0, 0], [1, 0, 0], [1, 1, 0]],
@@ -299,7 +375,7 @@ def test_meshes_are_embedded_and_bad_ones_noted(spatial, tmp_path):
     notes = "\n".join(v.notes)
     assert "missing.stl" in notes and "cannot be read" in notes
     assert "package://robot/a.dae" in notes and "resolve package://" in notes
-    assert "part.dae" in notes and "only STL and OBJ" in notes
+    assert "part.dae" in notes and "cannot be read" in notes
     assert v.scene["bodies"][1]["visuals"] == []  # the bob keeps its sphere
     assert "missing.stl" in v.html  # the notes are shown in the page
     with pytest.raises(jd.ModelError, match="'wheel', which is not a body of 'spatial'"):

@@ -19,11 +19,12 @@ What is drawn
 * the visuals of a body where given (:class:`Visual`, the ``visuals`` hook: per body a list
   of meshes — file, scale — and boxes, cylinders, spheres, each with its origin in the body
   frame; a URDF model's ``<visual>`` elements, :attr:`jourdain.io.urdf.UrdfModel.visuals`, are
-  taken as they are). STL (binary or ASCII) and OBJ files are read here and embedded, so the
-  page needs no file beside it. A body with visuals is drawn by them instead of its equivalent
-  shape; a mesh that cannot be read (missing file, another format such as COLLADA ``.dae``, an
-  unresolved ``package://`` address) is left out with a note, and the body keeps its
-  equivalent shape if none of its visuals could be drawn. Visuals of ``"world"`` stand still.
+  taken as they are). STL (binary or ASCII), OBJ and COLLADA (``.dae``) files are read here
+  (:mod:`.meshes`) and embedded, so the page needs no file beside it. A body with visuals is
+  drawn by them instead of its equivalent shape; a mesh that cannot be read (missing file,
+  another format such as glTF, an unresolved ``package://`` address) is left out with a note,
+  and the body keeps its equivalent shape if none of its visuals could be drawn. Visuals of
+  ``"world"`` stand still.
 
 The motion
 ----------
@@ -43,7 +44,6 @@ import base64
 import html
 import json
 import math
-import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import lru_cache
@@ -55,6 +55,7 @@ import numpy as np
 
 from ...errors import EvaluationError, JourdainError, ModelError
 from ...model.expressions import values_at
+from .meshes import Mesh, read_mesh
 
 if TYPE_CHECKING:
     from ...model.system import System
@@ -68,8 +69,7 @@ FRAMES_PER_SECOND = 50
 MAX_FRAMES = 2000
 MAX_POSES = 60_000
 #: meshes: at most this many triangles in one page (over all meshes), files at most this large
-MAX_TRIANGLES = 300_000
-MAX_MESH_BYTES = 64 * 2**20
+MAX_TRIANGLES = 200_000
 #: the smallest side of an equivalent shape, relative to its largest side and to the scene
 MIN_THICKNESS = (0.04, 0.01)
 SHAPES = ("box", "ellipsoid")
@@ -290,77 +290,6 @@ def equivalent_shape(mass: float, inertia: np.ndarray, shape: str = "box"
     return sides, V
 
 
-def _stl(data: bytes, where: str) -> np.ndarray:
-    """Triangles (n, 3, 3) of a binary or ASCII STL file."""
-    if len(data) >= 84:
-        n = int.from_bytes(data[80:84], "little")
-        if len(data) == 84 + 50 * n:
-            rec = np.frombuffer(data, dtype=np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)),
-                                                      ("a", "<u2")]), count=n, offset=84)
-            return rec["v"].astype(np.float64)
-    text = data.decode("ascii", errors="replace")
-    if not text.lstrip().lower().startswith("solid"):
-        raise ModelError(f"{where}: neither a binary STL (size 84 + 50·n bytes) nor ASCII STL")
-    nums = re.findall(r"vertex\s+(\S+)\s+(\S+)\s+(\S+)", text)
-    try:
-        v = np.array(nums, dtype=float).reshape(-1, 3)
-    except ValueError as exc:
-        raise ModelError(f"{where}: a vertex that is not three numbers ({exc})") from None
-    if len(v) % 3:
-        raise ModelError(f"{where}: {len(v)} vertices, not a whole number of triangles")
-    return v.reshape(-1, 3, 3)
-
-
-def _obj(data: bytes, where: str) -> np.ndarray:
-    """Triangles (n, 3, 3) of a Wavefront OBJ file (``v`` and ``f`` lines; polygons as fans)."""
-    verts: list[tuple[float, float, float]] = []
-    tris: list[tuple[int, int, int]] = []
-    for lineno, line in enumerate(data.decode("utf-8", errors="replace").splitlines(), 1):
-        parts = line.split()
-        if not parts:
-            continue
-        try:
-            if parts[0] == "v":
-                verts.append((float(parts[1]), float(parts[2]), float(parts[3])))
-            elif parts[0] == "f":
-                idx = []
-                for p in parts[1:]:
-                    i = int(p.split("/")[0])
-                    idx.append(i - 1 if i > 0 else len(verts) + i)
-                tris.extend((idx[0], idx[k], idx[k + 1]) for k in range(1, len(idx) - 1))
-        except (ValueError, IndexError):
-            raise ModelError(f"{where}, line {lineno}: cannot read {line.strip()[:60]!r}"
-                             ) from None
-    v = np.array(verts, float).reshape(-1, 3)
-    t = np.array(tris, int).reshape(-1, 3)
-    if t.size and (t.min() < 0 or t.max() >= len(v)):
-        raise ModelError(f"{where}: a face refers to a vertex that does not exist")
-    return v[t]
-
-
-def read_mesh(path: str | Path) -> np.ndarray:
-    """Triangles (n, 3, 3) of an STL or OBJ file; ModelError naming the file otherwise."""
-    where = f"mesh {str(path)!r}"
-    text = str(path)
-    if "://" in text:
-        raise ModelError(f"{where}: an address, not a file (resolve package:// first)")
-    p = Path(path)
-    suffix = p.suffix.lower()
-    if suffix not in (".stl", ".obj"):
-        raise ModelError(f"{where}: only STL and OBJ meshes are read (not {suffix or 'this'})")
-    try:
-        size = p.stat().st_size
-        if size > MAX_MESH_BYTES:
-            raise ModelError(f"{where}: {size} bytes, more than {MAX_MESH_BYTES}")
-        data = p.read_bytes()
-    except OSError as exc:
-        raise ModelError(f"{where}: cannot be read ({exc.strerror or exc})") from None
-    tri = _stl(data, where) if suffix == ".stl" else _obj(data, where)
-    if not np.all(np.isfinite(tri)):
-        raise ModelError(f"{where}: coordinates that are not finite numbers")
-    return tri
-
-
 def _from_geometry(g: Any) -> Visual:
     """A :class:`Visual` from a URDF import's geometry record (``kind``, ``pose`` 4×4 in the
     body frame, ``path``/``filename``, ``scale``, ``size``, ``rgba``)."""
@@ -430,6 +359,15 @@ def _check_visuals(visuals: Mapping[str, Sequence[Visual]], system: System) -> N
                 raise ModelError(f"{where}: rotation is not a rotation matrix")
 
 
+def _mesh_spec(m: Mesh) -> dict[str, Any]:
+    """A mesh in the page: vertices (float32), triangles as vertex indices (uint32), groups
+    of triangles with their colour."""
+    return {"vertices": _b64(m.vertices.reshape(-1), "<f4"),
+            "indices": _b64(m.faces.reshape(-1), "<u4"),
+            "groups": [[int(a), int(n), None if c is None else [float(x) for x in c]]
+                       for a, n, c in m.groups]}
+
+
 def _visual_specs(owner: str, items: Sequence[Visual], notes: list[str],
                   budget: list[int]) -> list[dict[str, Any]]:
     """The scene entries of one body's visuals; meshes read and embedded (``budget[0]``: the
@@ -443,17 +381,17 @@ def _visual_specs(owner: str, items: Sequence[Visual], notes: list[str],
             "color": None if v.color is None else [float(x) for x in tuple(v.color)[:3]]}
         if v.kind == "mesh":
             try:
-                tri = read_mesh(v.file)  # type: ignore[arg-type]
+                m = read_mesh(v.file)  # type: ignore[arg-type]
             except ModelError as exc:
                 notes.append(f"{owner}: {exc}; drawn without it")
                 continue
-            if len(tri) > budget[0]:
-                notes.append(f"{owner}: mesh {k} ({len(tri)} triangles) left out, more than "
-                             f"{MAX_TRIANGLES} triangles in the page")
+            if len(m.faces) > budget[0]:
+                notes.append(f"{owner}: mesh {k} ({len(m.faces)} triangles) left out, more "
+                             f"than {MAX_TRIANGLES} triangles in the page")
                 continue
-            budget[0] -= len(tri)
+            budget[0] -= len(m.faces)
+            spec.update(_mesh_spec(m))
             spec["file"] = str(v.file)
-            spec["triangles"] = _b64(tri.reshape(-1), "<f4")
         out.append(spec)
     return out
 
@@ -560,7 +498,7 @@ def scene(results: Results, visuals: Any = None,
     up = _up(system, values)
     center, extent, view_dir, ground = _camera(pts[1:1 + 2 * r.shape[0] * r.shape[1]], pts, up)
     L = max(extent, 1e-9)
-    distance = 1.6 * L  # the whole scene fits the 40° field of view
+    distance = 1.45 * L  # the whole scene in the 40° field of view
     mmax = max((m for m, _, _, _ in raw), default=0.0)
 
     budget = [MAX_TRIANGLES]

@@ -88,10 +88,21 @@
   // a visual: a mesh (triangles), box, cylinder (radius, length along z) or sphere (radius)
   function visual(v, colour) {
     var geo;
-    if (v.kind === "mesh") {
+    var base = { color: v.color ? new T.Color().fromArray(v.color) : colour, roughness: 0.6,
+                 metalness: 0.05, side: T.DoubleSide };
+    if (v.kind === "mesh") {  // indexed triangles, flat shaded (CAD meshes have hard edges)
       geo = new T.BufferGeometry();
-      geo.setAttribute("position", new T.BufferAttribute(decode(v.triangles, Float32Array), 3));
+      geo.setAttribute("position", new T.BufferAttribute(decode(v.vertices, Float32Array), 3));
+      geo.setIndex(new T.BufferAttribute(decode(v.indices, Uint32Array), 1));
       geo.computeVertexNormals();
+      var mats = v.groups.map(function (gr, n) {
+        geo.addGroup(3 * gr[0], 3 * gr[1], n);
+        return new T.MeshStandardMaterial(Object.assign({}, base, { flatShading: true },
+          gr[2] && !v.color ? { color: new T.Color().fromArray(gr[2]) } : {}));
+      });
+      var mm = new T.Mesh(geo, mats);
+      place(mm, v);
+      return mm;
     } else if (v.kind === "box") {
       geo = new T.BoxGeometry(v.size[0], v.size[1], v.size[2]);
     } else if (v.kind === "cylinder") {
@@ -100,9 +111,7 @@
     } else {
       geo = new T.SphereGeometry(v.size[0], 32, 16);
     }
-    var m = new T.Mesh(geo, new T.MeshStandardMaterial({
-      color: v.color ? new T.Color().fromArray(v.color) : colour, roughness: 0.6,
-      metalness: 0.05, side: T.DoubleSide }));
+    var m = new T.Mesh(geo, new T.MeshStandardMaterial(base));
     place(m, v);
     return m;
   }
@@ -133,15 +142,15 @@
       s.scale.set(b.shape.size[0] / 2, b.shape.size[1] / 2, b.shape.size[2] / 2);
       c.add(s);
     }
-    g.add(triad(0.12 * L, 1));
+    g.add(triad(0.07 * L, 1));
   });
   // joint frames: fixed in the parent's frame (or the inertial frame)
   scene.bodies.forEach(function (b) {
-    var j = triad(0.07 * L, 0.55);
+    var j = triad(0.045 * L, 0.55);
     place(j, b.joint);
     (b.parent === "world" ? world : groups[b.parent]).add(j);
   });
-  world.add(triad(0.1 * L, 0.7));
+  world.add(triad(0.08 * L, 0.7));
   scene.world_visuals.forEach(function (v) { world.add(visual(v, new T.Color(0x9a9a9a))); });
 
   // spring-dampers: one line each between their points
