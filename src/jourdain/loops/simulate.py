@@ -1,0 +1,282 @@
+"""Simulation of closed-loop systems on the constraint manifold (coordinate partitioning).
+
+The state is the independent ``(y, ẏ)``; at every evaluation the dependent coordinates are
+solved by Newton on ``Φ(y, d, t) = 0`` (to ``|Φ| ≲ 1e-13·scale``, warm-started from the last
+solution) and the dependent rates from ``Φ̇ = 0`` by a linear solve with ``Φ_d``, so every
+reported state lies on the manifold to rounding, whatever the integrator's error: the error
+of the integration is an error *along* the manifold (in y), never a drift off it. ``ÿ`` comes
+from ``M(y, ẏ, t)·ÿ = q − k`` in the independent coordinates
+(:class:`jourdain.loops.closed_loop.LoopEvaluator`); the integrator is SciPy's ``solve_ivp``
+(DOP853 by default) on the ODE in y.
+
+Singular configurations: at every accepted step the condition number of ``Φ_d`` is watched
+(an event of the integrator); where it exceeds ``cond_limit`` the run either switches to a
+new partition chosen by pivoting at that state (``repartition=True``, the default, when the
+new ``Φ_d`` is well-conditioned) and continues, or stops with :class:`SingularConfiguration`
+naming the time, the state, the condition number and the rank of ``Φ_z`` (a rank drop of
+``Φ_z`` itself, a bifurcation such as a four-bar's flat position, cannot be cured by a new
+partition and is reported as such).
+
+Why not SUNDIALS IDA (scikit-sundae) here: IDA integrates the redundant DAE in ``z`` and
+keeps ``Φ = 0`` only to its own error tolerance (a drift the projection of this module does
+not have), and its residual is called from Python for every Newton iteration of every step,
+like this module's right-hand side. Measured on the four-bar of
+:func:`jourdain.loops.models.four_bar` (see ``benchmarks/loops.py``, whose figures the
+closing note of issue 11 quotes), IDA at matching accuracy is not faster than this
+coordinate-partitioning route; the index-1 redundant form stays available
+(:meth:`LoopEvaluator.redundant_accelerations`) for comparisons.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from scipy.integrate import BDF, DOP853, RK45, Radau
+
+from ..errors import EvaluationError
+from .closed_loop import ClosedLoopSystem, LoopEvaluator, SingularConfiguration
+
+
+@dataclass
+class LoopResults:
+    """Time histories of a closed-loop simulation.
+
+    ``t`` (N,); ``z, zd, zdd`` (N, n): the tree's coordinates (on the manifold); ``Phi``,
+    ``Phi_dot`` (N, m): the constraint residuals; ``lam`` (N, m): the closing joints'
+    multipliers (labels in ``labels``); ``T``, ``V`` (N,): kinetic and potential energy;
+    ``partitions``: ``[(t_start, independent names), ...]``; ``status``, ``message``;
+    ``singular``: the :class:`SingularConfiguration` that stopped the run, or None.
+    """
+
+    loop: ClosedLoopSystem
+    t: np.ndarray
+    z: np.ndarray
+    zd: np.ndarray
+    zdd: np.ndarray
+    Phi: np.ndarray
+    Phi_dot: np.ndarray
+    lam: np.ndarray
+    T: np.ndarray
+    V: np.ndarray
+    labels: list[str]
+    partitions: list[tuple[float, tuple[str, ...]]]
+    status: str = "finished"
+    message: str = ""
+    nfev: int = 0
+    wall_time: float = 0.0
+    singular: SingularConfiguration | None = None
+    parameters: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def coordinate_names(self) -> list[str]:
+        return self.loop.coordinate_names
+
+    @property
+    def max_Phi(self) -> float:
+        """Largest |Φ_i| along the motion."""
+        return float(np.max(np.abs(self.Phi))) if self.Phi.size else 0.0
+
+    @property
+    def max_Phi_dot(self) -> float:
+        """Largest |Φ̇_i| along the motion."""
+        return float(np.max(np.abs(self.Phi_dot))) if self.Phi_dot.size else 0.0
+
+    @property
+    def total_energy(self) -> np.ndarray:
+        return self.T + self.V
+
+    @property
+    def energy_drift(self) -> float:
+        """max |E − E₀| / max(|E₀|, max T) (meaningful for a conservative model)."""
+        E = self.total_energy
+        return float(np.max(np.abs(E - E[0])) / max(abs(E[0]), float(np.max(self.T)), 1e-300))
+
+    def coordinate(self, name: str) -> np.ndarray:
+        """Time history of a tree coordinate (``<name>_d``, ``<name>_dd``: its rates)."""
+        for suffix, arr in (("_dd", self.zdd), ("_d", self.zd), ("", self.z)):
+            base = name[: len(name) - len(suffix)] if suffix and name.endswith(suffix) else name
+            if (not suffix or name.endswith(suffix)) and base in self.coordinate_names:
+                return arr[:, self.coordinate_names.index(base)]
+        raise EvaluationError(f'unknown coordinate "{name}"; coordinates are '
+                              f"{self.coordinate_names}")
+
+    def reaction(self, label: str) -> np.ndarray:
+        """Multiplier history of one constraint row (``closure.Fx``, ...)."""
+        if label not in self.labels:
+            raise EvaluationError(f'unknown constraint row "{label}"; rows are {self.labels}')
+        return self.lam[:, self.labels.index(label)]
+
+    def summary(self) -> str:
+        parts = "; ".join(f"t ≥ {t0:.6g}: {', '.join(n)}" for t0, n in self.partitions)
+        return "\n".join([
+            f"{self.loop.name}: {self.status} - {self.message}",
+            f"  t = {self.t[0]:.6g} .. {self.t[-1]:.6g} s, {len(self.t)} points, "
+            f"{self.nfev} right-hand sides, {self.wall_time:.3f} s",
+            f"  independent coordinates: {parts}",
+            f"  constraint residuals: max |Φ| = {self.max_Phi:.3e}, max |Φ̇| = "
+            f"{self.max_Phi_dot:.3e}",
+            f"  relative energy drift {self.energy_drift:.3e} (meaningful when conservative)"])
+
+    def tree_results(self) -> Any:
+        """The motion as :class:`jourdain.Results` of the tree (its coordinates z), for the
+        report, CSV/HDF5 and the plots of tree models."""
+        from ..results import Results
+
+        tree = self.loop.tree
+        n_u = len(tree.inputs)
+        return Results(tree, self.t, self.z, self.zd, self.zdd, np.zeros((len(self.t), n_u)),
+                       np.zeros(len(self.t)), dict(self.parameters), method="DOP853",
+                       status=self.status, message=self.message, nfev=self.nfev,
+                       wall_time=self.wall_time)
+
+
+def simulate_loop(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: Any,
+                  zd0: Any = None, *, t_eval: Sequence[float] | None = None,
+                  samples: int = 501, rtol: float = 1e-10, atol: float = 1e-12,
+                  method: str = "DOP853", parameters: Mapping[str, float] | None = None,
+                  inputs: Callable[[float], Any] | Sequence[float] | None = None,
+                  repartition: bool = True, cond_limit: float = 1e8,
+                  max_step: float = math.inf) -> LoopResults:
+    """Integrate a closed-loop system from approximate ``z0, zd0`` (assembled first, the
+    independent coordinates of the partition held) over ``t_span``.
+
+    Returns :class:`LoopResults` at ``t_eval`` (default: ``samples`` equally spaced times).
+    A singular configuration stops the run with ``status="singular"`` and the exception in
+    ``singular`` (the results up to there are kept) unless a new partition resolves it.
+    """
+    t0, t1 = float(t_span[0]), float(t_span[1])
+    if not (math.isfinite(t0) and math.isfinite(t1) and t1 > t0):
+        raise EvaluationError(f"t_span must be two finite times with t_end > t0, got {t_span}")
+    if not cond_limit > 1:
+        raise EvaluationError(f"cond_limit must be > 1, got {cond_limit}")
+    n_u = len(loop.tree.inputs)
+    if callable(inputs):
+        u_of = inputs
+    else:
+        u_const = np.zeros(n_u) if inputs is None else np.asarray(inputs, dtype=float)
+        if u_const.size != n_u:
+            raise EvaluationError(f"inputs must have {n_u} entries")
+
+        def u_of(_t: float) -> Any:
+            return u_const
+    ev = LoopEvaluator(loop, z0, t0, parameters, u_of(t0))
+    asm = ev.assemble(z0, zd0, t0)
+    tev = (np.linspace(t0, t1, samples) if t_eval is None
+           else np.asarray(t_eval, dtype=float))
+    if tev.size and (tev[0] < t0 or tev[-1] > t1 or np.any(np.diff(tev) <= 0)):
+        raise EvaluationError("t_eval must increase within t_span")
+    started = time.perf_counter()
+    nfev = 0
+    out: dict[str, list] = {k: [] for k in ("t", "z", "zd", "zdd", "Phi", "Phi_dot", "lam",
+                                             "T", "V")}
+    partitions = [(t0, tuple(ev.independent_names))]
+    status, message, singular = "finished", "the integration reached t_end", None
+    ind = list(ev.part.independent)
+    x = np.concatenate([asm.z[ind], asm.zd[ind]])
+    t = t0
+
+    def rhs(tt: float, xx: np.ndarray) -> np.ndarray:
+        f = ev.part.f
+        s = ev.accelerations(xx[:f], xx[f:], tt, u_of(tt))
+        return np.concatenate([xx[f:], s["ydd"]])
+
+    def record(tt: float, xx: np.ndarray) -> None:
+        f = ev.part.f
+        s = ev.accelerations(xx[:f], xx[f:], tt, u_of(tt))
+        out["t"].append(tt)
+        for k in ("z", "zd", "zdd", "Phi", "Phi_dot", "T", "V"):
+            out[k].append(s[k])
+        out["lam"].append(ev.multipliers(s))
+
+    solvers = {"DOP853": DOP853, "RK45": RK45, "Radau": Radau, "BDF": BDF}
+    if method not in solvers:
+        raise EvaluationError(f"method must be one of {', '.join(solvers)}, got {method!r}")
+    k_eval = 0
+    while True:
+        solver = solvers[method](rhs, t, x, t1, rtol=rtol, atol=atol, max_step=max_step)
+        if k_eval < len(tev) and tev[k_eval] == t:
+            record(t, x)
+            k_eval += 1
+        event = None
+        try:
+            while solver.status == "running":
+                z_start = ev.z_guess.copy()
+                msg = solver.step()
+                if solver.status == "failed":
+                    status, message = "failed", str(msg)
+                    break
+                # samples inside the step, Newton started from the step's beginning (the
+                # integrator's trial stages may have left the guess elsewhere)
+                z_end = ev.z_guess.copy()
+                if k_eval < len(tev) and tev[k_eval] <= solver.t:
+                    dense = solver.dense_output()
+                    while k_eval < len(tev) and tev[k_eval] <= solver.t:
+                        ev.z_guess = z_start.copy()
+                        ev._last = None
+                        record(float(tev[k_eval]), dense(tev[k_eval]))
+                        z_start = ev.z_guess.copy()
+                        k_eval += 1
+                # the accepted state: its configuration starts the next step, its Φ_d is
+                # watched for singularity
+                f = ev.part.f
+                ev.z_guess = z_end
+                ev._last = None
+                z_acc, _, _ = ev.solve_positions(solver.y[:f], solver.t)
+                ev.z_guess = z_acc
+                if ev.cond(z_acc, solver.t) > cond_limit:
+                    event = (float(solver.t), solver.y.copy())
+                    break
+        except SingularConfiguration as exc:
+            status, message, singular = "singular", str(exc), exc
+            break
+        nfev += int(solver.nfev)
+        if event is None:
+            break
+        # the condition of Φ_d passed cond_limit: a new partition, or a report
+        te, xe = event
+        f = ev.part.f
+        s = ev.state(xe[:f], xe[f:], te)
+        rank = ev.rank(s["z"], te)
+        new = ev.repartition(s["z"], te)
+        old_names = ev.independent_names
+        names = [loop.coordinate_names[j] for j in new.independent]
+        state = ", ".join(f"{n} = {v:.6g}" for n, v in zip(loop.coordinate_names, s["z"],
+                                                            strict=True))
+        if repartition and new.cond < cond_limit / 100 and names != old_names:
+            ev.set_partition(new)
+            partitions.append((te, tuple(names)))
+            ind = list(new.independent)
+            x = np.concatenate([s["z"][ind], s["zd"][ind]])
+            t = te
+            continue
+        cause = (f"the constraint Jacobian Φ_z has rank {rank} of {len(ev.part.rows)} there "
+                 "(a singular position of the mechanism: no partition helps)"
+                 if rank < len(ev.part.rows) else
+                 f"a new partition with independent {', '.join(names)} is well-conditioned "
+                 f"there (condition {new.cond:.3g})" + ("" if repartition else
+                                                         "; pass repartition=True to switch"))
+        singular = SingularConfiguration(
+            f"{loop.name}: singular configuration at t = {te:.9g}: Φ_d (dependent "
+            f"{', '.join(ev.dependent_names)}) has condition number > {cond_limit:.3g}; "
+            f"{cause}; state {state}", t=te, z=s["z"], zd=s["zd"], cond=cond_limit, rank=rank,
+            suggestion=tuple(names))
+        status, message = "singular", str(singular)
+        break
+    n = loop.tree.f
+    m = len(ev.labels)
+
+    def arr(k: str, w: int) -> np.ndarray:
+        return np.array(out[k]).reshape(-1, w) if out[k] else np.zeros((0, w))
+    return LoopResults(
+        loop, np.array(out["t"]), arr("z", n), arr("zd", n), arr("zdd", n), arr("Phi", m),
+        arr("Phi_dot", m), arr("lam", m), np.array(out["T"]), np.array(out["V"]),
+        list(ev.labels), partitions, status, message, nfev, time.perf_counter() - started,
+        singular, dict(zip([k for k, _ in loop.tree.parameters], ev.p.tolist(), strict=True)))
+
+
+__all__ = ["LoopResults", "simulate_loop"]
