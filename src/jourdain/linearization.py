@@ -35,7 +35,7 @@ linearization says so with a :class:`NominalMotionWarning` (:meth:`Linearization
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -690,6 +690,8 @@ class NumericLinearization:
     nominal_check : NominalCheck or None
         Whether the nominal motion solves the equations of motion at ``t``
         (:meth:`check_nominal`).
+    equations_of_motion : EquationsOfMotion or None
+        The stage it came from (for the cyclic coordinates of a stability verdict).
     """
 
     system: System
@@ -702,6 +704,8 @@ class NumericLinearization:
     parameters: dict[str, float]
     time_dependence: tuple[str, ...]
     nominal_check: NominalCheck | None = None
+    equations_of_motion: EquationsOfMotion | None = field(default=None, repr=False,
+                                                          compare=False)
 
     @property
     def is_time_invariant(self) -> bool:
@@ -843,7 +847,8 @@ def linearize_numeric(source: System | EquationsOfMotion, nominal: Mapping[Any, 
         warn(check.message(), NominalMotionWarning)
     return NumericLinearization(system=system, M_tilde=out["M_tilde"], P=out["P"], Q=out["Q"],
                                 h=out["h"], B=out["B"], t=tv, parameters=pars,
-                                time_dependence=dependence, nominal_check=check)
+                                time_dependence=dependence, nominal_check=check,
+                                equations_of_motion=eom)
 
 
 @dataclass(frozen=True)

@@ -40,42 +40,57 @@ CYCLIC_RTOL = 1e-9
 def cyclic_coordinates(source: System | EquationsOfMotion) -> tuple[str, ...]:
     """Names of the cyclic coordinates: those on which ``M``, ``k`` and ``q`` do not depend.
 
-    A coordinate whose symbol does not occur in the expressions is cyclic. One that occurs
-    (possibly in terms that cancel, ``A·sin²φ + A·cos²φ``) is tested numerically: the exact
-    derivatives ``∂M/∂y_c``, ``∂k/∂y_c``, ``∂q/∂y_c`` (forward mode,
-    :func:`jourdain.differentiate.jet_float`) at three random states, times and sets of
-    parameter values near the defaults must vanish to :data:`CYCLIC_RTOL` of the largest value
-    or derivative there. The result is a property of the model, for all parameter values.
+    A coordinate whose symbol does not occur in ``k``, ``q`` and ``J̄`` (``M = J̄ᵀM̄J̄``,
+    METHOD.md §3) is cyclic. One that occurs (possibly in terms that cancel,
+    ``A·sin²φ + A·cos²φ``) is tested numerically: the exact derivatives ``∂k/∂y_c``,
+    ``∂q/∂y_c`` and ``∂M/∂y_c = (∂J̄/∂y_c)ᵀM̄J̄ + J̄ᵀM̄(∂J̄/∂y_c)`` (forward mode,
+    :func:`jourdain.differentiate.jet_float`) at two random states and times, at the
+    default parameter values and at a random set near them, must vanish to
+    :data:`CYCLIC_RTOL` of the largest value or derivative there. The result is a property of
+    the model, for all parameter values.
     """
+    from ..differentiate import evaluate_float
     from ..linearization import _perturbed
     from ..projection import EquationsOfMotion
 
     eom = source if isinstance(source, EquationsOfMotion) else source.equations_of_motion()
     system = eom.system
     f = system.f
-    exprs = [*eom.k.entries(), *eom.q.entries(),
-             *(eom.M[i, j] for i in range(f) for j in range(i, f))]
+    ne = eom.newton_euler
+    n6 = ne.J_bar.shape[0]
+    exprs = [*eom.k.entries(), *eom.q.entries(), *ne.J_bar.entries()]
     present = free_symbol_names(exprs)
     names = system.coordinate_names
     candidates = [i for i, n in enumerate(names) if str(system.y[i]) in present]
     cyclic = {i for i in range(f) if i not in candidates}
     if candidates:
         graph = Graph(exprs)
-        variables = [system.y[i] for i in candidates]
         rng = np.random.default_rng(20261123)
         base = system.parameter_values
         still = set(candidates)
-        for trial in range(3):
+        for trial in range(2):
             values = dict(base) if trial == 0 else _perturbed(base, rng)
             values["t"] = float(rng.uniform(0.0, 2.0))
+            M_bar = np.array(evaluate_float(ne.M_bar.entries(), values)).reshape(n6, n6)
             for syms, lo, hi in ((system.y, -np.pi, np.pi), (system.yd, -1.0, 1.0),
                                  (system.inputs, -1.0, 1.0)):
                 values.update({str(s): float(rng.uniform(lo, hi)) for s in syms})
-            jet = jet_float(graph, variables, values)
-            scale = max(float(np.abs(jet.values).max(initial=0.0)),
-                        float(np.abs(jet.jacobian).max(initial=0.0)), np.finfo(float).tiny)
-            column = np.abs(jet.jacobian).max(axis=0, initial=0.0)
-            for j, i in enumerate(candidates):
+            # after the first trial only the coordinates still in question are differentiated
+            remaining = sorted(still)
+            jet = jet_float(graph, [system.y[i] for i in remaining], values)
+            J = jet.values[2 * f:].reshape(n6, f)
+            dJ = jet.jacobian[2 * f:].reshape(n6, f, len(remaining))
+            MJ = M_bar @ J
+            dM = np.einsum("rjv,rk->jkv", dJ, MJ)
+            dM = dM + np.swapaxes(dM, 0, 1)
+            terms = np.einsum("rjv,rk->jkv", np.abs(dJ), np.abs(M_bar) @ np.abs(J))
+            scale = max(float(np.abs(jet.values[:2 * f]).max(initial=0.0)),
+                        float(np.abs(jet.jacobian[:2 * f]).max(initial=0.0)),
+                        float((np.abs(J).T @ np.abs(MJ)).max(initial=0.0)),
+                        float(terms.max(initial=0.0)), np.finfo(float).tiny)
+            column = np.maximum(np.abs(jet.jacobian[:2 * f]).max(axis=0, initial=0.0),
+                                np.abs(dM).max(axis=(0, 1), initial=0.0))
+            for j, i in enumerate(remaining):
                 if not np.isfinite(column[j]) or column[j] > CYCLIC_RTOL * scale:
                     still.discard(i)
             if not still:
