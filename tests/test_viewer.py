@@ -428,7 +428,11 @@ out.quat={};v.bodies.forEach(function(b){
 out.origin[b]=ks.map(function(k){return v.bodyPosition(b,v.times[k])});
 out.com[b]=ks.map(function(k){return v.comPosition(b,v.times[k])});
 out.quat[b]=ks.map(function(k){return v.bodyQuaternion(b,v.times[k])});});
-try{v.bodyPosition('nobody',0)}catch(err){out.unknown=String(err.message)}}
+try{v.bodyPosition('nobody',0)}catch(err){out.unknown=String(err.message)}
+var sl=document.querySelector('.jv-slider'),bt=document.querySelector('.jv-play');
+sl.value=String(v.times[ks[2]]);sl.dispatchEvent(new Event('input'));
+out.slider=[v.time(),document.querySelector('.jv-time').textContent];
+bt.click();out.button=[bt.textContent];bt.click();out.button.push(bt.textContent);}
 var pre=document.createElement('pre');pre.id='probe';pre.textContent=JSON.stringify(out);
 document.body.appendChild(pre);})();</script>"""
 
@@ -470,6 +474,11 @@ def test_view_in_headless_chromium_positions_equal_the_simulation(pendulum, tmp_
         pytest.skip("this Chromium has no WebGL (SwiftShader); the 3-D view cannot be checked")
     assert out["errors"] == [] and _console(run.stderr) == [], (out["errors"], run.stderr)
     assert out["unknown"] == 'no body named "nobody"'
+    # the slider sets the time, the button plays and pauses
+    # (the range input keeps the shortest decimal that reads back as a nearby double)
+    assert out["slider"][0] == pytest.approx(out["times"][2], rel=1e-15, abs=1e-15)
+    assert out["slider"][1] == f"t = {out['times'][2]:.3f} s"
+    assert out["button"] == ["❚❚ pause", "▶ play"]
     t = np.array(out["times"])
     worst = 0.0
     for name in ("rod1", "rod2"):
