@@ -149,6 +149,8 @@ class ModelFile:
     simulation: SimulationSettings = field(default_factory=SimulationSettings)
     descriptions: tuple[tuple[str, str], ...] = ()
     view: str | None = None
+    #: the :class:`jourdain.loops.ClosedLoopSystem` of ``[closing_joints.<name>]`` (else None)
+    loops: Any = None
 
     def error(self, message: str) -> ModelFileError:
         """A :class:`ModelFileError` for a problem a later stage found in this model (e.g. a
@@ -185,7 +187,7 @@ class ModelFile:
 # ------------------------------------------------------------------------------------------
 
 _TOP = {"model", "coordinates", "parameters", "inputs", "bodies", "forces", "nominal",
-        "simulation", "quantities"}
+        "simulation", "quantities", "closing_joints", "loops"}
 _JOINT_KEYS: dict[str, set[str]] = {
     "revolute": {"coordinate", "axis"},
     "prismatic": {"coordinate", "axis"},
@@ -539,8 +541,12 @@ class _Loader:
             raise self.fail(self.locate(str(exc)), str(exc)) from None
         nominal = self.read_nominal(data, system)
         sim = self.read_simulation(data, system)
+        loops = None
+        if "closing_joints" in data or "loops" in data:
+            from ..loops.modelfile import read_loops
+            loops = read_loops(self, data, system)
         return ModelFile(self.file, system, description, nominal, sim,
-                         tuple(self.descriptions.items()), view)
+                         tuple(self.descriptions.items()), view, loops)
 
     def nesting_error(self) -> ModelFileError:
         """The TOML reader recursed too deeply: name the value nested deepest."""
