@@ -663,3 +663,15 @@ def test_quantities_in_space_against_sympy_mechanics():
         q_ref = np.array(ref(*y, *yd), dtype=float)
         scale = float(np.max(np.abs(out["J_bar"]).T @ np.abs(out["q_e"])))
         assert_close_eval(out["q"], q_ref, n_terms=24, scale=scale)
+
+
+def test_check_lists_bushings_and_quantities(capsys):
+    """jourdain check names the bushings and the kinematic quantities with their symbols."""
+    from jourdain.cli import main
+
+    assert main(["check", str(EXAMPLES / "wheel_creep.toml")]) == 0
+    out = capsys.readouterr().out
+    assert ('kinematic quantities: velocity "slip" of wheel [0, -r, 0] (point in hub\'s axes), '
+            "components in world (slip_x, slip_y, slip_z)") in out
+    assert main(["check", str(EXAMPLES / "rotor_internal_damping.toml")]) == 0
+    assert "shaft (Bushing), air (Bushing)" in capsys.readouterr().out

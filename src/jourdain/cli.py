@@ -212,6 +212,8 @@ def summary(model: Any) -> dict[str, Any]:
         "joints": joints, "constraints": constraints,
         "parameters": system.parameter_values, "inputs": system.input_names,
         "forces": [{"name": f.name, "type": type(f).__name__} for f in system.forces],
+        "quantities": [{"name": q.name, "type": q.kind, "symbols": list(q.symbol_names),
+                        "definition": q.describe()} for q in system.quantities],
         "nominal_motions": [n.name for n in model.nominal],
         "cyclic_coordinates": list(_cyclic(system)),
     }
@@ -323,6 +325,9 @@ def cmd_check(args: argparse.Namespace) -> int:
               + (f" ({dirs})" if dirs else ""))
     if s["forces"]:
         print("  force elements: " + ", ".join(f"{f['name']} ({f['type']})" for f in s["forces"]))
+    if s["quantities"]:
+        print("  kinematic quantities: " + "; ".join(
+            f"{q['definition']} ({', '.join(q['symbols'])})" for q in s["quantities"]))
     if s["inputs"]:
         print("  inputs: " + ", ".join(s["inputs"]))
     print(f"  parameters ({len(s['parameters'])}): "

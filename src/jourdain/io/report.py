@@ -502,6 +502,11 @@ def _sections(model: ModelFile, out: Path, params: dict[str, float], t_end: floa
     if system.forces:
         s.append("<h3>Force elements</h3>" + _table(
             [(_e(f["name"]), _e(f["type"])) for f in summ["forces"]], ["name", "type"], "info"))
+    if summ.get("quantities"):
+        s.append("<p>Kinematic quantities in the force laws (replaced by their expressions in "
+                 "y, ẏ, t in q̄<sup>e</sup>):</p>" + _table(
+                     [(_e(q["name"]), _e(q["definition"]), _e(", ".join(q["symbols"])))
+                      for q in summ["quantities"]], ["name", "definition", "symbols"], "info"))
     sections.append("".join(s))
 
     # --- equations ------------------------------------------------------------------------

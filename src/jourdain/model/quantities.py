@@ -93,12 +93,17 @@ class Quantity:
         return (*self.point, *(self.point_b or ()))
 
     def describe(self) -> str:
+        """The definition in words, e.g. ``velocity "slip" of wheel [0, -r, 0] (point in hub's
+        axes), components in world``."""
+        comps = f", components in {self.frame}" if self.is_vector else ""
         if KINDS[self.kind][1]:
             return (f'{self.kind} "{self.name}" from {self.body} {_pt(self.point)} to '
-                    f"{self.body_b} {_pt(self.point_b or ())}")
+                    f"{self.body_b} {_pt(self.point_b or ())}{comps}")
         if self.kind == "angular_velocity":
-            return f'angular_velocity "{self.name}" of {self.body}'
-        return f'{self.kind} "{self.name}" of {self.body} {_pt(self.point)}'
+            return f'angular_velocity "{self.name}" of {self.body}{comps}'
+        where = (f" (point in {self.point_frame}'s axes)" if self.point_frame != self.body
+                 else "")
+        return f'{self.kind} "{self.name}" of {self.body} {_pt(self.point)}{where}{comps}'
 
 
 def _pt(p: tuple) -> str:
