@@ -191,11 +191,16 @@ BUSHING_COMPONENTS = ("x", "y", "z", "rx", "ry", "rz")
 
 
 def _six(value: object, where: str) -> tuple[Expr, ...]:
+    if isinstance(value, str | bytes):
+        raise ModelError(f"{where}: expected a 6-vector, got the string {value!r}")
     return as_vector(value, where, 6)
 
 
 def _six_by_six(value: object, where: str) -> tuple[tuple[Expr, ...], ...]:
     """A 6×6 matrix from a 6-vector (its diagonal), nested rows or a NumPy/SymPy matrix."""
+    if isinstance(value, str | bytes):
+        raise ModelError(f"{where}: expected a 6-vector (diagonal) or a 6×6 matrix of numbers or "
+                         f"expressions, got the string {value!r}")
     if isinstance(value, (int, float)) or isinstance(value, se.Basic) and value.is_Number:
         if value == 0:
             z = as_expr(0, where)
