@@ -130,9 +130,9 @@ class Resolver:
                       if any(x != 0 for x in c)]
             if moving:
                 raise ModelError(
-                    f"{q.describe()}: the acceleration of this point depends on the "
-                    f"accelerations of {moving} (a = J_T·ÿ + ā); a force law using it would "
-                    "put ÿ into q and make the equations of motion implicit, which jourdain "
+                    f'quantity "{q.name}": {q.describe()}: the acceleration of this point '
+                    f"depends on the accelerations of {moving} (a = J_T·ÿ + ā); a force law "
+                    "using it would put ÿ into q and make the equations of motion implicit, which jourdain "
                     "does not support. Accelerations may be used only for points whose motion "
                     "is prescribed (no coordinate); for others, write the force law with "
                     "positions and velocities")
