@@ -675,3 +675,55 @@ def test_check_lists_bushings_and_quantities(capsys):
             "components in world (slip_x, slip_y, slip_z)") in out
     assert main(["check", str(EXAMPLES / "rotor_internal_damping.toml")]) == 0
     assert "shaft (Bushing), air (Bushing)" in capsys.readouterr().out
+
+
+def test_inclined_bushing_axes_equal_the_turned_matrices():
+    """Mount axes turned by a constant rotation R0 (axes_a = axes_b = R0) with diagonal
+    stiffness and damping k_d, c_d are a mount in the body axes with the full matrices
+    T·k_d·Tᵀ, T = diag(R0, R0): the deflection in the turned axes is Tᵀ·x (s too, being the
+    axial vector of R0ᵀ·R·R0), so q agrees at any state, not only near rest."""
+    q = jd.symbols("x y z roll pitch yaw")
+    body = jd.Body("body", "world", jd.Free("float", q), mass=2.0,
+                   inertia=jd.box(2.0, 0.5, 0.4, 0.3))
+    turn = [jd.Rot("z", se.pi / 6), jd.Rot("x", -se.pi / 5)]
+    c, s5 = np.cos(np.pi / 6), np.sin(np.pi / 6)
+    Rz = np.array([[c, -s5, 0], [s5, c, 0], [0, 0, 1]])
+    a = -np.pi / 5
+    Rx = np.array([[1, 0, 0], [0, np.cos(a), -np.sin(a)], [0, np.sin(a), np.cos(a)]])
+    R0 = Rz @ Rx
+    T = np.kron(np.eye(2), R0)
+    kd = np.array([300.0, 500.0, 900.0, 20.0, 30.0, 40.0])
+    cd = kd * 0.01
+    pre = [0.0, 0.0, 5.0, 0.0, 0.3, 0.0]
+    p = (0.2, -0.1, -0.3)
+    inclined = jd.Bushing("m", "world", "body", p, p, stiffness=kd.tolist(),
+                          damping=cd.tolist(), preload=pre, axes_a=turn, axes_b=turn)
+    full = jd.Bushing("m", "world", "body", p, p, stiffness=(T @ np.diag(kd) @ T.T).tolist(),
+                      damping=(T @ np.diag(cd) @ T.T).tolist(), preload=(T @ pre).tolist())
+    s1 = jd.System(q, [body], [inclined])
+    s2 = jd.System(q, [body], [full])
+    rng = np.random.default_rng(4)
+    for _ in range(3):
+        y, yd = rng.normal(size=6) * 0.4, rng.normal(size=6)
+        q1, q2 = s1.evaluate(y, yd)["q"], s2.evaluate(y, yd)["q"]
+        assert_close_eval(q1, q2, n_terms=72, scale=float(np.max(np.abs(q2))) + 1000.0)
+    with pytest.raises(jd.ModelError, match=r'bushing "m" axes_a: the matrix .* is not a '
+                                            "rotation matrix"):
+        jd.Bushing("m", "world", "body", axes_a=[[1, 0, 0], [0, 1, 0], [0, 0, 2]])
+
+
+def test_model_file_bushing_axes():
+    """axes_a/axes_b in a model file: rotations about axes (as joint orientations) are the
+    Python API's; a matrix that is no rotation is refused at its line."""
+    from jourdain.io.modelfile import ModelFileError, loads_model
+
+    text = _FILE.replace('frame = "l2"\n', 'frame = "l2"\naxes_a = [{ rot = "z", angle = "pi/6" }]\n'
+                         'axes_b = [{ rot = "z", angle = "pi/6" }]\n')
+    b = next(f for f in loads_model(text, "m.toml").system.forces if f.name == "mount")
+    ref = jd.Bushing("x", "world", "l1", axes_a=[jd.Rot("z", se.pi / 6)])
+    assert b.axes_a == ref.axes_a == b.axes_b
+    bad = _FILE.replace('frame = "l2"\n', 'frame = "l2"\naxes_b = [[1, 0, 0], [0, 1, 0], '
+                        '[0, 0, 2]]\n')
+    with pytest.raises(ModelFileError, match="axes_b: the axes .* is not a rotation matrix") as e:
+        loads_model(bad, "m.toml")
+    assert e.value.line == bad[:bad.index("axes_b")].count("\n") + 1

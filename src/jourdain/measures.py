@@ -204,22 +204,44 @@ def rotation_measure_rate_matrix(R: Mat3) -> Mat3:
                  for i in range(3))  # type: ignore[return-value]
 
 
+def _turn(R: Mat3, v: Vec3) -> Vec3:
+    """R·v, v itself for the identity (no products of ones and zeros in the expressions)."""
+    return v if R == IDENTITY else _mv(R, v)
+
+
+def _turn_back(R: Mat3, v: Vec3) -> Vec3:
+    """Rᵀ·v"""
+    return v if R == IDENTITY else _mtv(R, v)
+
+
 def bushing_deflection(frames: Frames, fe: Bushing
                        ) -> tuple[tuple[se.Basic, ...], tuple[se.Basic, ...], dict]:
     """Deflection x (6), its rate ẋ (6) and the geometry needed for the wrenches
-    (a :class:`Bushing`'s docstring gives the definitions)."""
-    a, b, F = fe.body_a, fe.body_b, fe.frame
+    (a :class:`Bushing`'s docstring gives the definitions). The ends' axes are the bodies'
+    turned by the constant ``axes_a``, ``axes_b``: ``S_A = S_a·A_a``, ``S_B = S_b·A_b``."""
+    a, b = fe.body_a, fe.body_b
+    Aa, Ab = fe.axes_a, fe.axes_b
+    at_a = fe.frame == a
+    body_F, A_F = (a, Aa) if at_a else (b, Ab)
     ra, va = frames.point(a, fe.point_a)
     rb, vb = frames.point(b, fe.point_b)
-    R = relative_rotation_of(frames, a, b)
+    R_ab = relative_rotation_of(frames, a, b)
+    R = R_ab
+    if Aa != IDENTITY:
+        R = _mtm(Aa, R)
+    if Ab != IDENTITY:
+        R = tuple(tuple(se.Add(*(R[i][k] * Ab[k][j] for k in range(3))) for j in range(3))
+                  for i in range(3))  # type: ignore[assignment]
     H = rotation_measure_rate_matrix(R)
-    wa, wb = frames.omega(a), frames.omega(b)
-    w_rel = _sub(_mv(R, wb), wa)  # a's axes
-    d = frames.to_frame(_sub(rb, ra), F)
-    dd = _sub(frames.to_frame(_sub(vb, va), F), _cross(frames.omega(F), d))
+    w_A = _turn_back(Aa, frames.omega(a))
+    w_B = _turn_back(Ab, frames.omega(b))
+    w_rel = _sub(_mv(R, w_B), w_A)  # end a's axes
+    d = _turn_back(A_F, frames.to_frame(_sub(rb, ra), body_F))
+    w_F = _turn_back(A_F, frames.omega(body_F))
+    dd = _sub(_turn_back(A_F, frames.to_frame(_sub(vb, va), body_F)), _cross(w_F, d))
     s = rotation_measure(R)
     sd = _mv(H, w_rel)
-    geo = {"R": R, "H": H, "d": d}
+    geo = {"R": R, "H": H, "d": d, "body_F": body_F, "A_F": A_F}
     return (*d, *s), (*dd, *sd), geo
 
 
@@ -243,33 +265,35 @@ def bushing_wrench(fe: Bushing, x: tuple, xd: tuple,
 def bushing_loads(frames: Frames, fe: Bushing, w: tuple, geo: dict
                   ) -> list[tuple[str, Vec3 | None, Vec3, Vec3]]:
     """The loads of wrench ``w`` (on b, conjugate to x) on the two bodies, from the virtual
-    work ``wᵀ·δx`` with ``δd = S_Fᵀ(δr_b − δr_a) − δφ_F × d`` and ``δs = H·(δφ_b − δφ_a)``:
+    work ``wᵀ·δx`` with ``δd = S_Fᵀ(δr_b − δr_a) − δφ_F × d`` and ``δs = H·(δφ_B − δφ_A)``:
 
     * the force ``S_F·f`` at point b on body b, ``−S_F·f`` at point a on body a;
     * the torque ``−d × f`` (frame F's axes) on the body of frame F;
-    * the torque ``Hᵀ·m`` (a's axes) on body b and ``−Hᵀ·m`` on body a.
+    * the torque ``Hᵀ·m`` (end a's axes) on body b and ``−Hᵀ·m`` on body a.
 
     Returns ``(body, inertial force or None for a torque, vector in the body's axes, point)``
     for each load (the world's are left out)."""
-    a, b, F = fe.body_a, fe.body_b, fe.frame
+    a, b = fe.body_a, fe.body_b
+    body_F, A_F = geo["body_F"], geo["A_F"]
     f, m = tuple(w[:3]), tuple(w[3:])
     R, H, d = geo["R"], geo["H"], geo["d"]
     minus = se.Integer(-1)
-    f_I = frames.to_inertial(f, F)  # type: ignore[arg-type]
+    f_body = _turn(A_F, f)  # type: ignore[arg-type]
+    f_I = frames.to_inertial(f_body, body_F)
     out: list[tuple[str, Vec3 | None, Vec3, Vec3]] = []
     if b != WORLD:
-        out.append((b, f_I, f if F == b else frames.to_frame(f_I, b), fe.point_b))
+        out.append((b, f_I, f_body if body_F == b else frames.to_frame(f_I, b), fe.point_b))
     if a != WORLD:
-        f_a = f if F == a else frames.to_frame(f_I, a)
+        f_a = f_body if body_F == a else frames.to_frame(f_I, a)
         out.append((a, _scale(f_I, minus), _scale(f_a, minus), fe.point_a))
-    if F != WORLD:
-        out.append((F, None, _scale(_cross(d, f), minus), Z3))  # type: ignore[arg-type]
+    if body_F != WORLD:
+        out.append((body_F, None, _turn(A_F, _scale(_cross(d, f), minus)), Z3))  # type: ignore
     Hm = _mtv(H, m)  # type: ignore[arg-type]
     if any(v != 0 for v in Hm):
         if b != WORLD:
-            out.append((b, None, _mtv(R, Hm), Z3))
+            out.append((b, None, _turn(fe.axes_b, _mtv(R, Hm)), Z3))
         if a != WORLD:
-            out.append((a, None, _scale(Hm, minus), Z3))
+            out.append((a, None, _turn(fe.axes_a, _scale(Hm, minus)), Z3))
     return out
 
 

@@ -209,7 +209,7 @@ _FORCE_KEYS: dict[str, set[str]] = {
     "generalized": {"coordinate", "value"},
     "rotational_spring_damper": {"coordinate", "stiffness", "damping", "rest_angle"},
     "bushing": {"body_a", "point_a", "body_b", "point_b", "frame", "stiffness", "damping",
-                "preload", "laws"},
+                "preload", "laws", "axes_a", "axes_b"},
 }
 #: keys of a [quantities.<name>] table, by its type (one point, or two points)
 _QUANTITY_KEYS_ONE = {"body", "point", "frame", "point_frame"}
@@ -1114,6 +1114,16 @@ class _Loader:
             return [self.expr(x, (*kp, i), allowed, ctx) for i, x in enumerate(v)]
 
         ctx = "a bushing (coordinates, rates, parameters, inputs, t and kinematic quantities)"
+        axes = {}
+        for key in ("axes_a", "axes_b"):
+            if key in spec:
+                axes[key] = self.orientation(spec[key], (*p, key), params,
+                                             "a bushing's axes (parameters only)")
+                why = orientation_problem(
+                    axes[key] if not isinstance(axes[key], list) else _product(axes[key]),
+                    self.params)
+                if why:
+                    raise self.fail((*p, key), f"the axes {why}")
         laws = {}
         if "laws" in spec:
             tbl = self.table(spec["laws"], (*p, "laws"), set(BUSHING_COMPONENTS),
@@ -1128,7 +1138,7 @@ class _Loader:
                        self.vector(spec.get("point_b", [0, 0, 0]), (*p, "point_b"), params, pctx),
                        stiffness=six("stiffness", True), damping=six("damping", True),
                        preload=six("preload", False) if "preload" in spec else (0,) * 6,
-                       frame=fr, laws=laws)
+                       frame=fr, laws=laws, **axes)
 
     # --- kinematic quantities -------------------------------------------------------------
     def read_quantities(self, data: dict) -> None:
@@ -1301,6 +1311,13 @@ class _Loader:
         kw.setdefault("y0", tuple(0.0 for _ in self.coords))
         kw.setdefault("yd0", tuple(0.0 for _ in self.coords))
         return SimulationSettings(**kw)
+
+
+def _product(rotations: list) -> Any:
+    """The rotation matrix of a list of Rot steps."""
+    from ..model.forces import _axes
+
+    return _axes(rotations, "axes")
 
 
 def _free(step: Rot | Trans) -> set[str]:

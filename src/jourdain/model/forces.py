@@ -12,8 +12,8 @@ from dataclasses import dataclass
 import symengine as se
 
 from ..errors import ModelError
-from .expressions import Expr, as_expr, as_vector
-from .joints import Vec3
+from .expressions import Expr, as_expr, as_matrix3, as_vector
+from .joints import IDENTITY, Mat3, Rot, Vec3, orientation_problem, rotation_matrix
 
 #: In a :class:`SpringDamper` ``law``: the elongation ``L - L0`` and its rate ``dL/dt``.
 elongation = se.Symbol("elongation")
@@ -233,18 +233,39 @@ def _six_by_six(value: object, where: str) -> tuple[tuple[Expr, ...], ...]:
     return tuple(tuple(diag[i] if i == j else z for j in range(6)) for i in range(6))
 
 
+def _axes(value: object, where: str) -> Mat3:
+    """A bushing's axes in a body frame: a 3×3 rotation matrix or a list of :class:`Rot`."""
+    if value is None:
+        return IDENTITY
+    if isinstance(value, list | tuple) and value and all(isinstance(r, Rot) for r in value):
+        R = IDENTITY
+        for r in value:
+            A = rotation_matrix(r.axis, r.angle)
+            R = tuple(tuple(se.Add(*(R[i][k] * A[k][j] for k in range(3))) for j in range(3))
+                      for i in range(3))  # type: ignore[assignment]
+        return R
+    R = as_matrix3(value, where)
+    if not any(x.free_symbols for row in R for x in row):
+        why = orientation_problem(R, {})
+        if why:
+            raise ModelError(f"{where}: the matrix {why}")
+    return R
+
+
 @dataclass(frozen=True)
 class Bushing:
     """A 6-D spring–damper between a point of ``body_a`` and a point of ``body_b`` (either may
     be ``"world"``): rubber mounts, bearings, shaft couplings.
 
-    Deflection ``x = (d, s)`` (6), in the axes of ``frame`` (``body_a`` or ``body_b``; the
-    bushing's axes are that body's axes):
+    Each end has its own axes: the body's axes turned by ``axes_a`` (``axes_b``), a constant
+    rotation (3×3 matrix, or a list of :class:`jourdain.Rot`; default: the body's axes), so that
+    inclined mounts and bodies whose frames differ at rest are described directly. Deflection
+    ``x = (d, s)`` (6), in the axes of ``frame`` (``body_a`` or ``body_b``: that end's axes):
 
     * ``d = S_Fᵀ·(r_b − r_a)``: the position of point b relative to point a, in frame F;
-    * ``s = ½·vee(R − Rᵀ) = sin θ·n`` with ``R = S_aᵀ·S_b`` the rotation of body b relative
-      to body a (angle θ about the unit axis n): the axial vector of the relative rotation's
-      skew part, whose components are the same in the axes of a and of b.
+    * ``s = ½·vee(R − Rᵀ) = sin θ·n`` with ``R = S_Aᵀ·S_B`` the rotation of end b's axes
+      relative to end a's (angle θ about the unit axis n): the axial vector of the relative
+      rotation's skew part, whose components are the same in the axes of either end.
 
     Wrench on body b, in frame F, conjugate to x:
     ``w = preload − stiffness·x − damping·ẋ``, with ẋ the time derivative of x (``ḋ``: the rate
@@ -280,6 +301,8 @@ class Bushing:
     point_a: Vec3
     point_b: Vec3
     frame: str
+    axes_a: Mat3
+    axes_b: Mat3
     stiffness: tuple[tuple[Expr, ...], ...]
     damping: tuple[tuple[Expr, ...], ...]
     preload: tuple[Expr, ...]
@@ -288,7 +311,8 @@ class Bushing:
     def __init__(self, name: str, body_a: str, body_b: str, point_a: object = (0, 0, 0),
                  point_b: object = (0, 0, 0), stiffness: object = 0, damping: object = 0,
                  preload: object = (0, 0, 0, 0, 0, 0), frame: str | None = None,
-                 laws: dict | None = None) -> None:
+                 laws: dict | None = None, axes_a: object = None,
+                 axes_b: object = None) -> None:
         w = f'bushing "{name}"'
         set_ = object.__setattr__
         set_(self, "name", _name(name, "bushing"))
@@ -301,6 +325,8 @@ class Bushing:
             raise ModelError(f'{w}: frame "{fr}" must be one of its bodies, "{body_a}" or '
                              f'"{body_b}"')
         set_(self, "frame", fr)
+        set_(self, "axes_a", _axes(axes_a, f"{w} axes_a"))
+        set_(self, "axes_b", _axes(axes_b, f"{w} axes_b"))
         K = _six_by_six(stiffness, f"{w} stiffness")
         C = _six_by_six(damping, f"{w} damping")
         set_(self, "stiffness", K)
@@ -321,7 +347,8 @@ class Bushing:
     @property
     def expressions(self) -> list[Expr]:
         """Every expression of the element (for checks of the names used)."""
-        return [*self.point_a, *self.point_b, *(v for r in self.stiffness for v in r),
+        return [*self.point_a, *self.point_b, *(v for r in self.axes_a for v in r),
+                *(v for r in self.axes_b for v in r), *(v for r in self.stiffness for v in r),
                 *(v for r in self.damping for v in r), *self.preload,
                 *(law for law in self.laws if law is not None)]
 

@@ -29,6 +29,7 @@ from .forces import (
     elongation_d,
     rate,
 )
+from .joints import orientation_problem
 from .quantities import Quantity, quantities_in
 
 if TYPE_CHECKING:
@@ -434,6 +435,15 @@ def _validate(sys: System) -> None:
             if points:
                 raise ModelError(f"{w}: points use {sorted(points)}; points may use parameters "
                                  "only")
+            for key in ("axes_a", "axes_b"):
+                R = getattr(f, key)
+                bad = free_names([x for row in R for x in row]) - set(p_names)
+                if bad:
+                    raise ModelError(f"{w}: {key} uses {sorted(bad)}; axes may use parameters "
+                                     "only")
+                why = orientation_problem(R, defaults)
+                if why:
+                    raise ModelError(f"{w}: {key}: the matrix {why}")
             exprs = f.expressions
             extra = {str(deflection), str(deflection_d)}
         bad = free_names(exprs) - allowed_force - extra
