@@ -212,3 +212,16 @@ def test_cli_reads_urdf(capsys):
     M = np.array(data["values"]["M"])
     assert M.shape == (3, 3) and data["coordinates"] == ["shoulder", "elbow", "wrist"]
     assert main(["check", str(DATA / "missing.urdf")]) == 2
+
+
+def test_run_reports_a_urdf_example(tmp_path, capsys):
+    """``jourdain run`` on the example: a complete report with a copy of the URDF as
+    model.urdf (not model.toml); ``jd.load_urdf`` is the same function."""
+    assert jd.load_urdf is load_urdf
+    example = Path(__file__).resolve().parents[1] / "examples" / "planar_arm.urdf"
+    out = tmp_path / "report"
+    assert main(["run", str(example), "--out", str(out), "--t-end", "0.2"]) == 0
+    run = json.loads((out / "run.json").read_text())
+    assert run["status"] == "complete" and "model.urdf" in run["files"]
+    assert (out / "model.urdf").read_bytes() == example.read_bytes()
+    assert not (out / "model.toml").exists() and (out / "report.html").stat().st_size > 0

@@ -57,10 +57,16 @@ class ReportInfo:
 RUN_FORMAT = "jourdain-run/1"
 
 
+def model_copy(model: ModelFile) -> str:
+    """The name of the report's copy of the model: ``model.urdf`` for a URDF robot, else
+    ``model.toml``."""
+    return "model.urdf" if str(model.path).lower().endswith(".urdf") else "model.toml"
+
+
 def report_files(model: ModelFile) -> list[str]:
     """The names of the files :func:`write_report` writes for ``model`` (the command line
     refuses to overwrite them without ``--force``)."""
-    return ["report.html", "run.json", "model.toml", "equations.tex", "equations.json",
+    return ["report.html", "run.json", model_copy(model), "equations.tex", "equations.json",
             "values.json", *(f"linearization-{n.name}.json" for n in model.nominal),
             "simulation.csv", *(f"wrench-{b.joint.name}.csv" for b in model.system.bodies)]
 
@@ -471,9 +477,10 @@ def _sections(model: ModelFile, out: Path, params: dict[str, float], t_end: floa
     pv = system.parameter_values
     pv.update(params)
     src = Path(model.path)
-    if src.is_file() and not (out / "model.toml").resolve() == src.resolve():
-        shutil.copyfile(src, out / "model.toml")
-        info.files.append(out / "model.toml")
+    copy = out / model_copy(model)
+    if src.is_file() and not copy.resolve() == src.resolve():
+        shutil.copyfile(src, copy)
+        info.files.append(copy)
     names = export.display_names(system)
 
     def sym(n: str) -> str:
@@ -848,7 +855,8 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
                  progress: Any = False) -> ReportInfo:
     """Compute everything for ``model`` and write ``out/report.html`` with the data files.
 
-    Files: ``report.html``, ``model.toml`` (a copy of the input), ``equations.tex``,
+    Files: ``report.html``, ``model.toml`` (a copy of the input; ``model.urdf`` for a URDF
+    robot), ``equations.tex``,
     ``equations.json`` (the matrices with shared temporaries), ``values.json`` (the numbers at
     the initial state, the format of ``jourdain eval --json``), ``linearization-<name>.json``
     per nominal motion, ``simulation.csv`` (written as the simulation goes; ``progress`` is
