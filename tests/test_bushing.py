@@ -309,9 +309,10 @@ def test_rotor_internal_damping_bushing_gives_circulatory_matrix_and_threshold()
 
 # --- generalized forces on expressions ------------------------------------------------------
 def test_rotational_spring_damper_on_a_relative_angle():
-    """A torsion spring–damper on the relative angle e = φ2 − φ1 of a double pendulum in
-    absolute angles: by virtual work q = (−Q, +Q)·(−1, 1)… i.e. q1 = k(e − e0) + d·ė,
-    q2 = −k(e − e0) − d·ė; the same element in a model file gives the same q."""
+    """A torsion spring–damper on the relative angle e = φ2 − φ1 of two links hinged at the
+    ground, in absolute angles: by virtual work Q·δe = Q·(δφ2 − δφ1) with
+    Q = −k(e − e0) − d·ė, so q = (−Q, Q); K and D of the linearization are k and d times
+    [[1, −1], [−1, 1]]; without damping its potential is ½k(e − e0)² (up to a constant)."""
     p1, p2 = jd.symbols("phi1 phi2")
     b1 = jd.Body("l1", "world", jd.Revolute("h1", p1), mass=1.0, inertia=jd.rod(1.0, 1.0),
                  com=(0.5, 0, 0))
@@ -329,9 +330,13 @@ def test_rotational_spring_damper_on_a_relative_angle():
     lin = s.linearize({"phi1": 0.0, "phi2": e0}).evaluate()
     np.testing.assert_allclose(lin["K"], [[k, -k], [-k, k]], rtol=1e-14)
     np.testing.assert_allclose(lin["D"], [[d, -d], [-d, d]], rtol=1e-14)
-    # energy: the value a + b·deflection has the potential ½k(e − e0)² up to a constant
     en = jd.energy(s.kinematics())
-    assert en.nonconservative == ("torsion",)
+    assert en.nonconservative == ("torsion",)  # damped
+    s0 = jd.System([p1, p2], [b1, b2], [jd.RotationalSpringDamper("torsion", p2 - p1, k, 0, e0)])
+    en0 = jd.energy(s0.kinematics())
+    assert en0.conservative
+    rest = se.expand(en0.V - k / 2 * (p2 - p1 - e0) ** 2)
+    assert not rest.free_symbols and abs(float(rest) + k * e0**2 / 2) < 1e-12
 
 
 def test_generalized_force_on_a_distance_equals_a_spring_damper():
