@@ -10,7 +10,8 @@ problem (tests/tolerance.py through :func:`tests.reference.tree_crosscheck.judge
 Coordinates. Pinocchio's joints are found by their URDF names. Its continuous joints have
 ``q = (cos θ, sin θ)`` and ``v = θ̇``; its free-flyer has ``q = (p, quaternion)`` and
 ``v = (Rᵀṗ, ω)`` in the body frame, while jourdain's free joint has ``y = (p, yaw, pitch,
-roll)`` with ``R = Rz·Ry·Rx``. With ``ν = T(y)·ẏ`` (T square: nv = f) the two sets of equations
+roll)`` with ``R = Rz·Ry·Rx``; its planar joint has ``q = (x, y, cos θ, sin θ)`` and ``v =
+(R(θ)ᵀ·(ẋ, ẏ), θ̇)``, jourdain's ``y = (x, y, θ)``. With ``ν = T(y)·ẏ`` (T square: nv = f) the two sets of equations
 are related by ``M = TᵀM_pT`` and ``k − q = Tᵀ(nle_p + M_p·Ṫẏ)``, ``ν̇ = T·ÿ + Ṫẏ``;
 :class:`Twin` computes T and Ṫẏ in closed form (body-frame angular velocity of the z-y-x
 angles and its derivative).
@@ -112,6 +113,16 @@ class Twin:
                 th = y[ix[0]]
                 q[iq:iq + jm.nq] = [th] if jm.nq == 1 else [np.cos(th), np.sin(th)]
                 continue
+            if jm.shortname() == "JointModelPlanar":
+                # q = (x, y, cos θ, sin θ), v = (R(θ)ᵀ·(ẋ, ẏ), θ̇): velocity in the body frame
+                x, yy, th = y[ix]
+                xd, yyd, thd = yd[ix]
+                c, s = np.cos(th), np.sin(th)
+                q[iq:iq + 4] = (x, yy, c, s)
+                T[iv:iv + 3, ix] = np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])
+                vx, vy = c * xd + s * yyd, -s * xd + c * yyd
+                Tdot[iv:iv + 3] = (thd * vy, -thd * vx, 0.0)
+                continue
             assert jm.shortname() == "JointModelFreeFlyer", jm.shortname()
             p, ang, pd, angd = y[ix[:3]], y[ix[3:]], yd[ix[:3]], yd[ix[3:]]
             R = _rot("z", ang[0]) @ _rot("y", ang[1]) @ _rot("x", ang[2])
@@ -205,7 +216,7 @@ def test_zyx_rates_against_finite_differences():
 
 
 @pytest.mark.parametrize("name, floating", [("two_link_arm", False), ("slider_crank", False),
-                                            ("walker", True)])
+                                            ("walker", True), ("puck", False)])
 def test_small_urdfs_match_pinocchio(name, floating):
     twin = Twin(DATA / f"{name}.urdf", floating_base=floating)
     worst = _check(twin, n_states=4, seed=1)
