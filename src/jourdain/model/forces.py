@@ -1,8 +1,11 @@
 """Applied (impressed) forces: the sources of q̄^e.
 
 Expressions may depend on the coordinates ``y``, their rates (``phi_d`` for a coordinate ``phi``,
-see :func:`rate`), ``t``, the inputs ``u`` and the parameters. Vectors are given in the frame
-named by ``frame``: ``"world"`` (inertial) or a body name.
+see :func:`rate`), ``t``, the inputs ``u``, the parameters and kinematic quantities (positions,
+velocities, distances of body points: :mod:`jourdain.model.quantities`). Vectors are given in the
+frame named by ``frame``: ``"world"`` (inertial) or a body name. :class:`Bushing` is a 6-D
+spring–damper between two body frames; :class:`GeneralizedForce` and
+:func:`RotationalSpringDamper` act on a coordinate or on an expression of the coordinates.
 """
 
 from __future__ import annotations
