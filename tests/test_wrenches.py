@@ -147,3 +147,19 @@ def test_eval_json_and_report_files(tmp_path, capsys):
     assert "joint wrenches along the motion" in html
     values = json.loads((out / "values.json").read_text())
     assert set(values["joint_wrenches"]) == {files[0][len("wrench-"):-len(".csv")]}
+
+
+def test_models_with_inputs():
+    """The directions and orientations do not depend on the inputs: a model with inputs gets
+    its joint wrenches at one state and along a simulation (the quarter car's road input)."""
+    model = jd.load_model(ROOT / "examples" / "quarter_car.toml")
+    system = model.system
+    out = system.evaluate([0.01, 0.02], [0.1, -0.2], inputs={"z_r": 0.03})
+    assert set(out["joint_wrenches"]) == {b.joint.name for b in system.bodies}
+    res = system.simulate((0.0, 0.2), [0.0, 0.0], [0.0, 0.0], inputs={"z_r": 0.01},
+                          t_eval=np.linspace(0, 0.2, 5))
+    for name, w in res.joint_wrenches.items():
+        i = 3
+        one = joint_wrenches(system, res.g[i], res.y[i], res.yd[i], res.t[i])[name]
+        o = system.evaluate(res.y[i], res.yd[i], res.t[i], inputs={"z_r": 0.01})
+        assert np.abs(w.force_inertial[i] - one.force_inertial).max() <= reactions_tol(o)
