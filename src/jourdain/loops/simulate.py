@@ -140,7 +140,7 @@ def simulate_loop(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: Any,
                   samples: int = 501, rtol: float = 1e-10, atol: float = 1e-12,
                   method: str = "DOP853", parameters: Mapping[str, float] | None = None,
                   inputs: Callable[[float], Any] | Sequence[float] | None = None,
-                  repartition: bool = True, cond_limit: float = 1e8,
+                  repartition: bool = True, cond_limit: float = 1e6,
                   max_step: float = math.inf) -> LoopResults:
     """Integrate a closed-loop system from approximate ``z0, zd0`` (assembled first, the
     independent coordinates of the partition held) over ``t_span``.
@@ -197,6 +197,9 @@ def simulate_loop(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: Any,
     if method not in solvers:
         raise EvaluationError(f"method must be one of {', '.join(solvers)}, got {method!r}")
     k_eval = 0
+    # a new partition is sought when Φ_d's condition grows tenfold over this mark: the chart
+    # (y, ẏ) degrades long before Φ_d is singular (the rates ẏ → 0 at a limit position of y)
+    watermark = max(ev.part.cond, 10.0)
     while True:
         solver = solvers[method](rhs, t, x, t1, rtol=rtol, atol=atol, max_step=max_step)
         if k_eval < len(tev) and tev[k_eval] == t:
@@ -228,8 +231,9 @@ def simulate_loop(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: Any,
                 ev._last = None
                 z_acc, _, _ = ev.solve_positions(solver.y[:f], solver.t)
                 ev.z_guess = z_acc
-                if ev.cond(z_acc, solver.t) > cond_limit:
-                    event = (float(solver.t), solver.y.copy())
+                c_now = ev.cond(z_acc, solver.t)
+                if c_now > cond_limit or (repartition and c_now > 10 * watermark):
+                    event = (float(solver.t), solver.y.copy(), c_now)
                     break
         except SingularConfiguration as exc:
             status, message, singular = "singular", str(exc), exc
@@ -238,7 +242,7 @@ def simulate_loop(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: Any,
         if event is None:
             break
         # the condition of Φ_d passed cond_limit: a new partition, or a report
-        te, xe = event
+        te, xe, c_now = event
         f = ev.part.f
         s = ev.state(xe[:f], xe[f:], te)
         rank = ev.rank(s["z"], te)
@@ -247,12 +251,18 @@ def simulate_loop(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: Any,
         names = [loop.coordinate_names[j] for j in new.independent]
         state = ", ".join(f"{n} = {v:.6g}" for n, v in zip(loop.coordinate_names, s["z"],
                                                             strict=True))
-        if repartition and new.cond < cond_limit / 100 and names != old_names:
+        if repartition and new.cond < c_now / 10 and names != old_names:
             ev.set_partition(new)
+            watermark = max(new.cond, 10.0)
             partitions.append((te, tuple(names)))
             ind = list(new.independent)
             x = np.concatenate([s["z"][ind], s["zd"][ind]])
             t = te
+            continue
+        if c_now <= cond_limit:
+            # worse than at the partition, but no better one here: go on, watching for more
+            watermark = c_now
+            x, t = xe, te
             continue
         cause = (f"the constraint Jacobian Φ_z has rank {rank} of {len(ev.part.rows)} there "
                  "(a singular position of the mechanism: no partition helps)"
