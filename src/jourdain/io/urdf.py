@@ -685,8 +685,9 @@ def _build(robot: Any, src: _Source, *, floating_base: bool, g: float, mimic: st
         tuple(se.Integer(0) for _ in coords),
         description="every joint coordinate 0 (under gravity an equilibrium only where the "
                     "inputs hold it)")
+    descriptions = _descriptions(system, info.values(), link_data, floating_base)
     return UrdfModel(
-        path=path, system=system,
+        path=path, system=system, descriptions=descriptions,
         description=f'URDF robot "{robot.name}" ({Path(path).name})'
                     + (", floating base" if floating_base else ""),
         nominal=(zero,) if not floating_base else (),
@@ -694,6 +695,40 @@ def _build(robot: Any, src: _Source, *, floating_base: bool, g: float, mimic: st
         robot=str(robot.name), floating_base=floating_base,
         joints=tuple(info[j.name] for j in robot.joints), links=link_data,
         visual_geometry=tuple(visuals), collision_geometry=tuple(collisions))
+
+
+def _descriptions(system: System, joints: Any, links: Sequence[UrdfLink],
+                  floating_base: bool) -> tuple[tuple[str, str], ...]:
+    """One line per coordinate, input and mass parameter, for reports and ``check``."""
+    out: dict[str, str] = {}
+    if floating_base:
+        for c in ROOT_COORDINATES:
+            out[c] = f"floating base ({ROOT_JOINT}): {c[5:]}"
+    for j in joints:
+        lim = (f", limits [{j.lower:g}, {j.upper:g}]"
+               if j.lower is not None and j.upper is not None and j.type != "continuous" else "")
+        for c in j.coordinates:
+            out[c] = f'{j.type} joint "{j.name}" ({j.parent} → {j.child}){lim}'
+        if j.input:
+            effort = f", effort limit {j.effort:g}" if j.effort is not None else ""
+            out[j.input] = f'actuator of joint "{j.name}"{effort}'
+    welded: dict[str, list[str]] = {}
+    for lk in links:
+        if lk.body != "world" and lk.name != lk.body:
+            welded.setdefault(lk.body, []).append(lk.name)
+    params = system.parameter_values
+    for b in system.body_names:
+        extra = welded.get(b, [])
+        more = f" with the welded link(s) {', '.join(extra)}" if extra else ""
+        for key, what in (("m", "mass"), ("cx", "centre of mass x"), ("cy", "centre of mass y"),
+                          ("cz", "centre of mass z")):
+            if f"{key}_{b}" in params:
+                out[f"{key}_{b}"] = f"{what} of link {b}{more}"
+        for a in ("xx", "xy", "xz", "yy", "yz", "zz"):
+            if f"I{a}_{b}" in params:
+                out[f"I{a}_{b}"] = f"inertia I{a} of link {b}{more} about its centre of mass"
+    out["g"] = "gravity along -z"
+    return tuple(out.items())
 
 
 def _symbols(names: Sequence[str]) -> tuple[se.Symbol, ...]:
