@@ -16,6 +16,15 @@ from jourdain.models import n_link_pendulum_on_cart
 
 matplotlib.use("Agg")
 
+
+@pytest.fixture(autouse=True)
+def _close_figures():
+    """Each test's figures are closed after it (pyplot keeps them otherwise)."""
+    yield
+    import matplotlib.pyplot as plt
+
+    plt.close("all")
+
 # the angle of every rotation step and the distance of every translation step of each kind
 JOINT_KINDS = {
     "revolute": (lambda c: jd.Revolute("j", c[0], "z"), ["rad"]),
