@@ -14,6 +14,7 @@ import pytest
 
 import jourdain as jd
 from jourdain.cli import main
+from jourdain.io import capabilities
 from jourdain.wrenches import joint_wrenches
 from tests.reference.tree_crosscheck import wrench_tol
 from tests.tolerance import reactions_tol, tree_extent
@@ -133,20 +134,28 @@ def test_eval_json_and_report_files(tmp_path, capsys):
     assert w["force"] == [g["hinge2.F_x"], g["hinge2.F_y"], g["hinge2.F_z"]]
     assert np.linalg.norm(w["force_inertial"]) == pytest.approx(np.linalg.norm(w["force"]),
                                                                 rel=1e-14)
-    assert main(["eval", str(path), "--at", "phi1=0.3"]) == 0
-    assert "joint wrenches on the child body" in capsys.readouterr().out
-    out = tmp_path / "r"
-    assert main(["run", str(ROOT / "examples" / "simple_pendulum.toml"), "--t-end", "0.3",
-                 "--out", str(out)]) == 0
-    capsys.readouterr()
-    files = sorted(p.name for p in out.glob("wrench-*.csv"))
-    assert files == ["wrench-pivot.csv"] or len(files) == 1
-    header = (out / files[0]).read_text().splitlines()[0]
-    assert header.startswith("t,") and header.endswith("_inertial")
-    html = (out / "report.html").read_text()
-    assert "joint wrenches along the motion" in html
-    values = json.loads((out / "values.json").read_text())
-    assert set(values["joint_wrenches"]) == {files[0][len("wrench-"):-len(".csv")]}
+    from jourdain.cli import _wrench_text
+
+    model = jd.load_model(path)
+    out = model.system.evaluate([0.3, 0.0], [1.0, 0.0])
+    text = _wrench_text(model.system, out["joint_wrenches"])
+    assert "joint wrenches on the child body" in text and text.count("inertial") == 2
+    # the report's section: one table per joint, a plot, and the files listed for --force
+    from jourdain.io import report
+
+    model = jd.load_model(ROOT / "examples" / "simple_pendulum.toml")
+    res = capabilities.simulate(model, t_end=0.3, samples=31)
+    info = report.ReportInfo(tmp_path / "report.html")
+    html = report._wrench_section(res, tmp_path, info)
+    assert "joint wrenches along the motion" in html and "<svg" in html
+    files = [p.name for p in info.files]
+    assert files == [f"wrench-{b.joint.name}.csv" for b in model.system.bodies]
+    assert set(files) <= set(report.report_files(model))
+    lines = (tmp_path / files[0]).read_text().splitlines()
+    assert lines[0].startswith("t,") and lines[0].endswith("_inertial") and len(lines) == 32
+    name = files[0][len("wrench-"):-len(".csv")]
+    np.testing.assert_array_equal(np.loadtxt(tmp_path / files[0], delimiter=",", skiprows=1),
+                                  res.joint_wrench_table(name)[1])
 
 
 def test_models_with_inputs():
