@@ -340,3 +340,65 @@ def test_closing_joint_api_errors() -> None:
     with pytest.raises(ModelError, match="unknown name"):
         ClosedLoopSystem(loop.tree, [ClosingJoint(
             "x", "constraint", expressions=[se.Symbol("theta1") - se.Symbol("zeta")])])
+
+
+def test_linearization_about_equilibrium_equals_closed_form_four_bar() -> None:
+    """The four-bar of examples/four_bar.toml (torsion spring k on the crank, rest angle 1):
+    at its equilibrium the stiffness is V''(θ1) of the potential along the manifold and the
+    mass T = ½·M·θ̇1², both in closed form from the circle intersection; the eigenvalues are
+    ±i·√(K/M). Finite differences on both sides: fixed relative tolerances."""
+    from jourdain.io.modelfile import load_model
+    from jourdain.loops.linearization import equilibrium, linearize_loop
+
+    mf = load_model(EXAMPLES / "four_bar.toml")
+    k_s, g = 20.0, FB["g"]
+    a, b, c = FB["a"], FB["b"], FB["c"]
+
+    def V(th1: float) -> float:
+        phi2, th3, _, _ = _four_bar_closed_form(th1, 1.0, FB)
+        return (0.5 * k_s * (th1 - 1.0) ** 2 + FB["m1"] * g * a / 2 * math.sin(th1)
+                + FB["m2"] * g * (a * math.sin(th1) + b / 2 * math.sin(phi2))
+                + FB["m3"] * g * c / 2 * math.sin(th3))
+
+    z = equilibrium(mf.loops, [0.5, 0.8, 1.9])
+    th = float(z[0])
+    hh = 1e-3
+    dV = (V(th - 2 * hh) - 8 * V(th - hh) + 8 * V(th + hh) - V(th + 2 * hh)) / (12 * hh)
+    K_ref = (-V(th - 2 * hh) + 16 * V(th - hh) - 30 * V(th) + 16 * V(th + hh)
+             - V(th + 2 * hh)) / (12 * hh * hh)
+    assert abs(dV) <= 1e-9 * K_ref
+    phi2, th3, w2, w3 = _four_bar_closed_form(th, 1.0, FB)
+    vc = a * np.array([-math.sin(th), math.cos(th)]) + b / 2 * w2 * np.array(
+        [-math.sin(phi2), math.cos(phi2)])
+    M_ref = (FB["m1"] * a * a / 3 + FB["m2"] * vc @ vc + FB["m2"] * b * b / 12 * w2 ** 2
+             + FB["m3"] * c * c / 3 * w3 ** 2)
+    lin = linearize_loop(mf.loops, z)
+    assert lin.names == ("theta1",)
+    assert abs(lin.M_tilde[0, 0] - M_ref) <= 1e-12 * M_ref * 10
+    assert abs(lin.K[0, 0] - K_ref) <= 1e-7 * K_ref
+    assert np.max(np.abs(lin.P)) <= 1e-7 * K_ref and np.max(np.abs(lin.N)) == 0.0
+    w = math.sqrt(K_ref / M_ref)
+    assert np.allclose(lin.eigenvalues, [-1j * w, 1j * w], rtol=1e-7, atol=1e-7 * w)
+
+
+def test_cli_check_and_run_on_the_four_bar(tmp_path: Path, capsys: pytest.CaptureFixture
+                                           ) -> None:
+    import json
+
+    from jourdain.cli import main
+
+    assert main(["check", str(EXAMPLES / "four_bar.toml")]) == 0
+    text = capsys.readouterr().out
+    assert "closure" in text and "1 by the rank 2 of Φ_z" in text and "1 (planar)" in text
+    assert main(["check", "--json", str(EXAMPLES / "slider_crank.toml")]) == 0
+    s = json.loads(capsys.readouterr().out)["loops"]
+    assert s["degrees_of_freedom_rank"] == 1 and s["independent"] == ["phi"]
+    assert s["assembly_residual"]["Phi"] <= 1e-12
+    out = tmp_path / "rep"
+    assert main(["run", str(EXAMPLES / "four_bar.toml"), "--out", str(out), "--t-end",
+                 "0.5"]) == 0
+    info = json.loads((out / "loops.json").read_text())
+    assert info["status"] == "finished" and info["max_Phi"] <= 1e-10
+    assert info["max_Phi_dot"] <= 1e-10 and len(info["eigenvalues"]) == 2
+    for f in ("index.html", "constraint_residual.png", "reactions.png", "motion.csv"):
+        assert (out / f).stat().st_size > 0

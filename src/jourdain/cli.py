@@ -310,6 +310,11 @@ def cmd_check(args: argparse.Namespace) -> int:
             raise model.error(str(exc)) from None
     _check_initial_state(model)
     s = summary(model)
+    loops = getattr(model, "loops", None)
+    if loops is not None:  # closing joints (jourdain.loops): the loops and their mobility
+        from .loops.report import check_lines, loop_summary
+
+        s["loops"] = loop_summary(model)
     if args.json:
         print(json.dumps(s, indent=2))
         return EXIT_OK
@@ -337,6 +342,9 @@ def cmd_check(args: argparse.Namespace) -> int:
     if s["cyclic_coordinates"]:
         print(f"  cyclic coordinates: {', '.join(s['cyclic_coordinates'])} (in no equation, only "
               "their rates; stability verdicts are taken in Routh's sense without them)")
+    if loops is not None:
+        for line in check_lines(model):
+            print(line)
     return EXIT_OK
 
 
@@ -853,6 +861,13 @@ def cmd_run(args: argparse.Namespace) -> int:
     params = _overrides(model.system, args.set)
     opts = _sim_options(model, args)
     out = _output_folder(args.out, args.force, model)
+    if getattr(model, "loops", None) is not None:  # a loop model: jourdain.loops' report
+        from .loops.report import run_report
+
+        for line in run_report(model, out, params, opts.get("t_end")):
+            print(line)
+        print(f"report: {out / 'index.html'}")
+        return EXIT_OK
     progress = _progress(args.progress, f"simulating {model.system.name}")
     try:
         info = write_report(model, out, parameters=params, t_end=opts.get("t_end"),

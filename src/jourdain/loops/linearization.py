@@ -1,0 +1,108 @@
+"""Linearization of a closed-loop system in its independent coordinates (METHOD.md §5, §6).
+
+About a nominal motion ``y_s`` (with ``ẏ_s``, ``ÿ_s``) of the independent coordinates:
+
+    M̃ = M(y_s),  P = ∂(k − q)/∂ẏ |_s,  Q = ∂(M·ÿ_s + k − q)/∂y |_s,  h = q − k − M·ÿ_s
+
+and ``D, G, K, N`` as the symmetric and skew parts of P and Q. M, k and q are those of
+:class:`jourdain.loops.closed_loop.LoopEvaluator` (dependent coordinates by Newton on the
+manifold), so their derivatives are taken by central differences of the compiled
+evaluation: the step ``δ = ε^(1/3)·(1 + |y_i|)`` balances truncation (δ²) against rounding
+(ε/δ), about 1e-10 relative; a symbolic derivative would need the dependent coordinates as
+functions of y, which exist only implicitly.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .closed_loop import ClosedLoopSystem, LoopEvaluator
+
+
+@dataclass(frozen=True)
+class LoopLinearization:
+    """``M_tilde, P, Q, h`` and ``D, G, K, N`` (f×f, f) in the independent coordinates
+    ``names``; ``A`` (2f×2f) the state matrix of ``x = (η, η̇)``; ``eigenvalues`` of A
+    sorted by real part, then imaginary part."""
+
+    names: tuple[str, ...]
+    y_s: np.ndarray
+    z_s: np.ndarray
+    M_tilde: np.ndarray
+    P: np.ndarray
+    Q: np.ndarray
+    h: np.ndarray
+    D: np.ndarray
+    G: np.ndarray
+    K: np.ndarray
+    N: np.ndarray
+    A: np.ndarray
+    eigenvalues: np.ndarray
+
+
+def linearize_loop(loop: ClosedLoopSystem, z_s: Any, zd_s: Any = None, t: float = 0.0,
+                   ydd_s: Any = None, parameters: Mapping[str, float] | None = None
+                   ) -> LoopLinearization:
+    """Linearize ``loop`` about the configuration assembled from ``z_s`` (independent
+    coordinates held), with rates from ``zd_s`` (default rest) and ``ÿ_s`` (default 0)."""
+    ev = LoopEvaluator(loop, z_s, t, parameters)
+    asm = ev.assemble(z_s, zd_s, t)
+    ind = list(ev.part.independent)
+    y0, yd0 = asm.z[ind], asm.zd[ind]
+    f = len(ind)
+    ydd = np.zeros(f) if ydd_s is None else np.asarray(ydd_s, dtype=float).reshape(f)
+    z_ref = asm.z.copy()
+
+    def parts(y: np.ndarray, yd: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        ev.z_guess = z_ref.copy()
+        ev._last = None
+        s = ev.mkq(y, yd, t)
+        return s["M"], s["k"] - s["q"]
+
+    M0, r0 = parts(y0, yd0)
+    step = np.finfo(float).eps ** (1 / 3)
+    P = np.zeros((f, f))
+    Q = np.zeros((f, f))
+    for i in range(f):
+        e = np.zeros(f)
+        e[i] = step * (1 + abs(y0[i]))
+        Mp, rp = parts(y0 + e, yd0)
+        Mm, rm = parts(y0 - e, yd0)
+        Q[:, i] = ((Mp - Mm) @ ydd + rp - rm) / (2 * e[i])
+        e[i] = step * (1 + abs(yd0[i]))
+        _, rp = parts(y0, yd0 + e)
+        _, rm = parts(y0, yd0 - e)
+        P[:, i] = (rp - rm) / (2 * e[i])
+    h = -r0 - M0 @ ydd
+    Minv = np.linalg.inv(M0)
+    A = np.block([[np.zeros((f, f)), np.eye(f)], [-Minv @ Q, -Minv @ P]])
+    lam = np.linalg.eigvals(A)
+    order = np.lexsort((lam.imag, lam.real))
+    return LoopLinearization(tuple(ev.independent_names), y0, asm.z, M0, P, Q, h,
+                             (P + P.T) / 2, (P - P.T) / 2, (Q + Q.T) / 2, (Q - Q.T) / 2, A,
+                             lam[order])
+
+
+def equilibrium(loop: ClosedLoopSystem, z_guess: Any, t: float = 0.0,
+                parameters: Mapping[str, float] | None = None, tol: float = 1e-12,
+                max_iter: int = 50) -> np.ndarray:
+    """An equilibrium ``q − k = 0`` at rest near ``z_guess`` (Newton in the independent
+    coordinates with the finite-difference stiffness of :func:`linearize_loop`); returns z."""
+    z = np.asarray(z_guess, dtype=float).copy()
+    for _ in range(max_iter):
+        lin = linearize_loop(loop, z, None, t, None, parameters)
+        if np.max(np.abs(lin.h)) <= tol * (1 + np.max(np.abs(lin.Q))):
+            return lin.z_s
+        ev = LoopEvaluator(loop, lin.z_s, t, parameters)
+        ind = list(ev.part.independent)
+        z = lin.z_s.copy()
+        z[ind] += np.linalg.solve(lin.Q, lin.h)
+    from .closed_loop import AssemblyError
+    raise AssemblyError(f"{loop.name}: no equilibrium found near {list(z_guess)}")
+
+
+__all__ = ["LoopLinearization", "equilibrium", "linearize_loop"]

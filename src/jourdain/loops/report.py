@@ -1,0 +1,183 @@
+"""What ``jourdain check`` and ``jourdain run`` show of a loop model.
+
+``check``: the closing joints, the rows of Φ, the degrees of freedom by Grübler's count and by
+the rank of the constraint Jacobian at the initial configuration, and the partition.
+``run``: assembly, a simulation on the manifold, the constraint residuals |Φ| and |Φ̇| along
+the motion, the closing joints' reactions, the energy, and the linearization about the
+equilibrium nearest the initial configuration with its eigenvalues: an HTML page with plots
+and a CSV of the motion.
+"""
+
+from __future__ import annotations
+
+import html
+import json
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import JourdainError
+from .closed_loop import ClosedLoopSystem, constraints
+
+
+def loop_summary(model: Any) -> dict[str, Any]:
+    """Closing joints, constraint rows, degrees of freedom (Grübler, rank) and partition."""
+    loop: ClosedLoopSystem = model.loops
+    sim = model.simulation
+    ev = loop.evaluator(sim.y0)
+    asm = ev.assemble(sim.y0, sim.yd0)
+    rank = ev.rank(asm.z)
+    planar = _planar_grubler(loop)
+    return {
+        "closing_joints": [{"name": c.name, "type": c.type, "body_a": c.body_a,
+                            "body_b": c.body_b} for c in loop.closing],
+        "constraint_rows": constraints(loop).labels,
+        "tree_coordinates": loop.coordinate_names,
+        "degrees_of_freedom_grubler_spatial": loop.grubler(),
+        "degrees_of_freedom_grubler_planar": planar,
+        "degrees_of_freedom_rank": loop.n - rank,
+        "rank_Phi_z": rank,
+        "independent": list(ev.independent_names),
+        "dependent": list(ev.dependent_names),
+        "cond_Phi_d": ev.part.cond,
+        "assembly_residual": {"Phi": asm.Phi, "Phi_dot": asm.Phi_dot,
+                              "newton_iterations": asm.iterations},
+        "z0": asm.z.tolist(),
+    }
+
+
+def _planar_grubler(loop: ClosedLoopSystem) -> int | None:
+    """Grübler's planar count 3·n − Σ(3 − f_j) when every joint is a revolute about z or a
+    prismatic joint in the x-y plane (None otherwise)."""
+    from ..model.joints import Rot, Trans
+
+    dofs = []
+    for b in loop.tree.bodies:
+        j = b.joint
+        moving = [s for s in j.steps if isinstance(s, Rot) and s.angle.free_symbols
+                  or isinstance(s, Trans) and any(v.free_symbols for v in s.vector)]
+        for s in moving:
+            if isinstance(s, Rot) and tuple(s.axis) != (0, 0, 1):
+                return None
+            if isinstance(s, Trans) and s.vector[2] != 0:
+                return None
+        dofs.append(len(j.coordinates))
+    total = 3 * len(loop.tree.bodies) - sum(3 - f for f in dofs)
+    for c in loop.closing:
+        if c.type not in ("revolute", "prismatic") or (c.axis and tuple(c.axis) != (0, 0, 1)
+                                                       and c.type == "revolute"):
+            return None
+        total -= 2
+    return total
+
+
+def check_lines(model: Any) -> list[str]:
+    s = loop_summary(model)
+    lines = [f"  loops: {len(s['closing_joints'])} closing joint(s), "
+             f"{len(s['constraint_rows'])} constraint equations Φ = 0 "
+             f"({', '.join(s['constraint_rows'])})"]
+    for c in s["closing_joints"]:
+        lines.append(f"    {c['name']:<14} {c['type']:<12} {c['body_a']} ↔ {c['body_b']}")
+    planar = s["degrees_of_freedom_grubler_planar"]
+    lines.append(
+        f"  degrees of freedom of the mechanism: {s['degrees_of_freedom_rank']} by the rank "
+        f"{s['rank_Phi_z']} of Φ_z at the assembled initial configuration; Grübler: "
+        f"{s['degrees_of_freedom_grubler_spatial']} (spatial)"
+        + (f", {planar} (planar)" if planar is not None else ""))
+    lines.append(f"  independent: {', '.join(s['independent'])}; dependent: "
+                 f"{', '.join(s['dependent'])} (cond Φ_d = {s['cond_Phi_d']:.3g}); assembly "
+                 f"residual |Φ| = {s['assembly_residual']['Phi']:.2e}, |Φ̇| = "
+                 f"{s['assembly_residual']['Phi_dot']:.2e}")
+    return lines
+
+
+def run_report(model: Any, out: Path, parameters: Mapping[str, float] | None = None,
+               t_end: float | None = None) -> list[str]:
+    """Simulate and linearize a loop model, write ``index.html``, plots and ``motion.csv``
+    into ``out``; returns summary lines."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from .linearization import equilibrium, linearize_loop
+    from .simulate import simulate_loop
+
+    loop: ClosedLoopSystem = model.loops
+    sim = model.simulation
+    t1 = float(t_end if t_end is not None else sim.t_end)
+    out.mkdir(parents=True, exist_ok=True)
+    res = simulate_loop(loop, (0.0, t1), sim.y0, sim.yd0, samples=sim.samples,
+                        parameters=parameters)
+    names = loop.coordinate_names
+    lines = res.summary().splitlines()
+    # linearization about the equilibrium nearest the initial configuration
+    lin = None
+    try:
+        zeq = equilibrium(loop, res.z[0], parameters=parameters)
+        lin = linearize_loop(loop, zeq, parameters=parameters)
+        eig = ", ".join(f"{v.real:.6g}{v.imag:+.6g}j" for v in lin.eigenvalues)
+        lines.append(f"  equilibrium z = {np.round(zeq, 6).tolist()}; eigenvalues in "
+                     f"{', '.join(lin.names)}: {eig}")
+    except (JourdainError, np.linalg.LinAlgError) as exc:
+        lines.append(f"  no linearization: {exc}")
+    # CSV of the motion, residuals and reactions
+    cols = ["t", *names, *[f"{n}_d" for n in names], *[f"Phi[{r}]" for r in res.labels],
+            *[f"Phi_d[{r}]" for r in res.labels], *[f"lambda[{r}]" for r in res.labels],
+            "T", "V"]
+    data = np.column_stack([res.t, res.z, res.zd, res.Phi, res.Phi_dot, res.lam, res.T,
+                            res.V])
+    np.savetxt(out / "motion.csv", data, delimiter=",", header=",".join(cols), comments="")
+    figs = []
+    fig, ax = plt.subplots(figsize=(7, 3.5))
+    for i, n in enumerate(names):
+        ax.plot(res.t, res.z[:, i], label=n)
+    ax.set_xlabel("t / s")
+    ax.set_ylabel("tree coordinates")
+    ax.legend()
+    figs.append(("coordinates.png", fig))
+    fig, ax = plt.subplots(figsize=(7, 3.5))
+    tiny = 1e-300
+    ax.semilogy(res.t, np.max(np.abs(res.Phi), axis=1) + tiny, label="max |Φ|")
+    ax.semilogy(res.t, np.max(np.abs(res.Phi_dot), axis=1) + tiny, label="max |Φ̇|")
+    ax.set_xlabel("t / s")
+    ax.set_ylabel("constraint residual")
+    ax.legend()
+    figs.append(("constraint_residual.png", fig))
+    fig, ax = plt.subplots(figsize=(7, 3.5))
+    for i, r in enumerate(res.labels):
+        ax.plot(res.t, res.lam[:, i], label=r)
+    ax.set_xlabel("t / s")
+    ax.set_ylabel("closing-joint reactions λ")
+    ax.legend()
+    figs.append(("reactions.png", fig))
+    fig, ax = plt.subplots(figsize=(7, 3.5))
+    E = res.total_energy
+    ax.plot(res.t, E - E[0])
+    ax.set_xlabel("t / s")
+    ax.set_ylabel("E − E₀ / J")
+    figs.append(("energy.png", fig))
+    for fname, fg in figs:
+        fg.tight_layout()
+        fg.savefig(out / fname, dpi=90)
+        plt.close(fg)
+    info = {"name": loop.name, "status": res.status, "message": res.message,
+            "max_Phi": res.max_Phi, "max_Phi_dot": res.max_Phi_dot,
+            "energy_drift": res.energy_drift,
+            "partitions": [[t, list(n)] for t, n in res.partitions],
+            "eigenvalues": None if lin is None else [[v.real, v.imag]
+                                                     for v in lin.eigenvalues]}
+    (out / "loops.json").write_text(json.dumps(info, indent=2))
+    body = "\n".join(f"<p>{html.escape(x)}</p>" for x in lines)
+    imgs = "\n".join(f'<img src="{f}" alt="{f}">' for f, _ in figs)
+    (out / "index.html").write_text(
+        f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{html.escape(loop.name)}"
+        f"</title></head><body><h1>{html.escape(loop.name)}</h1>{body}{imgs}"
+        "<p>motion.csv: tree coordinates, rates, constraint residuals, closing-joint "
+        "reactions and energies at every sample.</p></body></html>")
+    return lines
+
+
+__all__ = ["check_lines", "loop_summary", "run_report"]
