@@ -91,6 +91,20 @@ def _energy_function(system: System) -> tuple[Any, bool, tuple[str, ...], bool]:
 
 
 @lru_cache(maxsize=32)
+def _potential_rate_function(system: System) -> Any:
+    """Compiled ``∂V/∂t`` (the explicit change of the potential with t), or None where V does
+    not depend on t."""
+    from .energy import energy
+    from .numeric import lambdify
+    from .symbolic import SymMatrix
+
+    rate = se.diff(energy(system.kinematics()).V, system.t)
+    if rate.is_Number and rate == 0:
+        return None
+    return lambdify(system, {"dVdt": SymMatrix.column([rate])})
+
+
+@lru_cache(maxsize=32)
 def _drive_power_function(system: System) -> Any:
     """Compiled ``a`` (f×1) and ``b`` (1×1) of the power of a prescribed (rheonomic) motion,
     ``P = aᵀ·ÿ + b``: with ``ṽ = [v̄_1; …; v̄_p; ω̄_1; …; ω̄_p]`` the explicitly time-dependent
@@ -279,13 +293,36 @@ class Results:
 
     @property
     def work_nonconservative(self) -> np.ndarray:
-        """Work of the non-conservative forces since t0: ``W + V − V(t0)``, (N,).
+        """Work of the non-conservative forces since t0: ``W + V − V(t0) − ∫∂V/∂t dt``, (N,).
 
         ``W`` (integrated with the motion) is the work of all generalized applied forces; the
-        conservative ones did ``−(V − V0)`` of it.
+        conservative ones did ``−∫ẏᵀ·∂V/∂y dt = −(V − V0) + ∫∂V/∂t dt`` of it. The last term,
+        the explicit change of a potential with t (gravity on a support moved by a prescribed
+        motion), is the drive's and is in :attr:`work_drive`.
         """
         V = self.potential_energy
-        return self.W + V - V[0]
+        return self.W + V - V[0] - self._potential_time_work()
+
+    def _potential_time_work(self) -> np.ndarray:
+        """``∫∂V/∂t dt`` since t0 along the motion (three-point Gauss–Legendre per step, as
+        :attr:`work_drive`); zeros where V does not depend on t explicitly, and for results
+        loaded without the system (which do not know it either, like :attr:`work_drive`)."""
+        if "W_Vt" in self._energies:
+            return self._energies["W_Vt"]
+        system = self.system
+        fn = None if system is None else _potential_rate_function(system)
+        if fn is None or len(self.t) < 2:
+            W = np.zeros(len(self.t))
+        else:
+            T = self.t
+            h = np.diff(T)
+            tq = (T[:-1, None] + h[:, None] * _GAUSS_S[None, :]).reshape(-1)
+            m = self.interpolate(tq)
+            p = np.array([self.parameters[k] for k, _ in system.parameters])
+            rate = fn.batch(m["y"], m["yd"], tq, p, None)["dVdt"][:, 0, 0].reshape(-1, 3)
+            W = np.concatenate([[0.0], np.cumsum(h * (rate @ _GAUSS_W))])
+        self._energies["W_Vt"] = W
+        return W
 
     @property
     def conservative(self) -> bool:
