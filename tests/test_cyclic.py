@@ -108,6 +108,11 @@ def test_detection():
                                                jd.RotationalSpringDamper("k", x, stiffness=5.0)],
                        parameters={"m": 1.0})
     assert cyclic_coordinates(sprung) == ()
+    # a force with no real value at many random states (sqrt(1 − x²)): those states are
+    # skipped, and x, which occurs, is not cyclic
+    root = jd.System([x], [cart], [jd.GeneralizedForce("f", x, -jd.sqrt(1 - x**2))],
+                     parameters={"m": 1.0})
+    assert cyclic_coordinates(root) == ()
     # the pendulum on a free cart: the hanging position is stable with x cyclic
     st = jd.stability(s.linearize({"x": 0, "phi": 0}))
     assert st.verdict == jd.analysis.MARGINALLY_STABLE and st.cyclic == ("x",)

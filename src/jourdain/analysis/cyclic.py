@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..differentiate import Graph, free_symbol_names, jet_float
+from ..errors import JourdainError
 
 if TYPE_CHECKING:
     from ..model.system import System
@@ -68,16 +69,25 @@ def cyclic_coordinates(source: System | EquationsOfMotion) -> tuple[str, ...]:
         rng = np.random.default_rng(20261123)
         base = system.parameter_values
         still = set(candidates)
-        for trial in range(2):
-            values = dict(base) if trial == 0 else _perturbed(base, rng)
+        done = 0
+        # two trials; a random state where the expressions have no real value (sqrt of a
+        # negative number, a singular position) is skipped, at most six are drawn
+        for attempt in range(6):
+            if done == 2:
+                break
+            values = dict(base) if attempt == 0 else _perturbed(base, rng)
             values["t"] = float(rng.uniform(0.0, 2.0))
-            M_bar = np.array(evaluate_float(ne.M_bar.entries(), values)).reshape(n6, n6)
             for syms, lo, hi in ((system.y, -np.pi, np.pi), (system.yd, -1.0, 1.0),
                                  (system.inputs, -1.0, 1.0)):
                 values.update({str(s): float(rng.uniform(lo, hi)) for s in syms})
             # after the first trial only the coordinates still in question are differentiated
             remaining = sorted(still)
-            jet = jet_float(graph, [system.y[i] for i in remaining], values)
+            try:
+                M_bar = np.array(evaluate_float(ne.M_bar.entries(), values)).reshape(n6, n6)
+                jet = jet_float(graph, [system.y[i] for i in remaining], values)
+            except JourdainError:
+                continue
+            done += 1
             J = jet.values[2 * f:].reshape(n6, f)
             dJ = jet.jacobian[2 * f:].reshape(n6, f, len(remaining))
             MJ = M_bar @ J
@@ -95,7 +105,8 @@ def cyclic_coordinates(source: System | EquationsOfMotion) -> tuple[str, ...]:
                     still.discard(i)
             if not still:
                 break
-        cyclic |= still
+        if done:  # no state with numbers: nothing is called cyclic that occurs at all
+            cyclic |= still
     return tuple(names[i] for i in sorted(cyclic))
 
 
