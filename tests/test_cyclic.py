@@ -149,3 +149,17 @@ def test_numeric_linearization_keeps_its_equations():
     assert num.equations_of_motion is not None
     st = jd.stability(num)
     assert st.cyclic == ("psi", "phi") and st.verdict == jd.analysis.MARGINALLY_STABLE, st.reason
+
+
+@pytest.mark.parametrize("name", ["precessing_top", "heavy_top", "wheel_creep", "robot_arm",
+                                  "double_pendulum"])
+def test_compiled_screen_agrees_with_exact_derivatives(name, monkeypatch):
+    """The compiled shift test (the fast path) and the exact derivatives of the expression
+    graph (forward mode) find the same cyclic coordinates."""
+    from jourdain.analysis import cyclic
+
+    system = load_model(Path(__file__).parents[1] / "examples" / f"{name}.toml").system
+    fast = cyclic_coordinates(system)
+    assert cyclic._screen_compiled(system, list(range(system.f))) is not None
+    monkeypatch.setattr(cyclic, "_screen_compiled", lambda *a: None)
+    assert cyclic_coordinates(system) == fast
