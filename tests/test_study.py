@@ -244,10 +244,12 @@ def test_local_processes_and_dask_cluster_equal_the_serial_run() -> None:
                                   dashboard_address=None) as cluster, \
             distributed.Client(cluster) as client:
         on_cluster = run_study(spec, scheduler=client)
+        again = run_study(spec, scheduler=client)  # the same study twice on one client
         by_address = run_study(spec, scheduler=cluster.scheduler_address)
         # both workers took part (two blocks, one each or both on one: at least ran there)
         assert len(client.scheduler_info()["workers"]) == 2
     _same(on_cluster, serial)
+    _same(again, serial)
     _same(by_address, serial)
 
 

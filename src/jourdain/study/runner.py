@@ -170,14 +170,15 @@ def _run_dask(spec: StudySpec, todo: list[tuple[int, int]], scheduler: Any,
     own = not isinstance(scheduler, Client)
     client = Client(scheduler) if own else scheduler
     try:
-        spec_f = client.scatter(spec, broadcast=True)
-        futures = [client.submit(compute_block, spec_f, s, e, keys, pure=False)
+        # the spec (a few kB: the study and model texts) travels with each task; a scattered
+        # copy, content-keyed, raced with its release when the same study ran again
+        futures = [client.submit(compute_block, spec, s, e, keys, pure=False)
                    for s, e in todo]
         try:
             for fut in as_completed(futures):
                 yield fut.result()
         finally:
-            client.cancel(futures)
+            client.cancel([f for f in futures if not f.done()])
     finally:
         if own:
             client.close()
