@@ -1,0 +1,204 @@
+"""Kinematic loops: derivation and simulation of the four-bar, against sympy + SciPy and IDA.
+
+Derivation: jourdain's symbolic stages of a loop model (the tree's M, k, q and the
+constraints Φ, Φ_z, Φ_t, c) against sympy.physics.mechanics' ``KanesMethod`` with dependent
+speeds (configuration and velocity constraints) on the same four-bar (the model of
+``tests/test_loops.py``), and for the slider-crank.
+
+Simulation of the four-bar over ``T`` seconds from the same consistent state, each route's
+error measured against a reference (jourdain at rtol 1e-13) at the end:
+
+* jourdain: coordinate partitioning (``jourdain.loops.simulate.simulate_loop``, DOP853);
+* sympy + SciPy: Kane's ``mass_matrix_full`` and ``forcing_full`` lambdified (NumPy) and
+  integrated by ``solve_ivp`` (DOP853) in q, u with the dependent speeds from the velocity
+  constraints (the standard sympy route; Φ drifts with the integration error);
+* IDA (scikit-sundae, if installed): the index-1 redundant form in z, ż, λ with jourdain's
+  compiled tree and constraints in the residual.
+
+    python benchmarks/loops.py [--T 5]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from jourdain.loops import LoopEvaluator, constraints  # noqa: E402
+from jourdain.loops.models import four_bar, slider_crank  # noqa: E402
+from jourdain.loops.simulate import simulate_loop  # noqa: E402
+
+
+def derive_jourdain(make) -> float:  # noqa: ANN001
+    t0 = time.perf_counter()
+    loop = make()
+    loop.tree.equations_of_motion()
+    constraints(loop)
+    return time.perf_counter() - t0
+
+
+def derive_sympy() -> tuple[float, object]:
+    from tests.test_loops import _kane_four_bar
+
+    t0 = time.perf_counter()
+    fns = _kane_four_bar()
+    return time.perf_counter() - t0, fns
+
+
+def kane_full_four_bar():  # noqa: ANN201
+    """Kane's full (q, u) mass matrix and forcing of the four-bar, lambdified."""
+    import sympy as sm
+    import sympy.physics.mechanics as me
+
+    # the model of tests/test_loops.py::_kane_four_bar, kept whole: mass_matrix_full and
+    # forcing_full (q and u) for the integration
+    q1, q2, q3 = me.dynamicsymbols("q1:4")
+    u1, u2, u3 = me.dynamicsymbols("u1:4")
+    a, b, c, d, m1, m2, m3, g = sm.symbols("a b c d m1 m2 m3 g")
+    N = me.ReferenceFrame("N")
+    A = N.orientnew("A", "Axis", (q1, N.z))
+    B = A.orientnew("B", "Axis", (q2, A.z))
+    C = N.orientnew("C", "Axis", (q3, N.z))
+    A.set_ang_vel(N, u1 * N.z)
+    B.set_ang_vel(A, u2 * A.z)
+    C.set_ang_vel(N, u3 * N.z)
+    O = me.Point("O")
+    O.set_vel(N, 0)
+    Pa = O.locatenew("Pa", a * A.x)
+    Pa.v2pt_theory(O, N, A)
+    Ca = O.locatenew("Ca", a / 2 * A.x)
+    Ca.v2pt_theory(O, N, A)
+    Cb = Pa.locatenew("Cb", b / 2 * B.x)
+    Cb.v2pt_theory(Pa, N, B)
+    Pb = Pa.locatenew("Pb", b * B.x)
+    Pb.v2pt_theory(Pa, N, B)
+    O2 = O.locatenew("O2", d * N.x)
+    O2.set_vel(N, 0)
+    Cc = O2.locatenew("Cc", c / 2 * C.x)
+    Cc.v2pt_theory(O2, N, C)
+    Pc = O2.locatenew("Pc", c * C.x)
+    Pc.v2pt_theory(O2, N, C)
+    gap = Pb.pos_from(O) - Pc.pos_from(O)
+    dv = Pb.vel(N) - Pc.vel(N)
+    bodies = [me.RigidBody("crank", Ca, A, m1, (me.inertia(A, 0, 0, m1 * a**2 / 12), Ca)),
+              me.RigidBody("coupler", Cb, B, m2, (me.inertia(B, 0, 0, m2 * b**2 / 12), Cb)),
+              me.RigidBody("rocker", Cc, C, m3, (me.inertia(C, 0, 0, m3 * c**2 / 12), Cc))]
+    loads = [(Ca, -m1 * g * N.y), (Cb, -m2 * g * N.y), (Cc, -m3 * g * N.y)]
+    kane = me.KanesMethod(N, q_ind=[q1], u_ind=[u1], q_dependent=[q2, q3],
+                          u_dependent=[u2, u3],
+                          kd_eqs=[q1.diff() - u1, q2.diff() - u2, q3.diff() - u3],
+                          configuration_constraints=[gap.dot(N.x), gap.dot(N.y)],
+                          velocity_constraints=[dv.dot(N.x), dv.dot(N.y)])
+    kane.kanes_equations(bodies, loads)
+    syms = [q1, q2, q3, u1, u2, u3, a, b, c, d, m1, m2, m3, g]
+    return (sm.lambdify(syms, kane.mass_matrix_full, "numpy"),
+            sm.lambdify(syms, kane.forcing_full, "numpy"))
+
+
+PARS = [0.4, 1.0, 0.8, 1.1, 1.0, 2.0, 1.5, 9.81]
+
+
+def simulate_sympy(fns, z0, zd0, T, rtol):  # noqa: ANN001, ANN201
+    from scipy.integrate import solve_ivp
+
+    MMf, Ff = fns
+
+    def rhs(_t: float, x: np.ndarray) -> np.ndarray:
+        MM = np.asarray(MMf(*x, *PARS), dtype=float)
+        F = np.asarray(Ff(*x, *PARS), dtype=float).reshape(-1)
+        return np.linalg.solve(MM, F)
+
+    t0 = time.perf_counter()
+    r = solve_ivp(rhs, (0, T), np.concatenate([z0, zd0]), method="DOP853", rtol=rtol,
+                  atol=rtol * 1e-2)
+    return time.perf_counter() - t0, r.y[:3, -1], r.nfev
+
+
+def simulate_ida(loop, z0, zd0, T, rtol):  # noqa: ANN001, ANN201
+    from sksundae.ida import IDA
+
+    ev = LoopEvaluator(loop, z0)
+    n = loop.n
+    m = len(ev.labels)
+    zdd, lam = ev.redundant_accelerations(z0, zd0, 0.0)
+
+    def res(t: float, y: np.ndarray, yp: np.ndarray, r: np.ndarray) -> None:
+        z, v, lm = y[:n], y[n:2 * n], y[2 * n:]
+        tr = ev.tree_mkq.split(ev.tree_mkq.raw(np.ascontiguousarray(z),
+                                               np.ascontiguousarray(v), t, ev.p, ev.u))
+        cd = ev._con(z, v, t)
+        r[:n] = yp[:n] - v
+        r[n:2 * n] = tr["M"] @ yp[n:2 * n] + tr["k"][:, 0] - tr["q"][:, 0] - cd["Phi_z"].T @ lm
+        r[2 * n:] = cd["Phi_z"] @ yp[n:2 * n] + cd["c"][:, 0]
+
+    y0 = np.concatenate([z0, zd0, lam])
+    yp0 = np.concatenate([zd0, zdd, np.zeros(m)])
+    solver = IDA(res, rtol=rtol, atol=rtol * 1e-2, algebraic_idx=list(range(2 * n, 2 * n + m)))
+    t0 = time.perf_counter()
+    sol = solver.solve(np.array([0.0, T]), y0, yp0)
+    wall = time.perf_counter() - t0
+    zT = sol.y[-1, :n]
+    cd = ev._con(zT, sol.y[-1, n:2 * n], T)
+    return wall, zT, float(np.max(np.abs(cd["Phi"])))
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--T", type=float, default=5.0)
+    ap.add_argument("--json", action="store_true")
+    args = ap.parse_args()
+    T = args.T
+    out: dict = {}
+    out["derivation_s"] = {"jourdain_four_bar": derive_jourdain(four_bar),
+                           "jourdain_slider_crank": derive_jourdain(slider_crank)}
+    t_sym, _ = derive_sympy()
+    out["derivation_s"]["sympy_kane_four_bar"] = t_sym
+    loop = four_bar()
+    ref = simulate_loop(loop, (0, T), [0.5, 0.8, 1.9], [1.0, 0, 0], samples=2, rtol=1e-13,
+                        atol=1e-14)
+    z0, zd0, zT = ref.z[0], ref.zd[0], ref.z[-1]
+    rows = []
+    fns = kane_full_four_bar()
+    for rtol in (1e-8, 1e-10):
+        t0 = time.perf_counter()
+        r = simulate_loop(loop, (0, T), z0, zd0, samples=2, rtol=rtol, atol=rtol * 1e-2)
+        wall = time.perf_counter() - t0
+        rows.append({"route": "jourdain", "rtol": rtol, "wall_s": wall, "nfev": r.nfev,
+                     "error": float(np.max(np.abs(r.z[-1] - zT))), "max_Phi": r.max_Phi})
+        wall, zs, nfev = simulate_sympy(fns, z0, zd0, T, rtol)
+        rows.append({"route": "sympy+scipy", "rtol": rtol, "wall_s": wall, "nfev": nfev,
+                     "error": float(np.max(np.abs(zs - zT)))})
+        try:
+            wall, zi, phi = simulate_ida(loop, z0, zd0, T, rtol)
+            rows.append({"route": "IDA index-1", "rtol": rtol, "wall_s": wall,
+                         "error": float(np.max(np.abs(zi - zT))), "max_Phi_end": phi})
+        except ImportError:
+            rows.append({"route": "IDA index-1", "rtol": rtol, "skipped": "no scikit-sundae"})
+    out["simulation"] = rows
+    if args.json:
+        print(json.dumps(out, indent=2))
+        return
+    d = out["derivation_s"]
+    print(f"derivation: jourdain four-bar {d['jourdain_four_bar']:.3f} s, slider-crank "
+          f"{d['jourdain_slider_crank']:.3f} s; sympy KanesMethod four-bar "
+          f"{d['sympy_kane_four_bar']:.3f} s (ratio "
+          f"{d['sympy_kane_four_bar'] / d['jourdain_four_bar']:.0f}x)")
+    print(f"simulation of the four-bar over {T} s (error: max |z(T) − z_ref(T)|):")
+    for r in rows:
+        if "skipped" in r:
+            print(f"  {r['route']:<12} rtol {r['rtol']:.0e}: {r['skipped']}")
+            continue
+        extra = (f", max |Φ| {r['max_Phi']:.1e}" if "max_Phi" in r else
+                 f", |Φ(T)| {r['max_Phi_end']:.1e}" if "max_Phi_end" in r else "")
+        print(f"  {r['route']:<12} rtol {r['rtol']:.0e}: {r['wall_s']:.3f} s, error "
+              f"{r['error']:.2e}{extra}")
+
+
+if __name__ == "__main__":
+    main()
