@@ -291,6 +291,9 @@ def _model_of(model: Any) -> tuple[System, Any]:
     system = getattr(model, "system", None)
     if isinstance(system, System):
         return system, model
+    if type(model).__name__ == "ClosedLoopSystem":
+        raise ModelError("export_fmu: a model with closing joints (kinematic loops) cannot be "
+                         "exported; the FMU export covers tree-structured models only")
     raise ModelError(f"export_fmu: expected a jourdain.System or a model file (load_model), got "
                      f"{type(model).__name__}")
 
@@ -330,6 +333,9 @@ def export_fmu(model: Any, path: str | os.PathLike[str], *,
     from ... import __version__
 
     system, mf = _model_of(model)
+    if getattr(mf, "loops", None) is not None:
+        raise ModelError(f"{system.name!r} has closing joints (kinematic loops): the FMU export "
+                         "covers tree-structured models only; its FMU would leave the loops open")
     if system.f == 0:
         raise ModelError(f"{system.name!r} has no coordinates: an FMU needs continuous states")
     if not (0.0 < float(tolerance) < 1.0):
