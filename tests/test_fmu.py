@@ -5,10 +5,11 @@ with its CVode (BDF) and in co-simulation with the FMU's own Dormand–Prince 5(
 jourdain's simulation (DOP853 in C) of the same model. The tolerance 1e-6 on y and ẏ comes
 from the integrators' tolerances: both sides run at relative tolerances 1e-10 (FMU) and 1e-11
 (jourdain), so each keeps its local error near 1e-10 of the state, and the global errors over
-the runs below (3 s of a double pendulum released from 90°, 2 s of a quarter car on a road
-input) grow to about 1e-8 (measured: 2e-8 model exchange, 6e-10 co-simulation for the
-pendulum): 1e-6 is a hundred times that, and a thousand times below the states' size, so a
-wrong term in the FMU's equations fails it. Reaction outputs are compared with System.evaluate
+the runs below (3 s of a double pendulum released from 90°, 2 s of a quarter car) grow to
+1e-7 at most (measured on y and ẏ: pendulum 1.2e-7 model exchange, 3.4e-9 co-simulation;
+quarter car 2.5e-8 and 5.2e-11; along the road table 1.8e-9): 1e-6 leaves room for other
+machines' rounding and stays a thousand times below the states' size, so a wrong term in the
+FMU's equations fails it. Reaction outputs are compared with System.evaluate
 at the same states by the tolerance of the sub-tree path (tests/README.md, subtree_tol).
 """
 
