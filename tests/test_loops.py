@@ -402,3 +402,25 @@ def test_cli_check_and_run_on_the_four_bar(tmp_path: Path, capsys: pytest.Captur
     assert info["max_Phi_dot"] <= 1e-10 and len(info["eigenvalues"]) == 2
     for f in ("index.html", "constraint_residual.png", "reactions.png", "motion.csv"):
         assert (out / f).stat().st_size > 0
+
+
+def test_spatial_rssr_with_a_spherical_closing_joint() -> None:
+    """examples/spatial_rssr.toml: the ball joint keeps the ball centres b apart, so along the
+    whole motion cos θ3 = (a² + d² + c² − b² − 2ad·cos θ1)/(2ac·sin θ1) (closed form of
+    |A(θ1) − B(θ3)| = b), while the energy stays constant and the partition may change."""
+    mf = loads_model((EXAMPLES / "spatial_rssr.toml").read_text(), "spatial_rssr.toml")
+    loop = mf.loops
+    assert [r for r in loop.constraints().labels] == ["ball.Fx", "ball.Fy", "ball.Fz"]
+    assert loop.grubler() == 2
+    res = simulate_loop(loop, (0.0, 2.0), mf.simulation.y0, mf.simulation.yd0, samples=41,
+                        rtol=1e-10, atol=1e-12)
+    assert res.status == "finished"
+    a, b, c, d = 0.3, 1.2, 0.6, 1.0
+    th1, th3 = res.coordinate("theta1"), res.coordinate("theta3")
+    cos3 = (a * a + d * d + c * c - b * b - 2 * a * d * np.cos(th1)) / (2 * a * c * np.sin(th1))
+    tol = 10 * (2 * b * math.sqrt(3) * res.max_Phi + 3 * EPS * (a + b + c + d) ** 2) / (
+        2 * a * c * np.abs(np.sin(th1)))
+    assert np.all(np.abs(np.cos(th3) - cos3) <= tol)
+    assert res.max_Phi <= 1e-10 and res.max_Phi_dot <= 1e-10
+    E = res.total_energy
+    assert np.max(np.abs(E - E[0])) <= 1e-9 * max(abs(E[0]), float(np.max(res.T)))

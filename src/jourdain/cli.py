@@ -339,7 +339,7 @@ def cmd_check(args: argparse.Namespace) -> int:
           + ", ".join(f"{k} = {v:g}" for k, v in s["parameters"].items()))
     if s["nominal_motions"]:
         print("  nominal motions: " + ", ".join(s["nominal_motions"]))
-    if s["cyclic_coordinates"]:
+    if s["cyclic_coordinates"] and loops is None:  # the tree's, not the loop system's
         print(f"  cyclic coordinates: {', '.join(s['cyclic_coordinates'])} (in no equation, only "
               "their rates; stability verdicts are taken in Routh's sense without them)")
     if loops is not None:
