@@ -6,8 +6,8 @@ import argparse
 import time
 from typing import Any
 
-EXAMPLE = ("jourdain study --spec examples/rotor_stability_map.toml --out map.nc --plots plots/\n"
-           "  jourdain study examples/rotor_internal_damping.toml --spec map.toml "
+EXAMPLE = ("jourdain study --spec examples/studies/rotor_stability_map.toml --out map.nc "
+           "--plots plots/\n  jourdain study --spec examples/studies/rotor_critical_speed.toml "
            "--scheduler tcp://10.0.0.5:8786")
 
 

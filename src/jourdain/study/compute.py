@@ -23,7 +23,7 @@ A case that fails records its error (a string) and NaN outputs; it never stops t
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -58,6 +58,9 @@ class Context:
     compiled_linearization: Any = None
     cyclic: tuple[str, ...] = ()
     bounds: Any = None
+    #: problems of the model's numbers found so far, by the values of the parameters the
+    #: bodies and joints use ("" where the values passed the checks)
+    checked: dict[tuple[float, ...], str] = field(default_factory=dict)
 
     @property
     def parameter_names(self) -> list[str]:
@@ -251,14 +254,22 @@ def _check_parameters(ctx: Context, P: np.ndarray, errors: list[str]) -> np.ndar
     combos, inverse = np.unique(P[:, cols], axis=0, return_inverse=True)
     base = ctx.p0.tolist()
     for c, row in enumerate(combos):
-        vals = dict(zip(names, base, strict=True))
-        vals.update({names[j]: float(x) for j, x in zip(cols, row, strict=True)})
-        try:
-            check_values(ctx.system.bodies, vals)
-        except _FAILURES as exc:
+        key = tuple(row.tolist())
+        problem = ctx.checked.get(key)
+        if problem is None:
+            vals = dict(zip(names, base, strict=True))
+            vals.update({names[j]: float(x) for j, x in zip(cols, row, strict=True)})
+            try:
+                check_values(ctx.system.bodies, vals)
+                problem = ""
+            except _FAILURES as exc:
+                problem = f"parameters: {exc}"
+            if len(ctx.checked) < 100_000:
+                ctx.checked[key] = problem
+        if problem:
             for i in np.flatnonzero(inverse.reshape(-1) == c):
                 ok[i] = False
-                errors[i] = f"parameters: {exc}"
+                errors[i] = problem
     return ok
 
 

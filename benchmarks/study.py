@@ -1,0 +1,234 @@
+"""Parameter studies: a stability map and a Monte-Carlo simulation, against plain Python loops.
+
+1. A stability map of ``examples/rotor_internal_damping.toml`` over the spin rate Omega and the
+   internal damping d_i (``--n`` × ``--n`` grid, 100 × 100 = 10 000 cases by default):
+
+   * *loop*: what a user writes today, a Python loop over ``jourdain.analysis.stability`` of
+     the linearization (``System.linearize`` once, then per case the symbolic result evaluated
+     and judged); timed on ``--loop-cases`` cases, reported as cases per second;
+   * *loop, compiled*: the same loop over the compiled linearization (``lin.compile()``);
+   * *batched*: :func:`jourdain.study.run_study` in this process (blocks of 512 cases: one C
+     call for M̃, P, Q, h of a block, stacked solves and eigenvalues), the derivation and
+     compilation not counted (timed apart as *set-up*);
+   * *1 and 2 processes*, *2 Dask workers* (a ``LocalCluster``, started beforehand): the whole
+     ``run_study`` call, worker start and model rebuild in each worker included.
+
+   The batched verdicts are compared with the loop's on the cases the loop ran.
+
+2. A Monte-Carlo run of ``examples/quarter_car.toml`` (``--mc`` runs, 1 000 by default): body
+   and wheel masses, stiffnesses and damping drawn from normal distributions, 4 s of road
+   excitation each, the largest body displacement per run; 1 process against 2.
+
+    python benchmarks/study.py             # 10 000 cases, 1 000 runs (about a minute)
+    python benchmarks/study.py --quick     # 40 × 40 cases, 200 runs
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from jourdain.analysis import stability  # noqa: E402
+from jourdain.io.capabilities import nominal_mapping  # noqa: E402
+from jourdain.study import VERDICTS, loads_study, run_study  # noqa: E402
+from jourdain.study.compute import context  # noqa: E402
+
+ROTOR = ROOT / "examples" / "rotor_internal_damping.toml"
+CAR = ROOT / "examples" / "quarter_car.toml"
+
+
+def _map_spec(n: int) -> str:
+    return f"""[study]
+model = "{ROTOR}"
+name = "rotor stability map"
+design = "grid"
+block = 512
+[vary.Omega]
+range = {{ start = 0, stop = 40, num = {n} }}
+[vary.d_i]
+range = {{ start = 0.1, stop = 3.0, num = {n} }}
+[compute.linearize]
+"""
+
+
+def _mc_spec(n: int) -> str:
+    return f"""[study]
+model = "{CAR}"
+name = "quarter car Monte-Carlo"
+design = "random"
+samples = {n}
+seed = 1
+block = 25
+[vary.m_b]
+distribution = "normal"
+mean = 300
+std = 15
+[vary.k_s]
+distribution = "normal"
+mean = 15000
+std = 750
+[vary.d_s]
+distribution = "normal"
+mean = 1200
+std = 120
+[vary.k_t]
+distribution = "normal"
+mean = 180000
+std = 9000
+[compute.simulate]
+t_end = 4.0
+samples = 401
+max_abs = ["z_b"]
+final = false
+"""
+
+
+def _timed(fn):
+    t0 = time.perf_counter()
+    out = fn()
+    return time.perf_counter() - t0, out
+
+
+def stability_map(n: int, loop_cases: int) -> dict:
+    spec = loads_study(_map_spec(n))
+    t_setup, ctx = _timed(lambda: context(spec))
+    system, model = ctx.system, ctx.model
+    lin = system.linearize(nominal_mapping(system, model.nominal_motion()))
+    clin = lin.compile()
+    cases = ctx.cases
+    rng = np.random.default_rng(0)
+    pick = np.sort(rng.choice(len(cases), size=min(loop_cases, len(cases)), replace=False))
+
+    def loop(target: object) -> list[str]:
+        return [stability(target, parameters={"Omega": float(c[0]), "d_i": float(c[1])},
+                          cyclic=()).verdict for c in cases[pick]]
+
+    t_loop, verdicts_loop = _timed(lambda: loop(lin))
+    t_cloop, verdicts_cloop = _timed(lambda: loop(clin))
+    nominal = nominal_mapping(system, model.nominal_motion())
+
+    def relinearize() -> list[str]:  # System.linearize for every case, as a script would
+        return [stability(system.linearize(nominal), parameters={
+            "Omega": float(c[0]), "d_i": float(c[1])}, cyclic=()).verdict
+            for c in cases[pick[:5]]]
+
+    t_relin, _ = _timed(relinearize)
+    run_study(spec, workers=1)  # imports (xarray) and first calls, not counted
+    t_batch, ds = _timed(lambda: run_study(spec, workers=1))
+    ours = [VERDICTS[int(v)] for v in ds["verdict"].values.reshape(-1)[pick]]
+    agree = sum(a == b for a, b in zip(ours, verdicts_loop, strict=True))
+    t_p1, _ = _timed(lambda: run_study(spec, workers=1))
+    t_p2, ds2 = _timed(lambda: run_study(spec, workers=2))
+    same_p2 = bool(np.array_equal(ds2["max_real_part"].values, ds["max_real_part"].values))
+    dask = _dask(spec, ds)
+    N = len(cases)
+    out = {
+        "cases": N, "setup_s": t_setup,
+        "loop_cases_per_s": len(pick) / t_loop,
+        "compiled_loop_cases_per_s": len(pick) / t_cloop,
+        "relinearize_loop_cases_per_s": 5 / t_relin,
+        "batched_cases_per_s": N / t_batch,
+        "speedup_vs_relinearize_loop": (N / t_batch) / (5 / t_relin),
+        "speedup_vs_loop": (N / t_batch) / (len(pick) / t_loop),
+        "speedup_vs_compiled_loop": (N / t_batch) / (len(pick) / t_cloop),
+        "verdicts_agree": f"{agree}/{len(pick)}",
+        "compiled_loop_agrees": verdicts_cloop == verdicts_loop,
+        "unstable_fraction": float(np.mean(ds["verdict"].values == 2)),
+        "1_process_s": t_p1, "2_processes_s": t_p2, "processes_speedup": t_p1 / t_p2,
+        "2_processes_identical": same_p2, **dask,
+    }
+    return out
+
+
+def _dask(spec: object, ref: object, var: str = "max_real_part") -> dict:
+    """The study on a LocalCluster of 1 and of 2 worker processes (one thread each), the
+    workers warm (they built the model in a first run, not counted)."""
+    try:
+        import distributed
+    except ImportError:
+        return {"dask": "not installed"}
+    out: dict = {}
+    for n in (1, 2):
+        with distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                      dashboard_address=None) as cluster, \
+                distributed.Client(cluster) as client:
+            run_study(spec, scheduler=client)
+            t, ds = min((_timed(lambda: run_study(spec, scheduler=client)) for _ in range(3)),
+                        key=lambda r: r[0])
+        out[f"dask_{n}_workers_s"] = t
+        out[f"dask_{n}_identical"] = bool(np.array_equal(ds[var].values, ref[var].values,
+                                                         equal_nan=True))
+    out["dask_speedup"] = out["dask_1_workers_s"] / out["dask_2_workers_s"]
+    return out
+
+
+def monte_carlo(n: int) -> dict:
+    spec = loads_study(_mc_spec(n))
+    context(spec)
+    run_study(loads_study(_mc_spec(4)), workers=1)  # imports and first calls, not counted
+    t1, ds1 = _timed(lambda: run_study(spec, workers=1))
+    t2, ds2 = _timed(lambda: run_study(spec, workers=2))
+    z = ds1["max_abs_z_b"].values
+    return {"runs": n, "1_process_s": t1, "2_processes_s": t2, "speedup": t1 / t2,
+            **_dask(spec, ds1, "max_abs_z_b"),
+            "runs_per_s_1": n / t1, "runs_per_s_2": n / t2,
+            "identical": bool(np.array_equal(z, ds2["max_abs_z_b"].values, equal_nan=True)),
+            "failed": int(ds1.attrs["n_failed"]),
+            "max_abs_z_b_mean_mm": float(np.nanmean(z) * 1e3),
+            "max_abs_z_b_std_mm": float(np.nanstd(z, ddof=1) * 1e3)}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--n", type=int, default=100, help="grid points per axis of the map")
+    ap.add_argument("--loop-cases", type=int, default=300, help="cases timed in the loop")
+    ap.add_argument("--mc", type=int, default=1000, help="Monte-Carlo runs")
+    ap.add_argument("--quick", action="store_true", help="40 × 40 map, 200 runs")
+    ap.add_argument("--json", metavar="FILE", help="also write the figures as JSON")
+    args = ap.parse_args()
+    if args.quick:
+        args.n, args.loop_cases, args.mc = 40, 100, 200
+    with tempfile.TemporaryDirectory() as tmp:
+        os.chdir(tmp)
+        res = {"cpus": os.cpu_count(), "stability_map": stability_map(args.n, args.loop_cases),
+               "monte_carlo": monte_carlo(args.mc)}
+    m, c = res["stability_map"], res["monte_carlo"]
+    print(f"stability map, {m['cases']} cases of {ROTOR.name} (set-up {m['setup_s']:.2f} s):")
+    print(f"  loop over stability(lin):          {m['loop_cases_per_s']:10.0f} cases/s")
+    print(f"  loop over the compiled lin:        {m['compiled_loop_cases_per_s']:10.0f} cases/s")
+    print(f"  batched (run_study, 1 process):    {m['batched_cases_per_s']:10.0f} cases/s  "
+          f"{m['speedup_vs_loop']:.0f}x the loop, {m['speedup_vs_compiled_loop']:.0f}x the "
+          f"compiled loop; verdicts agree {m['verdicts_agree']}")
+    print(f"  run_study 1 process {m['1_process_s']:.2f} s, 2 processes "
+          f"{m['2_processes_s']:.2f} s: {m['processes_speedup']:.2f}x "
+          f"(identical: {m['2_processes_identical']})")
+    print(f"  loop calling System.linearize per case: {m['relinearize_loop_cases_per_s']:.1f} "
+          f"cases/s (batched: {m['speedup_vs_relinearize_loop']:.0f}x)")
+    if "dask_2_workers_s" in m:
+        print(f"  Dask LocalCluster (warm): 1 worker {m['dask_1_workers_s']:.3f} s, 2 workers "
+              f"{m['dask_2_workers_s']:.3f} s: {m['dask_speedup']:.2f}x (identical: "
+              f"{m['dask_1_identical']}, {m['dask_2_identical']})")
+    print(f"Monte-Carlo, {c['runs']} runs of {CAR.name}: 1 process {c['1_process_s']:.2f} s "
+          f"({c['runs_per_s_1']:.0f} runs/s), 2 processes {c['2_processes_s']:.2f} s "
+          f"({c['runs_per_s_2']:.0f} runs/s): {c['speedup']:.2f}x (identical: {c['identical']}); "
+          f"max |z_b| {c['max_abs_z_b_mean_mm']:.2f} ± {c['max_abs_z_b_std_mm']:.2f} mm")
+    if "dask_2_workers_s" in c:
+        print(f"  Dask LocalCluster (warm): 1 worker {c['dask_1_workers_s']:.2f} s, 2 workers "
+              f"{c['dask_2_workers_s']:.2f} s: {c['dask_speedup']:.2f}x (identical: "
+              f"{c['dask_1_identical']}, {c['dask_2_identical']})")
+    if args.json:
+        Path(args.json).write_text(json.dumps(res, indent=1))
+
+
+if __name__ == "__main__":
+    main()
