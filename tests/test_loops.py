@@ -424,3 +424,51 @@ def test_spatial_rssr_with_a_spherical_closing_joint() -> None:
     assert res.max_Phi <= 1e-10 and res.max_Phi_dot <= 1e-10
     E = res.total_energy
     assert np.max(np.abs(E - E[0])) <= 1e-9 * max(abs(E[0]), float(np.max(res.T)))
+
+
+def test_general_constraint_and_prismatic_closing_joint_give_the_same_motion() -> None:
+    """The four-bar closed by two constraint expressions (the loop closure in closed form)
+    has the M, k, q of the revolute closing joint; the slider-crank with the slider hanging
+    from the rod and a prismatic closing joint to the ground has the slider's closed-form
+    position."""
+    from jourdain.model import Body, Gravity, Revolute, System, rod, symbols
+
+    fb = four_bar()
+    th1, th2, th3, a, b, c, d = symbols("theta1 theta2 theta3 a b c d")
+    closure = ClosingJoint("loop", "constraint", expressions=[
+        a * se.cos(th1) + b * se.cos(th1 + th2) - d - c * se.cos(th3),
+        a * se.sin(th1) + b * se.sin(th1 + th2) - c * se.sin(th3)])
+    gen = ClosedLoopSystem(fb.tree, [closure], ("theta1",))
+    s1 = evaluate(fb, [1.1, 0.3, 1.9], [1.5, 0, 0])
+    s2 = evaluate(gen, [1.1, 0.3, 1.9], [1.5, 0, 0])
+    tol = solve_tol(s1["Phi_z"][:, 1:], 1 + float(np.max(np.abs(s1["q_tree"]))))
+    for k in ("z", "zd", "M", "k", "q"):
+        assert np.max(np.abs(s1[k] - s2[k])) <= tol * (1 + float(np.max(np.abs(s1[k]))))
+    # λ of the closed-form rows: the same pin force (x, y components)
+    assert np.max(np.abs(s1["lambda"] - s2["lambda"])) <= tol * 10 * (
+        1 + float(np.max(np.abs(s1["lambda"]))))
+
+    phi, psi, chi = symbols("phi psi chi")
+    r, l, m1, m2, m3, g = symbols("r l m1 m2 m3 g")
+    bodies = [Body("crank", "world", Revolute("main", phi, "z"), mass=m1,
+                   com=(r / 2, 0, 0), inertia=rod(m1, r, "x")),
+              Body("rod", "crank", Revolute("pin", psi, "z", position=(r, 0, 0)), mass=m2,
+                   com=(l / 2, 0, 0), inertia=rod(m2, l, "x")),
+              Body("slider", "rod", Revolute("wrist", chi, "z", position=(l, 0, 0)),
+                   mass=m3, inertia=(0.01, 0.01, 0.01))]
+    tree = System([phi, psi, chi], bodies, [Gravity((0, -g, 0))],
+                  parameters={"r": 0.3, "l": 1.0, "m1": 1.0, "m2": 1.5, "m3": 2.0, "g": 9.81})
+    guide = ClosingJoint("guide", "prismatic", "world", "slider", axis="x")
+    loop = ClosedLoopSystem(tree, [guide], ("phi",))
+    assert [row for row in loop.constraints().labels] == ["guide.N2", "guide.Mz"]
+    res = simulate_loop(loop, (0.0, 1.0), [0.5, -0.6, 0.1], [2.0, 0, 0], samples=11,
+                        rtol=1e-10, atol=1e-12)
+    ph = res.coordinate("phi")
+    x = 0.3 * np.cos(ph) + np.sqrt(1.0 - (0.3 * np.sin(ph)) ** 2)
+    x_ours = 0.3 * np.cos(ph) + np.cos(ph + res.coordinate("psi"))
+    assert np.max(np.abs(x_ours - x)) <= 10 * (res.max_Phi + 4 * EPS) * 10
+    # the slider does not turn: phi + psi + chi = 0
+    assert np.max(np.abs(ph + res.coordinate("psi") + res.coordinate("chi"))) <= 10 * (
+        res.max_Phi + 4 * EPS) * 10
+    E = res.total_energy
+    assert np.max(np.abs(E - E[0])) <= 1e-9 * max(abs(E[0]), float(np.max(res.T)))
