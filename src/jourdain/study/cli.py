@@ -30,7 +30,8 @@ def add_study_parser(subs: Any, parser_class: type) -> Any:
                    help="run on this dask.distributed scheduler (tcp://host:8786)")
     p.add_argument("--plots", metavar="DIR",
                    help="write the study's plots there (stability map, Campbell diagram, "
-                        "histograms) as SVG and PNG")
+                        "histograms) as SVG and PNG, and index.html: a page with the "
+                        "study, its plots, a summary of the outputs and the failed cases")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--force", action="store_true",
                    help="replace an existing --out file and the saved parts of another study")
@@ -50,7 +51,7 @@ def _workers(text: str) -> int:
 
 def cmd_study(args: argparse.Namespace) -> int:
     from . import load_study, run_study
-    from .plots import study_plots
+    from .plots import study_report
 
     spec = load_study(args.spec, model=args.model)
     t0 = time.perf_counter()
@@ -64,6 +65,5 @@ def cmd_study(args: argparse.Namespace) -> int:
     if args.out:
         print(f"results: {args.out}")
     if args.plots:
-        for path in study_plots(ds, args.plots):
-            print(f"plot: {path}")
+        print(f"report: {study_report(ds, args.plots)}")
     return 0
