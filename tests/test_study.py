@@ -283,7 +283,9 @@ def test_cli_study(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
     assert "40 cases" in text.out and text.err == ""
     ds = open_study(out)
     assert ds.attrs["seed"] == 2026 and ds.sizes["case"] == 40
-    assert (tmp_path / "plots" / "histogram_max_abs_x.svg").exists()
+    assert (tmp_path / "plots" / "histogram_max_abs_x.png").exists()
+    page = (tmp_path / "plots" / "index.html").read_text()
+    assert "<svg" in page and "max_abs_x" in page and "Failed cases (0)" in page
     assert main(["study", "--spec", str(DATA / "montecarlo.toml"), "--out", str(out),
                  "--workers", "1", "--quiet"]) != 0
     assert "exists" in capsys.readouterr().err
