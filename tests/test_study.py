@@ -163,6 +163,31 @@ def test_critical_speed_equals_closed_form() -> None:
     assert np.all(np.abs(ours - ref) <= tol), (ours - ref, tol)
 
 
+def test_critical_spin_of_the_sleeping_top_equals_closed_form() -> None:
+    """The sleeping top is stable above C²Ω² = 4·A₀·m·g·L, A₀ = A + m·L² (Klein–Sommerfeld;
+    Magnus), with the spin angle cyclic (Routh). The stable side is only marginally stable, so
+    the value is the bisection's: where the verdict changes. Within Δ of the threshold the two
+    nutation eigenvalues ±(i)·√|C²Ω² − C²Ω_c²|/(2A₀)-apart lie closer than the verdict's
+    cluster width r = 1e3·√eps·|λ| (modes._verdict groups them as one Jordan pair), so the
+    verdict changes within Δ = A₀²·r²/(2·C²·Ω_c) of Ω_c."""
+    root = Path(__file__).resolve().parents[1]
+    spec = loads_study(f'[study]\nmodel = "{root / "examples" / "heavy_top.toml"}"\n'
+                       'design = "list"\n[vary.L]\nvalues = [0.05, 0.1, 0.15]\n[vary.C]\n'
+                       'values = [0.006, 0.008, 0.006]\n[compute.critical]\nparameter = "Omega"\n'
+                       'lower = 1\nupper = 400\nabout = "fast"\n')
+    ds = run_study(spec, workers=1)
+    assert ds.attrs["cyclic_coordinates"] == "gamma"
+    m, A, g = 1.0, 0.004, 9.81
+    L, C = ds.L.values, ds.C.values
+    A0 = A + m * L**2
+    ref = np.sqrt(4 * A0 * m * g * L) / C
+    r = 1e3 * np.sqrt(EPS) * C * ref / (2 * A0)
+    tol = 2 * A0**2 * r**2 / (2 * C**2 * ref) + 1e-12 * ref
+    ours = ds["critical_Omega"].values
+    assert (ds.error.values == "").all()
+    assert np.all(np.abs(ours - ref) <= tol), (ours - ref, tol)
+
+
 # --- Monte-Carlo, failures, resuming -------------------------------------------------------------
 
 def test_monte_carlo_is_reproducible_from_its_seed() -> None:
