@@ -143,6 +143,19 @@ def _init_worker() -> None:
     numeric.clear_cache()
 
 
+def _result(fut: Any, spec: StudySpec) -> dict[str, Any]:
+    """A block's result; a block that failed as a whole (not one of its cases: a worker that
+    died, another jourdain on a cluster node) stops the study with a StudyError naming it (the
+    blocks saved so far stay, for a later run to resume from)."""
+    try:
+        return fut.result()
+    except StudyError:
+        raise
+    except Exception as exc:  # from another process: any type; re-raised as the study's error
+        raise StudyError(f"a block of the study failed in its worker: {type(exc).__name__}: "
+                         f"{exc}", spec.filename) from exc
+
+
 def _run_local(spec: StudySpec, todo: list[tuple[int, int]], workers: int,
                keys: dict[str, str]) -> Iterator[dict[str, Any]]:
     import concurrent.futures as cf
@@ -154,7 +167,7 @@ def _run_local(spec: StudySpec, todo: list[tuple[int, int]], workers: int,
         futures = [pool.submit(compute_block, spec, s, e, keys) for s, e in todo]
         try:
             for fut in cf.as_completed(futures):
-                yield fut.result()
+                yield _result(fut, spec)
         finally:
             for fut in futures:
                 fut.cancel()
@@ -168,7 +181,11 @@ def _run_dask(spec: StudySpec, todo: list[tuple[int, int]], scheduler: Any,
         raise StudyError("running on a Dask cluster needs dask.distributed: pip install "
                          "'jourdain[study]'") from None
     own = not isinstance(scheduler, Client)
-    client = Client(scheduler) if own else scheduler
+    try:
+        client = Client(scheduler) if own else scheduler
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise StudyError(f"cannot reach the Dask scheduler at {scheduler!r}: {exc}",
+                         spec.filename) from None
     try:
         # the spec (a few kB: the study and model texts) travels with each task; a scattered
         # copy, content-keyed, raced with its release when the same study ran again
@@ -176,7 +193,7 @@ def _run_dask(spec: StudySpec, todo: list[tuple[int, int]], scheduler: Any,
                    for s, e in todo]
         try:
             for fut in as_completed(futures):
-                yield fut.result()
+                yield _result(fut, spec)
         finally:
             client.cancel([f for f in futures if not f.done()])
     finally:

@@ -61,6 +61,12 @@ _COMPUTE_KEYS = {
 }
 
 
+#: Names of the results' dimensions and outputs that a varied quantity cannot have.
+RESERVED = frozenset({"case", "coordinate", "coordinate_j", "state", "mode", "time",
+                      "wrench_component", "error", "final", "verdict", "max_real_part",
+                      "eigenvalue_real", "eigenvalue_imag"})
+
+
 class StudyError(JourdainError, ValueError):
     """A mistake in a study file or study arguments; ``file`` and ``line`` say where."""
 
@@ -285,10 +291,16 @@ class _Reader:
         kinds = {n: "parameter" for n in defaults}
         kinds.update({n: "y0" for n in system.coordinate_names})
         kinds.update({f"{n}_d": "yd0" for n in system.coordinate_names})
-        vary = self.table(top.get("vary", {}), ("vary",), set(kinds) | set(top.get("vary", {})))
+        raw_vary = top.get("vary", {})
+        vary = self.table(raw_vary, ("vary",), set(raw_vary) if isinstance(raw_vary, dict)
+                          else set())
         varied = []
         for vname, entry in vary.items():
             path = ("vary", vname)
+            if vname in RESERVED:
+                raise self.error(path, f'"{vname}" names a dimension or output of the results '
+                                 f"({', '.join(sorted(RESERVED))}): rename the model's "
+                                 "parameter to vary it")
             if vname not in kinds:
                 raise self.error(path, f'"{vname}" is not a parameter, coordinate or rate of '
                                  f"the model; parameters: {', '.join(defaults) or '(none)'}; "
