@@ -313,6 +313,11 @@ class _Loader:
         loc = f"{self.file}:{line}" if line else self.file
         return ModelFileError(f"{loc}: {where}: {message}", self.file, line, path, message)
 
+    def missing(self, message: str) -> ModelFileError:
+        """A table the file lacks, located at its first line (a file whose table headers
+        were swallowed, e.g. by an unterminated multi-line string, still names a line)."""
+        return ModelFileError(f"{self.file}:1: the file: {message}", self.file, 1, (), message)
+
     def suggest(self, word: str, options: list[str]) -> str:
         close = difflib.get_close_matches(word, options, n=1)
         if not close:  # a name in the other case ("G" for "g") is close, however short
@@ -583,7 +588,7 @@ class _Loader:
     def read_coordinates(self, data: dict) -> None:
         path: Path = ("coordinates",)
         if "coordinates" not in data:
-            raise self.fail((), "missing table [coordinates] (the generalized coordinates)")
+            raise self.missing("missing table [coordinates] (the generalized coordinates)")
         coords = data["coordinates"]
         if isinstance(coords, list):
             for i, c in enumerate(coords):
@@ -672,7 +677,7 @@ class _Loader:
     def read_bodies(self, data: dict) -> list[Body]:
         path: Path = ("bodies",)
         if "bodies" not in data:
-            raise self.fail((), "missing table [bodies.<name>] (at least one body)")
+            raise self.missing("missing table [bodies.<name>] (at least one body)")
         tbl = self.table(data["bodies"], path, what="tables [bodies.<name>]")
         if not tbl:
             raise self.fail(path, "the model needs at least one body")

@@ -109,8 +109,15 @@ def run_report(model: Any, out: Path, parameters: Mapping[str, float] | None = N
     sim = model.simulation
     t1 = float(t_end if t_end is not None else sim.t_end)
     out.mkdir(parents=True, exist_ok=True)
+    from ..simulate import DEFAULT_ATOL, DEFAULT_RTOL
+
+    # the file's method and tolerances where it sets them; else tighter defaults than a tree
+    # model's (the energy of a conservative loop is reported to 1e-9)
+    rtol = sim.rtol if sim.rtol != DEFAULT_RTOL else 1e-10
+    atol = sim.atol if sim.atol != DEFAULT_ATOL else 1e-12
+    method = sim.method if sim.method in ("DOP853", "RK45", "Radau", "BDF") else "DOP853"
     res = simulate_loop(loop, (0.0, t1), sim.y0, sim.yd0, samples=sim.samples,
-                        parameters=parameters)
+                        parameters=parameters, rtol=rtol, atol=atol, method=method)
     names = loop.coordinate_names
     lines = res.summary().splitlines()
     # linearization about the equilibrium nearest the initial configuration
