@@ -402,6 +402,9 @@ def test_cli_check_and_run_on_the_four_bar(tmp_path: Path, capsys: pytest.Captur
     assert info["max_Phi_dot"] <= 1e-10 and len(info["eigenvalues"]) == 2
     for f in ("index.html", "constraint_residual.png", "reactions.png", "motion.csv"):
         assert (out / f).stat().st_size > 0
+    # the tree-only commands refuse a loop model instead of ignoring its closing joints
+    assert main(["simulate", str(EXAMPLES / "four_bar.toml")]) != 0
+    assert "closing joints closure" in capsys.readouterr().err
 
 
 def test_spatial_rssr_with_a_spherical_closing_joint() -> None:

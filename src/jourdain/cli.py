@@ -168,6 +168,18 @@ def _load(path: str) -> Any:
     return load_model(path)
 
 
+def _tree_only(model: Any, command: str) -> None:
+    """Refuse a command that would treat a loop model as its open tree."""
+    if getattr(model, "loops", None) is not None:
+        from .errors import ModelError
+
+        names = ", ".join(c.name for c in model.loops.closing)
+        raise ModelError(f"{model.path}: the model closes kinematic loops (closing joints "
+                         f"{names}); jourdain {command} works on trees and would ignore them: "
+                         "use jourdain check and jourdain run, or jourdain.loops in Python "
+                         "(evaluate, simulate_loop, linearize_loop)")
+
+
 def _suggest(name: str, names: Sequence[str]) -> str:
     close = difflib.get_close_matches(name, list(names), n=1)
     return f' (did you mean "{close[0]}"?)' if close else ""
@@ -460,6 +472,7 @@ def cmd_eval(args: argparse.Namespace) -> int:
     from .units import value_units
 
     model = _load(args.model)
+    _tree_only(model, "eval")
     system = model.system
     params = _overrides(system, args.set)
     y, yd, t, inputs = _state(model, args.at)
@@ -521,6 +534,7 @@ def _wrench_text(system: Any, wrenches: dict[str, Any]) -> str:
 
 def cmd_reactions(args: argparse.Namespace) -> int:
     model = _load(args.model)
+    _tree_only(model, "reactions")
     system = model.system
     params = _overrides(system, args.set)
     y, yd, t, inputs = _state(model, args.at)
@@ -614,6 +628,7 @@ def _period(system: Any, text: str | None) -> Any:
 
 def cmd_linearize(args: argparse.Namespace) -> int:
     model = _load(args.model)
+    _tree_only(model, "linearize")
     system = model.system
     _capability(system, "linearize", "the linearization")
     from .io import capabilities as integration
@@ -807,6 +822,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     from .simulate import OUTPUT_SUFFIXES
 
     model = _load(args.model)
+    _tree_only(model, "simulate")
     system = model.system
     _capability(system, "simulate", "simulation")
     from .io import capabilities as integration
