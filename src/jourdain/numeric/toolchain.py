@@ -134,11 +134,13 @@ def cached_library(key: str) -> ctypes.CDLL | None:
     return lib
 
 
-def build(key: str, source: str | Sequence[str]) -> ctypes.CDLL:
+def build(key: str, source: str | Sequence[str], extra_flags: Sequence[str] = ()) -> ctypes.CDLL:
     """Compile ``source`` to ``<cache>/<key>.so`` (unless there) and load it.
 
     ``source`` may be several translation units: they are compiled in parallel (one compiler
     process each) and linked into one library; ``<key>.c`` keeps them one after the other.
+    ``extra_flags`` follow :data:`CFLAGS` (``-O3`` overrides ``-O2``); the caller puts them in
+    ``key`` (:func:`content_key`).
     """
     lib = cached_library(key)
     if lib is not None:
@@ -160,11 +162,12 @@ def build(key: str, source: str | Sequence[str]) -> ctypes.CDLL:
                 fh.write(text)
             tmp_units.append(tmp_c)
         if len(units) == 1:
-            procs = [subprocess.Popen([compiler(), *CFLAGS, "-o", tmp, tmp_units[0], "-lm"],
+            procs = [subprocess.Popen([compiler(), *CFLAGS, *extra_flags, "-o", tmp,
+                                       tmp_units[0], "-lm"],
                                       stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)]
         else:
             objects = [u[:-2] + ".o" for u in tmp_units]
-            flags = [f for f in CFLAGS if f != "-shared"]
+            flags = [f for f in (*CFLAGS, *extra_flags) if f != "-shared"]
             procs = [subprocess.Popen([compiler(), *flags, "-c", "-o", o, u],
                                       stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
                      for u, o in zip(tmp_units, objects, strict=True)]
