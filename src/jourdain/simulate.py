@@ -151,7 +151,9 @@ def integrator_library() -> ctypes.CDLL:
 
 
 def _ptr(a: np.ndarray | None) -> int | None:
-    return None if a is None else a.ctypes.data
+    """The address of ``a``'s data (``__array_interface__``: 0.6 µs less than ``a.ctypes.data``,
+    and a run's set-up takes 25 of them)."""
+    return None if a is None else a.__array_interface__["data"][0]
 
 
 class _Setup:
@@ -673,11 +675,10 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
                 n_out[0] = 0
             id_chunk += 1
             code = lib.jd_integrate(
-                ctypes.byref(setup.problem), t1, st.ctypes.data, x.ctypes.data, k0.ctypes.data,
-                g_old.ctypes.data, cnt.ctypes.data, _ptr(te), 0 if te is None else te.size,
-                i_eval.ctypes.data, out_t.ctypes.data, out_x.ctypes.data, out_dx.ctypes.data, cap,
-                n_out.ctypes.data, ev_t.ctypes.data, ev_x.ctypes.data, ev_i.ctypes.data, ev_cap,
-                n_ev.ctypes.data, max_steps, fail.ctypes.data)
+                ctypes.byref(setup.problem), t1, _ptr(st), _ptr(x), _ptr(k0), _ptr(g_old),
+                _ptr(cnt), _ptr(te), 0 if te is None else te.size, _ptr(i_eval), _ptr(out_t),
+                _ptr(out_x), _ptr(out_dx), cap, _ptr(n_out), _ptr(ev_t), _ptr(ev_x), _ptr(ev_i),
+                ev_cap, _ptr(n_ev), max_steps, _ptr(fail))
             if te is None:
                 _keep_chunk()
                 if writer:
