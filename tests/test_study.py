@@ -16,6 +16,7 @@ from jourdain.analysis import stability, state_space  # noqa: E402
 from jourdain.io.capabilities import nominal_mapping  # noqa: E402
 from jourdain.study import (  # noqa: E402
     VERDICTS,
+    Progress,
     StudyError,
     load_study,
     loads_study,
@@ -314,3 +315,32 @@ def test_cli_study(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
     assert main(["study", "--spec", str(DATA / "montecarlo.toml"), "--out", str(out),
                  "--workers", "1", "--quiet"]) != 0
     assert "exists" in capsys.readouterr().err
+
+
+def test_progress_bar() -> None:
+    import io
+
+    class Tty(io.StringIO):
+        def isatty(self) -> bool:
+            return True
+
+    tty = Tty()
+    bar = Progress(10, stream=tty, interval=0.0)
+    bar.update(4)
+    bar.update(6, 1)
+    bar.close()
+    lines = tty.getvalue().split("\r")[1:]
+    assert lines[0].startswith("[" + "#" * 12 + "-" * 18 + "] 4/10 cases, 0.")
+    assert lines[-1].startswith("[" + "#" * 30 + "] 10/10 cases, 1 failed, ")
+    assert lines[-1].endswith(" s\n")
+    pipe = io.StringIO()  # not a terminal: one line at the end
+    bar = Progress(3, stream=pipe)
+    bar.update(3)
+    assert pipe.getvalue() == ""
+    bar.close()
+    assert pipe.getvalue().count("\n") == 1 and "3/3 cases" in pipe.getvalue()
+    quiet = Tty()
+    bar = Progress(3, stream=quiet, quiet=True, interval=0.0)
+    bar.update(3)
+    bar.close()
+    assert quiet.getvalue() == ""

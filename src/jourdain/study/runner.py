@@ -34,8 +34,9 @@ _PARTS_FORMAT = "jourdain-study-parts-1"
 
 class Progress:
     """A progress bar on stderr (``[#####-----] 512/1000 cases, 3 failed, 1.2 s``), redrawn at
-    most every ``interval`` seconds; on a stream that is not a terminal, one line at the end.
-    ``quiet``: nothing."""
+    most every ``interval`` seconds; in a Jupyter notebook, the same line in the cell's output,
+    updated in place; on a stream that is not a terminal, one line at the end. ``quiet``:
+    nothing."""
 
     def __init__(self, total: int, quiet: bool = False, stream: Any = None,
                  interval: float = 0.2, label: str = "cases") -> None:
@@ -49,15 +50,27 @@ class Progress:
         self.start = time.perf_counter()
         self._last = -1.0
         self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
+        self.handle = None
+        if not quiet and stream is None and not self.tty and "ipykernel" in sys.modules:
+            try:
+                from IPython.display import Pretty, display
+
+                self._pretty = Pretty
+                self.handle = display(Pretty(self.line()), display_id=True)
+            except ImportError:  # a kernel without IPython's display: the line at the end
+                self.handle = None
 
     def update(self, done: int, failed: int = 0) -> None:
         self.done += done
         self.failed += failed
         now = time.perf_counter()
-        if self.quiet or not self.tty or (now - self._last < self.interval
-                                          and self.done < self.total):
+        if self.quiet or not (self.tty or self.handle) or (now - self._last < self.interval
+                                                           and self.done < self.total):
             return
         self._last = now
+        if self.handle is not None:
+            self.handle.update(self._pretty(self.line()))
+            return
         self.stream.write("\r" + self.line())
         self.stream.flush()
 
@@ -71,6 +84,9 @@ class Progress:
 
     def close(self) -> None:
         if self.quiet:
+            return
+        if self.handle is not None:
+            self.handle.update(self._pretty(self.line()))
             return
         self.stream.write(("\r" if self.tty else "") + self.line() + "\n")
         self.stream.flush()
@@ -202,7 +218,7 @@ def _run_dask(spec: StudySpec, todo: list[tuple[int, int]], scheduler: Any,
 
 
 def run_study(spec: StudySpec, out: str | Path | None = None, *, workers: int | None = None,
-              scheduler: Any = None, quiet: bool = True, force: bool = False,
+              scheduler: Any = None, quiet: bool = False, force: bool = False,
               on_block: Callable[[dict[str, Any]], None] | None = None) -> Any:
     """Run ``spec`` and return its results as an ``xarray.Dataset``
     (:func:`jourdain.study.dataset.to_dataset`).
@@ -216,7 +232,7 @@ def run_study(spec: StudySpec, out: str | Path | None = None, *, workers: int | 
         process; a study of one block always runs in this process)
     scheduler : address of a ``dask.distributed`` scheduler (``"tcp://host:8786"``) or a
         ``distributed.Client``: the blocks run on that cluster (``workers`` is then ignored)
-    quiet : no progress bar
+    quiet : no progress bar (:class:`Progress`: on stderr, or in the notebook's cell)
     force : start afresh where ``<out>.parts/`` holds another study's parts, and replace an
         existing ``out``
     on_block : called with every block computed in this run (after it was saved)
