@@ -123,12 +123,12 @@ def stability_map(n: int, loop_cases: int) -> dict:
             for c in cases[pick[:5]]]
 
     t_relin, _ = _timed(relinearize)
-    run_study(spec, workers=1)  # imports (xarray) and first calls, not counted
-    t_batch, ds = _timed(lambda: run_study(spec, workers=1))
+    run_study(spec, workers=1, quiet=True)  # imports (xarray) and first calls, not counted
+    t_batch, ds = _timed(lambda: run_study(spec, workers=1, quiet=True))
     ours = [VERDICTS[int(v)] for v in ds["verdict"].values.reshape(-1)[pick]]
     agree = sum(a == b for a, b in zip(ours, verdicts_loop, strict=True))
-    t_p1, _ = _timed(lambda: run_study(spec, workers=1))
-    t_p2, ds2 = _timed(lambda: run_study(spec, workers=2))
+    t_p1, _ = _timed(lambda: run_study(spec, workers=1, quiet=True))
+    t_p2, ds2 = _timed(lambda: run_study(spec, workers=2, quiet=True))
     same_p2 = bool(np.array_equal(ds2["max_real_part"].values, ds["max_real_part"].values))
     dask = _dask(spec, ds)
     N = len(cases)
@@ -162,8 +162,8 @@ def _dask(spec: object, ref: object, var: str = "max_real_part") -> dict:
         with distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
                                       dashboard_address=None) as cluster, \
                 distributed.Client(cluster) as client:
-            run_study(spec, scheduler=client)
-            t, ds = min((_timed(lambda: run_study(spec, scheduler=client)) for _ in range(3)),
+            run_study(spec, scheduler=client, quiet=True)
+            t, ds = min((_timed(lambda: run_study(spec, scheduler=client, quiet=True)) for _ in range(3)),
                         key=lambda r: r[0])
         out[f"dask_{n}_workers_s"] = t
         out[f"dask_{n}_identical"] = bool(np.array_equal(ds[var].values, ref[var].values,
@@ -175,9 +175,9 @@ def _dask(spec: object, ref: object, var: str = "max_real_part") -> dict:
 def monte_carlo(n: int) -> dict:
     spec = loads_study(_mc_spec(n))
     context(spec)
-    run_study(loads_study(_mc_spec(4)), workers=1)  # imports and first calls, not counted
-    t1, ds1 = _timed(lambda: run_study(spec, workers=1))
-    t2, ds2 = _timed(lambda: run_study(spec, workers=2))
+    run_study(loads_study(_mc_spec(4)), workers=1, quiet=True)  # imports and first calls, not counted
+    t1, ds1 = _timed(lambda: run_study(spec, workers=1, quiet=True))
+    t2, ds2 = _timed(lambda: run_study(spec, workers=2, quiet=True))
     z = ds1["max_abs_z_b"].values
     return {"runs": n, "1_process_s": t1, "2_processes_s": t2, "speedup": t1 / t2,
             **_dask(spec, ds1, "max_abs_z_b"),
@@ -186,6 +186,26 @@ def monte_carlo(n: int) -> dict:
             "failed": int(ds1.attrs["n_failed"]),
             "max_abs_z_b_mean_mm": float(np.nanmean(z) * 1e3),
             "max_abs_z_b_std_mm": float(np.nanstd(z, ddof=1) * 1e3)}
+
+
+def _busy(_: int) -> int:
+    s = 0
+    for i in range(3_000_000):
+        s += i
+    return s
+
+
+def machine_ceiling() -> float:
+    """What 2 processes give on this machine now: two units of pure-Python work, one after the
+    other against one each on 2 processes (2.0 on two free cores; less where other work holds
+    them). The scaling figures are to be read against it."""
+    import multiprocessing as mp
+
+    t1, _ = _timed(lambda: (_busy(0), _busy(1)))
+    with mp.get_context("fork").Pool(2) as pool:
+        pool.map(_busy, [0, 1])
+        t2, _ = _timed(lambda: pool.map(_busy, [0, 1]))
+    return t1 / t2
 
 
 def main() -> None:
@@ -200,8 +220,9 @@ def main() -> None:
         args.n, args.loop_cases, args.mc = 40, 100, 200
     with tempfile.TemporaryDirectory() as tmp:
         os.chdir(tmp)
-        res = {"cpus": os.cpu_count(), "stability_map": stability_map(args.n, args.loop_cases),
-               "monte_carlo": monte_carlo(args.mc)}
+        res = {"cpus": os.cpu_count(), "ceiling_before": machine_ceiling(),
+               "stability_map": stability_map(args.n, args.loop_cases),
+               "monte_carlo": monte_carlo(args.mc), "ceiling_after": machine_ceiling()}
     m, c = res["stability_map"], res["monte_carlo"]
     print(f"stability map, {m['cases']} cases of {ROTOR.name} (set-up {m['setup_s']:.2f} s):")
     print(f"  loop over stability(lin):          {m['loop_cases_per_s']:10.0f} cases/s")
@@ -226,6 +247,9 @@ def main() -> None:
         print(f"  Dask LocalCluster (warm): 1 worker {c['dask_1_workers_s']:.2f} s, 2 workers "
               f"{c['dask_2_workers_s']:.2f} s: {c['dask_speedup']:.2f}x (identical: "
               f"{c['dask_1_identical']}, {c['dask_2_identical']})")
+    print(f"this machine's own ceiling for 2 processes (pure-Python busy loop): "
+          f"{res['ceiling_before']:.2f}x before, {res['ceiling_after']:.2f}x after "
+          f"({res['cpus']} CPUs)")
     if args.json:
         Path(args.json).write_text(json.dumps(res, indent=1))
 
