@@ -545,9 +545,10 @@ def _simulate(ctx: Context, P: np.ndarray, Y: np.ndarray, YD: np.ndarray, ok: np
             r = simulate(system, (0.0, s["t_end"]), Y[i], YD[i],
                          parameters=dict(zip(names, P[i].tolist(), strict=True)),
                          inputs=inputs, method=s["method"], rtol=s["rtol"], atol=s["atol"],
-                         t_eval=t_eval)
-            if r.interrupted if hasattr(r, "interrupted") else False:
-                raise StudyError(f"the run stopped at t = {r.t[-1]:.6g}")
+                         t_eval=t_eval, raise_on_interrupt=True)  # Ctrl-C stops the study
+            if len(r.t) != len(t_eval):
+                raise StudyError(f"the run stopped at t = {r.t[-1]:.6g} ({r.status}: "
+                                 f"{r.message})")
         except _FAILURES as exc:
             _record(errors, np.array([i]), {0: str(exc)}, "simulate")
             continue
