@@ -344,3 +344,18 @@ def test_progress_bar() -> None:
     bar.update(3)
     bar.close()
     assert quiet.getvalue() == ""
+
+
+def test_workers_check_the_model_hash_and_the_compiled_keys() -> None:
+    import dataclasses
+
+    from jourdain.study import compute_block
+
+    spec = load_study(DATA / "critical.toml")
+    block = compute_block(spec, 0, 2, context(spec).keys)
+    assert block["errors"] == ["", ""]
+    with pytest.raises(StudyError, match="compiled another model"):
+        compute_block(spec, 0, 2, {"linearize": "0" * 32})
+    edited = dataclasses.replace(spec, model_text=spec.model_text.replace("100.0", "101.0"))
+    with pytest.raises(StudyError, match="does not match the study's model hash"):
+        compute_block(edited, 0, 2)

@@ -72,6 +72,12 @@ _CONTEXTS: dict[str, Context] = {}
 
 def context(spec: StudySpec) -> Context:
     """The study's :class:`Context` in this process (built on first use, then reused)."""
+    import hashlib
+
+    # every block: the model text that came with it must be the one the study hashed
+    if hashlib.sha256(spec.model_text.encode()).hexdigest() != spec.model_hash:
+        raise StudyError(f"{spec.model_path}: the model's text does not match the study's model "
+                         "hash", spec.filename)
     ctx = _CONTEXTS.get(spec.spec_hash)
     if ctx is None:
         _CONTEXTS.clear()  # one study at a time per worker: its compiled model, not all
@@ -81,14 +87,9 @@ def context(spec: StudySpec) -> Context:
 
 
 def _build(spec: StudySpec) -> Context:
-    import hashlib
-
     from ..io.capabilities import nominal_mapping
     from ..io.modelfile import loads_model
 
-    if hashlib.sha256(spec.model_text.encode()).hexdigest() != spec.model_hash:
-        raise StudyError(f"{spec.model_path}: the model's text does not match the study's model "
-                         "hash", spec.filename)
     model = loads_model(spec.model_text, spec.model_path)
     system = model.system
     f = system.f
