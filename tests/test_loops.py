@@ -495,3 +495,24 @@ def test_redundant_form_side_by_side() -> None:
         assert np.max(np.abs(red.lam - ref.lam)) <= 1e-7 * lam_scale
         assert red.max_Phi <= 1e-8
     assert ref.max_Phi <= 1e-12 * 10
+
+
+def test_n_four_bar_through_its_singular_flat_positions() -> None:
+    """The N four-bar (N = 3) passes its flat positions, where Φ_z loses rank, in the
+    augmented-Lagrangian form; the crank angle follows the exact one-degree-of-freedom motion
+    of the parallelogram chain (benchmarks/n_four_bar.py runs N = 5, 10, 40 over 20 s)."""
+    from benchmarks.n_four_bar import initial_state, reference
+    from jourdain.loops.models import n_four_bar
+    from jourdain.loops.simulate import simulate_penalty
+
+    n = 3
+    loop = n_four_bar(n)
+    z, zd = initial_state(n)
+    ev = loop.evaluator(z)
+    assert ev.rank([0.0, 0.0] * n + [0.0]) < 2 * n  # flat: rank lost
+    res = simulate_penalty(loop, (0.0, 4.0), z, zd, samples=41)
+    assert res.status == "finished"
+    th0 = res.coordinate("th0")
+    assert th0[-1] - th0[0] > math.pi  # it went through the horizontal positions
+    assert np.max(np.abs(th0 - reference(n, res.t))) <= 1e-5
+    assert res.max_Phi <= 1e-6

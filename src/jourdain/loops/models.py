@@ -60,3 +60,33 @@ def slider_crank(independent: tuple[str, ...] | None = ("phi",)) -> ClosedLoopSy
                   name="slider-crank")
     wrist = ClosingJoint("wrist", "revolute", "rod", "slider", point_a=(l, 0, 0), axis="z")
     return ClosedLoopSystem(tree, [wrist], independent=independent)
+
+
+def n_four_bar(n: int) -> ClosedLoopSystem:
+    """The N four-bar mechanism of the IFToMM multibody benchmark library: n + 1 cranks of
+    length ``L`` pinned to the ground at ``x = i·L`` (angles ``th0 … thn`` from the x axis)
+    and n couplers of length ``L`` hinged at the tops of cranks 0 … n−1 (angles ``ph0 …`` relative
+    to their crank), each closed by a revolute joint ``close<i>`` at the top of crank i+1:
+    n parallelograms in a row, one degree of freedom. Uniform rods of mass ``m``, gravity
+    ``g`` along −y. Where the cranks lie horizontal every bar is on the x axis and the
+    constraint Jacobian loses rank (the benchmark's singular positions)."""
+    if n < 1:
+        raise ValueError("n must be at least 1")
+    L, m, g = symbols("L m g")
+    th = [symbols(f"th{i}") for i in range(n + 1)]
+    ph = [symbols(f"ph{i}") for i in range(n)]
+    bodies = []
+    for i in range(n + 1):
+        bodies.append(Body(f"crank{i}", "world", Revolute(f"ground{i}", th[i], "z",
+                                                          position=(i * L, 0, 0)),
+                           mass=m, com=(L / 2, 0, 0), inertia=rod(m, L, "x")))
+        if i < n:
+            bodies.append(Body(f"coupler{i}", f"crank{i}",
+                               Revolute(f"top{i}", ph[i], "z", position=(L, 0, 0)), mass=m,
+                               com=(L / 2, 0, 0), inertia=rod(m, L, "x")))
+    coords = [c for i in range(n + 1) for c in ([th[i], ph[i]] if i < n else [th[i]])]
+    tree = System(coords, bodies, [Gravity((0, -g, 0))],
+                  parameters={"L": 1.0, "m": 1.0, "g": 9.81}, name=f"{n} four-bar")
+    closing = [ClosingJoint(f"close{i}", "revolute", f"coupler{i}", f"crank{i + 1}",
+                            point_a=(L, 0, 0), point_b=(L, 0, 0), axis="z") for i in range(n)]
+    return ClosedLoopSystem(tree, closing, independent=("th0",))
