@@ -26,7 +26,10 @@ The redundant-coordinate form, side by side: ``[M_tree Φ_zᵀ; Φ_z 0]·[z̈; �
 (index 1), :meth:`LoopEvaluator.redundant_accelerations`, optionally with Baumgarte's
 stabilization. It needs no partition and so no singular ``Φ_d``, but its positions drift off
 the manifold unless projected back; the independent form stays on the manifold by
-construction (the dependent coordinates are solved by Newton at every evaluation).
+construction (the dependent coordinates are solved by Newton at every evaluation). Where
+Φ_z itself loses rank (a mechanism's flat or bifurcation positions) neither a partition nor
+the bordered matrix can be solved; the augmented-Lagrangian form
+(:func:`jourdain.loops.simulate.simulate_penalty`) passes there.
 """
 
 from __future__ import annotations
