@@ -6,16 +6,18 @@ solution) and the dependent rates from ``Φ̇ = 0`` by a linear solve with ``Φ_
 reported state lies on the manifold to rounding, whatever the integrator's error: the error
 of the integration is an error *along* the manifold (in y), never a drift off it. ``ÿ`` comes
 from ``M(y, ẏ, t)·ÿ = q − k`` in the independent coordinates
-(:class:`jourdain.loops.closed_loop.LoopEvaluator`); the integrator is SciPy's ``solve_ivp``
-(DOP853 by default) on the ODE in y.
+(:class:`jourdain.loops.closed_loop.LoopEvaluator`); the integrator is one of SciPy's
+explicit or implicit Runge–Kutta/BDF steppers (DOP853 by default), driven step by step.
 
-Singular configurations: at every accepted step the condition number of ``Φ_d`` is watched
-(an event of the integrator); where it exceeds ``cond_limit`` the run either switches to a
-new partition chosen by pivoting at that state (``repartition=True``, the default, when the
-new ``Φ_d`` is well-conditioned) and continues, or stops with :class:`SingularConfiguration`
-naming the time, the state, the condition number and the rank of ``Φ_z`` (a rank drop of
-``Φ_z`` itself, a bifurcation such as a four-bar's flat position, cannot be cured by a new
-partition and is reported as such).
+Singular configurations: after every accepted step the condition number of ``Φ_d`` is
+computed. When it has grown tenfold over its value at the partition (``repartition=True``,
+the default) a new partition is chosen by pivoting at that state and the run goes on in it:
+the chart (y, ẏ) degrades long before Φ_d is singular (ẏ → 0 at a limit position of y). When
+it passes ``cond_limit`` (default 1e6) and no better partition exists there — ``Φ_z`` itself
+has lost rank, a singular position of the mechanism — or re-partitioning is off, the run
+stops with status "singular" and a :class:`SingularConfiguration` naming the time, the state,
+the condition number, the rank of ``Φ_z`` and a partition that would serve (if any). The
+augmented-Lagrangian form :func:`simulate_penalty` passes singular positions.
 
 Why not SUNDIALS IDA (scikit-sundae) here, measured (``python benchmarks/loops.py``, the
 four-bar of :func:`jourdain.loops.models.four_bar` over 5 s, error of z(5 s) against a run at
