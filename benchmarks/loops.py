@@ -52,53 +52,11 @@ def derive_sympy() -> tuple[float, object]:
 
 
 def kane_full_four_bar():  # noqa: ANN201
-    """Kane's full (q, u) mass matrix and forcing of the four-bar, lambdified."""
-    import sympy as sm
-    import sympy.physics.mechanics as me
+    """Kane's full (q, u) mass matrix and forcing of the four-bar, lambdified (the model of
+    tests/test_loops.py)."""
+    from tests.test_loops import _kane_four_bar
 
-    # the model of tests/test_loops.py::_kane_four_bar, kept whole: mass_matrix_full and
-    # forcing_full (q and u) for the integration
-    q1, q2, q3 = me.dynamicsymbols("q1:4")
-    u1, u2, u3 = me.dynamicsymbols("u1:4")
-    a, b, c, d, m1, m2, m3, g = sm.symbols("a b c d m1 m2 m3 g")
-    N = me.ReferenceFrame("N")
-    A = N.orientnew("A", "Axis", (q1, N.z))
-    B = A.orientnew("B", "Axis", (q2, A.z))
-    C = N.orientnew("C", "Axis", (q3, N.z))
-    A.set_ang_vel(N, u1 * N.z)
-    B.set_ang_vel(A, u2 * A.z)
-    C.set_ang_vel(N, u3 * N.z)
-    O = me.Point("O")
-    O.set_vel(N, 0)
-    Pa = O.locatenew("Pa", a * A.x)
-    Pa.v2pt_theory(O, N, A)
-    Ca = O.locatenew("Ca", a / 2 * A.x)
-    Ca.v2pt_theory(O, N, A)
-    Cb = Pa.locatenew("Cb", b / 2 * B.x)
-    Cb.v2pt_theory(Pa, N, B)
-    Pb = Pa.locatenew("Pb", b * B.x)
-    Pb.v2pt_theory(Pa, N, B)
-    O2 = O.locatenew("O2", d * N.x)
-    O2.set_vel(N, 0)
-    Cc = O2.locatenew("Cc", c / 2 * C.x)
-    Cc.v2pt_theory(O2, N, C)
-    Pc = O2.locatenew("Pc", c * C.x)
-    Pc.v2pt_theory(O2, N, C)
-    gap = Pb.pos_from(O) - Pc.pos_from(O)
-    dv = Pb.vel(N) - Pc.vel(N)
-    bodies = [me.RigidBody("crank", Ca, A, m1, (me.inertia(A, 0, 0, m1 * a**2 / 12), Ca)),
-              me.RigidBody("coupler", Cb, B, m2, (me.inertia(B, 0, 0, m2 * b**2 / 12), Cb)),
-              me.RigidBody("rocker", Cc, C, m3, (me.inertia(C, 0, 0, m3 * c**2 / 12), Cc))]
-    loads = [(Ca, -m1 * g * N.y), (Cb, -m2 * g * N.y), (Cc, -m3 * g * N.y)]
-    kane = me.KanesMethod(N, q_ind=[q1], u_ind=[u1], q_dependent=[q2, q3],
-                          u_dependent=[u2, u3],
-                          kd_eqs=[q1.diff() - u1, q2.diff() - u2, q3.diff() - u3],
-                          configuration_constraints=[gap.dot(N.x), gap.dot(N.y)],
-                          velocity_constraints=[dv.dot(N.x), dv.dot(N.y)])
-    kane.kanes_equations(bodies, loads)
-    syms = [q1, q2, q3, u1, u2, u3, a, b, c, d, m1, m2, m3, g]
-    return (sm.lambdify(syms, kane.mass_matrix_full, "numpy"),
-            sm.lambdify(syms, kane.forcing_full, "numpy"))
+    return _kane_four_bar(full=True)
 
 
 PARS = [0.4, 1.0, 0.8, 1.1, 1.0, 2.0, 1.5, 9.81]

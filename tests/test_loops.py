@@ -101,7 +101,10 @@ def test_slider_crank_kinematics_closed_form() -> None:
         z = s["z"].copy()
 
 
-def _kane_four_bar():
+def _kane_four_bar(full: bool = False):
+    """sympy.physics.mechanics' four-bar with dependent speeds: its mass matrix and forcing in
+    the independent speed (``full``: of all coordinates and speeds, for integration), lambdified
+    in (q1..3, u1..3, a, b, c, d, m1, m2, m3, g)."""
     sm = pytest.importorskip("sympy")
     me = pytest.importorskip("sympy.physics.mechanics")
     q1, q2, q3 = me.dynamicsymbols("q1:4")
@@ -143,6 +146,9 @@ def _kane_four_bar():
                           velocity_constraints=[dv.dot(N.x), dv.dot(N.y)])
     kane.kanes_equations(bodies, loads)
     syms = [q1, q2, q3, u1, u2, u3, a, b, c, d, m1, m2, m3, g]
+    if full:
+        return (sm.lambdify(syms, kane.mass_matrix_full, "numpy"),
+                sm.lambdify(syms, kane.forcing_full, "numpy"))
     return (sm.lambdify(syms, kane.mass_matrix, "numpy"),
             sm.lambdify(syms, kane.forcing, "numpy"))
 

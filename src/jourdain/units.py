@@ -121,8 +121,15 @@ def coordinate_units(system: System) -> dict[str, str]:
                 exprs, kind = list(step.vector), length
             for name, ok in _linear_in(exprs, system.y).items():
                 kinds.setdefault(name, set()).add(kind if ok else "")
+    return _decided(system.coordinate_names, declared, kinds)
+
+
+def _decided(names: list[str], declared: Mapping[str, str],
+             kinds: Mapping[str, set[str]]) -> dict[str, str]:
+    """The unit of each name: declared, else the one kind found for it, else "" (none found,
+    or several that disagree)."""
     out = {}
-    for name in system.coordinate_names:
+    for name in names:
         if name in declared:
             out[name] = declared[name]
         else:
@@ -155,14 +162,7 @@ def input_units(system: System) -> dict[str, str]:
             continue
         for name, ok in _linear_in(exprs, system.inputs).items():
             kinds.setdefault(name, set()).add(kind if ok else "")
-    out = {}
-    for name in system.input_names:
-        if name in declared:
-            out[name] = declared[name]
-        else:
-            k = kinds.get(name, set())
-            out[name] = next(iter(k)) if len(k) == 1 else ""
-    return out
+    return _decided(system.input_names, declared, kinds)
 
 
 def model_units(system: System) -> dict[str, str]:

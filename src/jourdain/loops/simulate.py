@@ -340,13 +340,7 @@ def simulate_redundant(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: 
         out["lam"].append(lam)
         out["T"].append(float(cd["T"][0, 0]))
         out["V"].append(float(cd["V"][0, 0]))
-    status = "finished" if sol.status == 0 else "failed"
-    return LoopResults(
-        loop, sol.t, np.array(out["z"]), np.array(out["zd"]), np.array(out["zdd"]),
-        np.array(out["Phi"]), np.array(out["Phi_dot"]), np.array(out["lam"]),
-        np.array(out["T"]), np.array(out["V"]), list(ev.labels), [(t0, ())], status,
-        str(sol.message), int(sol.nfev), wall, None,
-        dict(zip([k for k, _ in loop.tree.parameters], ev.p.tolist(), strict=True)))
+    return _redundant_results(loop, ev, sol, out, t0, wall)
 
 
 def simulate_penalty(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: Any,
@@ -417,6 +411,16 @@ def simulate_penalty(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: An
         out["lam"].append(-lam)
         out["T"].append(float(cd["T"][0, 0]))
         out["V"].append(float(cd["V"][0, 0]))
+    return _redundant_results(loop, ev, sol, out, t0, wall)
+
+
+__all__ = ["LoopResults", "simulate_loop", "simulate_penalty", "simulate_redundant"]
+
+
+def _redundant_results(loop: ClosedLoopSystem, ev: Any, sol: Any, out: dict, t0: float,
+                       wall: float) -> LoopResults:
+    """The results of a redundant-coordinate run (``simulate_redundant``,
+    ``simulate_penalty``) from SciPy's solution and the samples collected in ``out``."""
     status = "finished" if sol.status == 0 else "failed"
     return LoopResults(
         loop, sol.t, np.array(out["z"]), np.array(out["zd"]), np.array(out["zdd"]),
@@ -424,6 +428,3 @@ def simulate_penalty(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: An
         np.array(out["T"]), np.array(out["V"]), list(ev.labels), [(t0, ())], status,
         str(sol.message), int(sol.nfev), wall, None,
         dict(zip([k for k, _ in loop.tree.parameters], ev.p.tolist(), strict=True)))
-
-
-__all__ = ["LoopResults", "simulate_loop", "simulate_penalty", "simulate_redundant"]
