@@ -359,3 +359,74 @@ def test_workers_check_the_model_hash_and_the_compiled_keys() -> None:
     edited = dataclasses.replace(spec, model_text=spec.model_text.replace("100.0", "101.0"))
     with pytest.raises(StudyError, match="does not match the study's model hash"):
         compute_block(edited, 0, 2)
+
+
+# --- frequency response per case ---------------------------------------------------------------
+
+def test_frequency_response_per_case_is_the_jeffcott_closed_form() -> None:
+    """The Jeffcott rotor's dynamic compliance in closed form: Z = Q − Ω²M̃ + iΩP =
+    [[a, b], [−b, a]] with a = k − mω² + iω(d_a + d_i), b = d_i·Ω (spin Ω, excitation ω), so
+    H = [[a, −b], [b, a]]/(a² + b²), for every case of a grid over the spin and the internal
+    damping, within cond(Z)·eps of |H|."""
+    spec = loads_study(_study(
+        'design = "grid"\n[vary.Omega]\nvalues = [0.0, 12.0, 25.0]\n[vary.d_i]\n'
+        'values = [0.5, 2.0]\n[compute.frequency_response]\nabout = "centred"\n'
+        'excitation = "h"\nomega = { start = 0.5, stop = 40, num = 9, log = true }\n'))
+    ds = run_study(spec, workers=1, quiet=True)
+    assert ds["frf_magnitude"].dims == ("Omega", "d_i", "omega", "coordinate", "excitation")
+    assert list(ds.excitation.values) == ["x", "y"]
+    w = ds.omega.values
+    assert np.allclose(w, np.geomspace(0.5, 40, 9), rtol=4 * EPS, atol=0)
+    m, k, d_a = 1.0, 100.0, 0.5
+    for Om in ds.Omega.values:
+        for di in ds.d_i.values:
+            case = ds.sel(Omega=Om, d_i=di)
+            assert case.error.item() == ""
+            H = case.frf_magnitude.values * np.exp(1j * case.frf_phase.values)
+            for j, wj in enumerate(w):
+                a = k - m * wj**2 + 1j * wj * (d_a + di)
+                b = di * Om
+                Z = np.array([[a, b], [-b, a]])
+                ref = np.array([[a, -b], [b, a]]) / (a * a + b * b)
+                tol = 10 * np.linalg.cond(Z) * EPS * np.abs(ref).max()
+                assert np.abs(H[j] - ref).max() <= tol, (Om, di, wj)
+
+
+def test_frequency_response_to_inputs_equals_the_single_case_function() -> None:
+    """Excitation by the inputs (through B): the quarter car's road input, per case of a
+    list over the body mass, against jourdain.analysis.frequency_response of the case's own
+    linearization (the uncompiled path), within cond(Z)·eps."""
+    from jourdain.analysis import frequency_response
+
+    examples = Path(__file__).parents[1] / "examples"
+    spec = loads_study(
+        f'[study]\nmodel = "{examples / "quarter_car.toml"}"\ndesign = "list"\n'
+        '[vary.m_b]\nvalues = [250.0, 400.0]\n[compute.frequency_response]\n'
+        'omega = [1.0, 8.0, 60.0, 200.0]\n')
+    ds = run_study(spec, workers=1, quiet=True)
+    ctx = context(spec)
+    system, model = ctx.system, ctx.model
+    lin = system.linearize(nominal_mapping(system, model.nominal_motion(model.nominal[0].name)))
+    assert list(ds.excitation.values) == list(system.input_names)
+    for c in range(2):
+        case = ds.isel(case=c)
+        pars = {"m_b": float(case.m_b)}
+        ref = frequency_response(lin, ds.omega.values, "inputs", parameters=pars).response
+        got = case.frf_magnitude.values * np.exp(1j * case.frf_phase.values)
+        ss = state_space(lin, parameters=pars)
+        for j, wj in enumerate(ds.omega.values):
+            Z = ss.Q - wj**2 * ss.M_tilde + 1j * wj * ss.P
+            tol = 10 * np.linalg.cond(Z) * EPS * np.abs(ref[j]).max()
+            assert np.abs(got[j] - ref[j]).max() <= tol, (c, wj)
+
+
+def test_frequency_response_errors() -> None:
+    for body, words in [
+        ('[compute.frequency_response]\nomega = "fast"\n', "list of frequencies"),
+        ('[compute.frequency_response]\nomega = [1, -2]\n', "non-negative"),
+        ('[compute.frequency_response]\nomega = { start = 0, stop = 1, num = 3, log = true }\n',
+         "0 < start"),
+        ('[compute.frequency_response]\nomega = [1]\nexcitation = "inputs"\n', "no inputs"),
+    ]:
+        with pytest.raises(StudyError, match=words):
+            loads_study(_study(body), "s.toml")

@@ -12,6 +12,8 @@ with). A block of cases then only evaluates numbers:
   ``A = [[0, I], [−M̃⁻¹Q, −M̃⁻¹P]]`` by stacked Cholesky solves and the eigenvalues by one
   stacked LAPACK call; the verdict as :func:`jourdain.analysis.stability` gives it (its rule
   applied to the stack where the largest real part decides it, the function itself otherwise);
+- ``frequency_response``: magnitude and phase of the steady-state response over the study's
+  frequencies, from the same C call, the complex solves stacked over cases and frequencies;
 - ``critical``: bisection on the verdict for all cases of the block together, then the
   crossing of the largest real part through zero (as
   :func:`jourdain.analysis.stability_boundary`);
@@ -104,7 +106,12 @@ def _build(spec: StudySpec) -> Context:
 
         ctx.dynamics = dynamics_function(system)
         ctx.keys["evaluate"] = ctx.dynamics.key
-    about = (comp.get("linearize") or comp.get("critical") or {}).get("about")
+    abouts = {comp[k]["about"] for k in ("linearize", "critical", "frequency_response")
+              if k in comp}
+    if len(abouts) > 1:
+        raise StudyError(f"{spec.filename}: linearize, critical and frequency_response must be "
+                         f"about the same nominal motion, got {sorted(abouts)}", spec.filename)
+    about = next(iter(abouts), None)
     if about is not None:
         from ..analysis.modes import _cyclic_of
 
@@ -156,6 +163,12 @@ def output_layout(ctx: Context) -> dict[str, tuple[tuple[str, ...], tuple[int, .
         out["verdict"] = ((), (), "i1")
     if "critical" in comp:
         out[f"critical_{comp['critical']['parameter']}"] = ((), (), "f8")
+    if "frequency_response" in comp:
+        fr = comp["frequency_response"]
+        m = len(system.inputs) if fr["excitation"] == "inputs" else f
+        shape = (len(fr["omega"]), f, m)
+        out["frf_magnitude"] = (("omega", "coordinate", "excitation"), shape, "f8")
+        out["frf_phase"] = (("omega", "coordinate", "excitation"), shape, "f8")
     if "simulate" in comp:
         s = comp["simulate"]
         if s["final"]:
@@ -229,6 +242,12 @@ def compute_block(spec: StudySpec, start: int, stop: int,
         crit, errs = critical(ctx, P[idx])
         out[f"critical_{comp['critical']['parameter']}"][idx] = crit
         _record(errors, idx, errs, "critical")
+    if "frequency_response" in comp:
+        idx = np.flatnonzero(ok)
+        mag, phase, errs = frequency_responses(ctx, P[idx])
+        out["frf_magnitude"][idx] = mag
+        out["frf_phase"][idx] = phase
+        _record(errors, idx, errs, "frequency_response")
     if "simulate" in comp:
         _simulate(ctx, P, Y, YD, ok, out, errors)
     return {"start": start, "stop": stop, "outputs": out, "errors": errors}
@@ -396,6 +415,49 @@ def analyse(ctx: Context, P: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nda
     maxre[gi] = ev.real.max(axis=1)
     verdict[gi] = v
     return lam, maxre, verdict, errs
+
+
+def frequency_responses(ctx: Context, P: np.ndarray
+                        ) -> tuple[np.ndarray, np.ndarray, dict[int, str]]:
+    """``|η̂|`` and ``arg η̂`` (unwrapped along the frequencies), each (n, n_ω, f, m), of the
+    linearization at each row of ``P``: ``η̂ = (Q − Ω²M̃ + iΩP)⁻¹·F`` with ``F = B`` (inputs)
+    or the identity (``h``), as :func:`jourdain.analysis.frequency_response` gives it for one
+    case; M̃, P, Q, B of all cases from one C call, the complex solves stacked over cases and
+    frequencies. A case whose dynamic stiffness is singular at some Ω records its error."""
+    fr = ctx.spec.compute["frequency_response"]
+    n, f = len(P), ctx.system.f
+    w = np.asarray(fr["omega"], dtype=float)
+    m = len(ctx.system.inputs) if fr["excitation"] == "inputs" else f
+    mag = np.full((n, len(w), f, m), np.nan)
+    phase = np.full((n, len(w), f, m), np.nan)
+    errs: dict[int, str] = {}
+    if not n:
+        return mag, phase, errs
+    fn = ctx.compiled_linearization.function
+    Z0 = np.zeros((n, f))
+    nums = fn.batch(Z0, Z0, 0.0, P, np.zeros((n, len(ctx.system.inputs))) if ctx.system.inputs
+                    else None)
+    F = nums["B"] if fr["excitation"] == "inputs" else np.broadcast_to(np.eye(f), (n, f, f))
+    W = w[None, :, None, None]
+    Z = (nums["Q"][:, None] - W**2 * nums["M_tilde"][:, None] + 1j * W * nums["P"][:, None])
+    rhs = np.broadcast_to(F[:, None], (n, len(w), f, m)).astype(complex)
+    try:
+        eta = np.linalg.solve(Z, rhs)
+        rows = range(n) if not np.all(np.isfinite(eta)) else ()
+    except np.linalg.LinAlgError:
+        eta, rows = np.full(rhs.shape, np.nan + 0j), range(n)
+    for i in rows:  # case by case where the stack failed: name the frequency
+        for k, wk in enumerate(w):
+            try:
+                eta[i, k] = np.linalg.solve(Z[i, k], rhs[i, k])
+            except np.linalg.LinAlgError:
+                eta[i] = np.nan
+                errs[i] = (f"the dynamic stiffness Q - Ω²M̃ + iΩP is singular at Ω = {wk} "
+                           "rad/s (an undamped resonance, or a rigid-body mode at Ω = 0)")
+                break
+    mag[:] = np.abs(eta)
+    phase[:] = np.unwrap(np.angle(eta), axis=1)
+    return mag, phase, errs
 
 
 def state_matrices(M: np.ndarray, Pm: np.ndarray, Q: np.ndarray

@@ -88,6 +88,13 @@ def to_dataset(ctx: Context, blocks: Sequence[dict[str, Any]]) -> Any:
         coords["mode"] = np.arange(2 * f)
     if "wrench_component" in used:
         coords["wrench_component"] = list(WRENCH_COMPONENTS)
+    if "omega" in used:
+        fr = spec.compute["frequency_response"]
+        coords["omega"] = xr.Variable(("omega",), np.asarray(fr["omega"], dtype=float),
+                                      attrs={"units": "rad/s",
+                                             "long_name": "excitation angular frequency"})
+        coords["excitation"] = (list(system.input_names) if fr["excitation"] == "inputs"
+                                else list(coords_names))
     if "time" in used:
         s = spec.compute["simulate"]
         coords["time"] = xr.Variable(("time",), np.linspace(0.0, s["t_end"], s["samples"]),
@@ -144,6 +151,11 @@ def _attrs(ctx: Context, name: str, units: dict[str, str]) -> dict[str, Any]:
 
         return {"long_name": f"wrench of joint {name[7:]} on its child body, in the joint frame "
                 f"(F_x..F_z in {force_unit(units)}, T_x..T_z in {torque_unit(units)})"}
+    if name == "frf_magnitude":
+        return {"long_name": "steady-state amplitude per unit excitation amplitude"}
+    if name == "frf_phase":
+        return {"long_name": "phase of the steady-state response (unwrapped over omega)",
+                "units": "rad"}
     if name == "final":
         return {"long_name": "state at the end of the run (coordinates, then rates)"}
     return {"long_name": {"evaluate_M": "mass matrix M", "evaluate_k": "k (M·ÿ + k = q)",

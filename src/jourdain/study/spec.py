@@ -58,13 +58,15 @@ _COMPUTE_KEYS = {
     "simulate": {"t_end", "samples", "method", "rtol", "atol", "series", "final", "max",
                  "max_abs"},
     "critical": {"parameter", "lower", "upper", "rtol", "about"},
+    "frequency_response": {"about", "omega", "excitation"},
 }
 
 
 #: Names of the results' dimensions and outputs that a varied quantity cannot have.
 RESERVED = frozenset({"case", "coordinate", "coordinate_j", "state", "mode", "time",
                       "wrench_component", "error", "final", "verdict", "max_real_part",
-                      "eigenvalue_real", "eigenvalue_imag"})
+                      "eigenvalue_real", "eigenvalue_imag", "omega", "excitation",
+                      "frf_magnitude", "frf_phase"})
 
 
 class StudyError(JourdainError, ValueError):
@@ -379,7 +381,8 @@ class _Reader:
         system = model.system
         if value is None:
             raise self.error((), "nothing to compute: add [compute.evaluate], "
-                             "[compute.linearize], [compute.simulate] or [compute.critical]")
+                             "[compute.linearize], [compute.frequency_response], "
+                             "[compute.simulate] or [compute.critical]")
         comp = self.table(value, ("compute",), set(_COMPUTE_KEYS))
         out: dict[str, dict[str, Any]] = {}
         nominal_names = [n.name for n in model.nominal]
@@ -398,6 +401,8 @@ class _Reader:
                                      f"({', '.join(joints)}), got {reacts!r}")
                 t = self.number(entry.get("t", 0.0), (*path, "t"))
                 out[what] = {"outputs": tuple(outs), "reactions": tuple(reacts), "t": t}
+            elif what == "frequency_response":
+                out[what] = self.frequency_response(entry, path, model, nominal_names, defaults)
             elif what in ("linearize", "critical"):
                 about = entry.get("about", nominal_names[0] if nominal_names else None)
                 if about not in nominal_names:
@@ -431,6 +436,48 @@ class _Reader:
         if not out:
             raise self.error(("compute",), "nothing to compute")
         return out
+
+    def frequency_response(self, entry: dict, path: tuple[str | int, ...], model: Any,
+                           nominal_names: list[str], defaults: Mapping[str, float]
+                           ) -> dict[str, Any]:
+        """``about`` (a nominal motion), ``omega`` (a list of angular frequencies in rad/s, or
+        ``{start, stop, num}``, evenly spaced, or with ``log = true`` logarithmically) and
+        ``excitation`` (``"inputs"``: the model's inputs through B; ``"h"``: a unit
+        generalized force on each coordinate)."""
+        system = model.system
+        about = entry.get("about", nominal_names[0] if nominal_names else None)
+        if about not in nominal_names:
+            raise self.error((*path, "about"), f"no nominal motion {about!r} in the model; it "
+                             f"has: {', '.join(nominal_names) or '(none)'}")
+        w = entry.get("omega")
+        if isinstance(w, list) and w:
+            omega = tuple(self.number(v, (*path, "omega", i), defaults) for i, v in enumerate(w))
+        elif isinstance(w, dict):
+            rng = self.table(w, (*path, "omega"), {"start", "stop", "num", "log"})
+            if not {"start", "stop", "num"} <= set(rng):
+                raise self.error((*path, "omega"), "needs start, stop and num")
+            num = self.count(rng["num"], (*path, "omega", "num"), "num")
+            lo = self.number(rng["start"], (*path, "omega", "start"), defaults)
+            hi = self.number(rng["stop"], (*path, "omega", "stop"), defaults)
+            if rng.get("log", False) is True:
+                if not 0 < lo < hi:
+                    raise self.error((*path, "omega"), "a logarithmic range needs 0 < start "
+                                     f"< stop, got {lo} and {hi}")
+                omega = tuple(float(x) for x in np.geomspace(lo, hi, num))
+            else:
+                omega = tuple(float(x) for x in np.linspace(lo, hi, num))
+        else:
+            raise self.error((*path, "omega"), "expected a list of frequencies in rad/s or "
+                             "{start, stop, num}")
+        if not all(np.isfinite(v) and v >= 0 for v in omega):
+            raise self.error((*path, "omega"), "frequencies must be finite and non-negative")
+        exc = entry.get("excitation", "inputs" if system.inputs else "h")
+        if exc not in ("inputs", "h"):
+            raise self.error((*path, "excitation"), f'expected "inputs" or "h", got {exc!r}')
+        if exc == "inputs" and not system.inputs:
+            raise self.error((*path, "excitation"), 'the model has no inputs: use "h" (a unit '
+                             "generalized force on each coordinate)")
+        return {"about": about, "omega": omega, "excitation": exc}
 
     def simulate(self, entry: dict, path: tuple[str | int, ...], model: Any) -> dict[str, Any]:
         from ..simulate import MAX_SAMPLES, check_atol, check_rtol, check_t_end
