@@ -765,7 +765,8 @@ def _output_folder(text: str, force: bool, model: Any) -> Path:
     src = Path(model.path)
     if out.is_dir() and src.is_file() and out.resolve() == src.resolve().parent:
         raise UsageError(f"--out {text}: is the folder of the model file {model.path}; the "
-                         "report writes model.toml, report.html and its data files into a "
+                         f"report writes model{src.suffix or '.toml'}, report.html and its "
+                         "data files into a "
                          "folder of their own (e.g. --out report/)")
     if out.is_dir() and not force:
         clash = [n for n in report_files(model) if (out / n).exists()]
