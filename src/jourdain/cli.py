@@ -757,7 +757,7 @@ def _output_folder(text: str, force: bool, model: Any) -> Path:
     """The report folder of ``run --out``, checked before any work: a folder (created if
     missing) that can be written, not the model file's own, holding none of the files the
     report writes unless ``--force``."""
-    from .io.report import report_files
+    from .io.report import model_copy, report_files
 
     out = Path(text)
     if out.exists() and not out.is_dir():
@@ -765,7 +765,7 @@ def _output_folder(text: str, force: bool, model: Any) -> Path:
     src = Path(model.path)
     if out.is_dir() and src.is_file() and out.resolve() == src.resolve().parent:
         raise UsageError(f"--out {text}: is the folder of the model file {model.path}; the "
-                         f"report writes model{src.suffix or '.toml'}, report.html and its "
+                         f"report writes {model_copy(model)}, report.html and its "
                          "data files into a "
                          "folder of their own (e.g. --out report/)")
     if out.is_dir() and not force:
