@@ -540,7 +540,7 @@ def simulate(system: System, t_span: tuple[float, float], y0: Any, yd0: Any,
     max_step, first_step : step size limits; ``max_step`` asks for at most ``MAX_STEPS`` steps
         over ``t_span``
     progress : True prints the progress to stderr (every 0.5 s); a callable gets ``(t, t1)``
-        after every chunk of the C loop (about 0.2 s of work, at most 1024 output points)
+        after every chunk of the C loop (about 0.1 s of work, at most 1024 output points)
     output : path of a results file (``.csv``, ``.h5``) written as the run goes (accepted steps
         or ``t_eval`` samples appended under ``status: running``), then complete
     raise_on_interrupt : re-raise KeyboardInterrupt after keeping the results

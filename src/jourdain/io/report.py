@@ -837,7 +837,7 @@ def _floquet_html(fl: Any, name: str) -> str:
     return (f"<h4>Floquet analysis (periodic nominal motion, T = {_num(fl.period)} s)</h4>"
             "<p>Monodromy matrix Φ(t<sub>0</sub> + T, t<sub>0</sub>) of ẋ = A(t)·x over one "
             "period; its eigenvalues are the Floquet multipliers μ, the exponents ln(μ)/T.</p>"
-            + _table(rows, ["Re μ", "Im μ", "|μ|", "Re ln(μ)/T [1/s]", "Im ln(μ)/T [rad/s]"])
+            + _table(rows, ["Re μ", "Im μ", "|μ|", "Re ln(μ)/T / (1/s)", "Im ln(μ)/T / (rad/s)"])
             + _multiplier_plot(fl.multipliers, f"Floquet multipliers about {name}")
             + f"<p>Stability (Floquet): <span class='{cls}'>{_e(fl.verdict)}</span> — "
               f"{_e(fl.reason)}</p>")
