@@ -43,7 +43,9 @@ def cyclic_coordinates(source: System | EquationsOfMotion) -> tuple[str, ...]:
 
     A coordinate whose symbol does not occur in ``k``, ``q`` and ``J̄`` (``M = J̄ᵀM̄J̄``,
     METHOD.md §3) is cyclic. One that occurs (possibly in terms that cancel,
-    ``A·sin²φ + A·cos²φ``) is tested numerically: the exact derivatives ``∂k/∂y_c``,
+    ``A·sin²φ + A·cos²φ``) is tested numerically: first by the compiled M, k, q
+    (:func:`_screen_compiled`: shifted by three angles at two random states, no entry may
+    change); where that cannot decide (no compiler, no real value), by the exact derivatives ``∂k/∂y_c``,
     ``∂q/∂y_c`` and ``∂M/∂y_c = (∂J̄/∂y_c)ᵀM̄J̄ + J̄ᵀM̄(∂J̄/∂y_c)`` (forward mode,
     :func:`jourdain.differentiate.jet_float`) at two random states and times, at the
     default parameter values and at a random set near them, must vanish to
