@@ -42,6 +42,7 @@ from dataclasses import dataclass
 import symengine as se
 
 from ..errors import ModelError
+from ..kinematics import _cross, _dot, _mv
 from ..model.expressions import as_expr, as_vector, axis_vector, free_names
 
 Expr = se.Basic
@@ -159,20 +160,8 @@ class ClosingJoint:
         return free_names(exprs)
 
 
-def _mv(S: tuple, v: Vec3) -> Vec3:
-    return tuple(S[i][0] * v[0] + S[i][1] * v[1] + S[i][2] * v[2] for i in range(3))
-
-
-def _dot(a: Sequence[Expr], b: Sequence[Expr]) -> Expr:
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-
-
 def _sub(a: Vec3, b: Vec3) -> Vec3:
     return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
-
-
-def _cross(a: Sequence[Expr], b: Sequence[Expr]) -> Vec3:
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
 
 def perpendiculars(u: Vec3) -> tuple[Vec3, Vec3]:
@@ -232,9 +221,7 @@ def constraint_rows(kin: object, closing: Sequence[ClosingJoint]) -> list[Constr
         rB, SB = frame(cj.body_b)
         pA = tuple(rA[i] + _mv(SA, cj.point_a)[i] for i in range(3))
         pB = tuple(rB[i] + _mv(SB, cj.point_b)[i] for i in range(3))
-        ex = ((se.Integer(1), se.Integer(0), se.Integer(0)),
-              (se.Integer(0), se.Integer(1), se.Integer(0)),
-              (se.Integer(0), se.Integer(0), se.Integer(1)))
+        ex = _IDENT
         if cj.type in ("spherical", "revolute", "universal"):
             d = _sub(pA, pB)  # type: ignore[arg-type]
             for i, c in enumerate("xyz"):
