@@ -40,6 +40,7 @@ from typing import TYPE_CHECKING, Any
 from ...errors import EvaluationError, JourdainError, ModelError
 from ...numeric import parameter_vector
 from ...numeric.ccode import argument_names, function_source
+from ...numeric.integrator_c import tables as rk_tables
 from ...numeric.recursive import recursive_units
 from ...numeric.toolchain import CompilerError, compiler, content_key, library_dir, not_private
 from .description import Layout, build_description, layout, model_description
@@ -387,7 +388,7 @@ def export_fmu(model: Any, path: str | os.PathLike[str], *,
         local, engine = recursive_units(system, full=False, extra_source=extra)
     except JourdainError as exc:  # e.g. a function C has no counterpart for
         raise ModelError(f"{system.name!r} cannot be exported as an FMU: {exc}") from None
-    rk = (_HERE.parent.parent / "numeric" / "rk_tables.h").read_text()
+    rk = rk_tables()
     glue = (_HERE / "fmi2.c").read_text()
 
     def describe(guid: str) -> str:
