@@ -48,10 +48,10 @@ from scipy.linalg.lapack import dgetrs as getrs
 from scipy.linalg.lapack import dpotrf as potrf
 from scipy.linalg.lapack import dpotrs as potrs
 
-from ..errors import EvaluationError, JourdainError, ModelError
+from ..errors import JourdainError, ModelError
 from ..model import System
 from ..model.forces import rate
-from ..numeric import lambdify, mkq_function, parameter_vector, time_value
+from ..numeric import _vector, lambdify, mkq_function, parameter_vector, time_value
 from ..symbolic import SymMatrix
 from .constraints import ClosingJoint, ConstraintRow, constraint_rows, grubler
 
@@ -262,7 +262,6 @@ def partition(loop: ClosedLoopSystem, Phi_z: np.ndarray,
     (ModelError when its Φ_d is singular there, naming the coordinates)."""
     names = loop.coordinate_names
     n = len(names)
-    m = Phi_z.shape[0]
     _, R, piv = sla.qr(Phi_z.T, mode="economic", pivoting=True)
     diag = np.abs(np.diag(R)) if R.size else np.zeros(0)
     tol = _rank_tol(Phi_z) * 1e3
@@ -292,7 +291,6 @@ def partition(loop: ClosedLoopSystem, Phi_z: np.ndarray,
                          f"do not determine the others here: Φ_d (dependent "
                          f"{', '.join(names[j] for j in dep)}) is singular (condition number "
                          f"{cond:.3g}); choose others or leave the choice to the partition")
-    del m
     return Partition(ind, dep, rows, cond, tuple(names[j] for j in ind))
 
 
@@ -336,7 +334,7 @@ class LoopEvaluator:
         self.tree_mkq = mkq_function(tree)
         self.con = constraint_function(loop)
         self.labels = constraints(loop).labels
-        z = np.zeros(self.n) if z0 is None else _vec(z0, self.n, "z0", loop.coordinate_names)
+        z = np.zeros(self.n) if z0 is None else _vector(z0, self.n, "z0", loop.coordinate_names)
         self.z_guess = z.copy()
         self._last: tuple | None = None
         self.newton_tol = 1e-13
@@ -527,9 +525,9 @@ class LoopEvaluator:
         ``Φ = 0`` with the independent coordinates of ``z0`` held, then ``ż`` from the
         independent rates of ``zd0`` (``Φ̇ = 0``). The residuals left are reported."""
         names = self.loop.coordinate_names
-        z0 = _vec(z0, self.n, "z0", names)
-        zd0 = np.zeros(self.n) if zd0 is None else _vec(zd0, self.n, "zd0",
-                                                         [f"{c}_d" for c in names])
+        z0 = _vector(z0, self.n, "z0", names)
+        zd0 = np.zeros(self.n) if zd0 is None else _vector(zd0, self.n, "zd0",
+                                                            [f"{c}_d" for c in names])
         ind = list(self.part.independent)
         self.z_guess = z0.copy()
         self._last = None
@@ -550,18 +548,6 @@ class LoopEvaluator:
         Pz = self._con(np.asarray(z, dtype=float), np.zeros(self.n), t)["Phi_z"]
         s = np.linalg.svd(Pz, compute_uv=False)
         return int(np.sum(s > _rank_tol(Pz) * 1e3))
-
-
-def _vec(x: Any, n: int, what: str, names: Sequence[str]) -> np.ndarray:
-    try:
-        v = np.array(x, dtype=float).reshape(-1)
-    except (TypeError, ValueError):
-        raise EvaluationError(f"{what} must be a sequence of {n} numbers, got {x!r}") from None
-    if v.size != n:
-        raise EvaluationError(f"{what} must have {n} entries ({', '.join(names)}), got {v.size}")
-    if not np.all(np.isfinite(v)):
-        raise EvaluationError(f"{what} contains NaN or inf")
-    return v
 
 
 def evaluate(loop: ClosedLoopSystem, z: Any, zd: Any = None, t: float = 0.0,
