@@ -15,7 +15,20 @@ from collections.abc import Mapping
 import symengine as se
 
 from .errors import ModelError
-from .kinematics import Z3, Kinematics, _add, _cross, _dot, _mtv, _mv, _scale
+from .kinematics import (
+    Z3,
+    BodyKinematics,
+    Kinematics,
+    _add,
+    _cross,
+    _dot,
+    _mm,
+    _mtm,
+    _mtv,
+    _mv,
+    _scale,
+    _vec,
+)
 from .model.bodies import WORLD
 from .model.forces import BUSHING_COMPONENTS, Bushing, deflection, deflection_d
 from .model.joints import IDENTITY, Mat3, Vec3
@@ -27,11 +40,6 @@ HALF = se.Rational(1, 2)
 
 def _sub(a: Vec3, b: Vec3) -> Vec3:
     return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
-
-
-def _vec(m: object) -> Vec3:
-    rows = m.rows  # type: ignore[attr-defined]
-    return (rows[0][0], rows[1][0], rows[2][0])
 
 
 class Frames:
@@ -49,11 +57,6 @@ class Frames:
         """Angular velocity in the body's own axes, ``J_R·ẏ + ω̄``."""
         return Z3 if body == WORLD else _vec(self.kin[body].omega)
 
-    def omega_bar_parts(self, body: str) -> tuple[dict[int, Vec3], Vec3, Vec3]:
-        """(J_R columns, ᾱ, ω) in the body's axes, for angular accelerations."""
-        bk = self.kin[body]
-        return dict(bk.cols_R), _vec(bk.alpha_bar), _vec(bk.omega)
-
     def to_frame(self, vec_I: Vec3, frame: str) -> Vec3:
         """Components in ``frame`` of an inertial vector."""
         return vec_I if frame == WORLD else _mtv(self.S(frame), vec_I)
@@ -65,11 +68,17 @@ class Frames:
         """Inertial position and velocity of the point ``p`` (body frame) of ``body``."""
         if body == WORLD:
             return p, Z3
-        r, cols, v_bar, _ = self.kin[body].point(p)
+        r, v, _, _ = self._state(self.kin[body], p)
+        return r, v
+
+    def _state(self, bk: BodyKinematics, p: Vec3) -> tuple[Vec3, Vec3, dict[int, Vec3], Vec3]:
+        """Position, velocity ``J_T·ẏ + v̄``, J_T columns and ā of the point ``p`` (body
+        frame) of the body ``bk``."""
+        r, cols, v_bar, a_bar = bk.point(p)
         v = v_bar
         for j, c in sorted(cols.items()):
             v = _add(v, _scale(c, self.kin.yd[j]))
-        return r, v
+        return r, v, dict(cols), a_bar
 
     def material_point(self, body: str, p: Vec3, point_frame: str
                        ) -> tuple[Vec3, Vec3, dict[int, Vec3], Vec3]:
@@ -78,11 +87,7 @@ class Frames:
         if point_frame == body:
             if body == WORLD:
                 return p, Z3, {}, Z3
-            r, cols, v_bar, a_bar = self.kin[body].point(p)
-            v = v_bar
-            for j, c in sorted(cols.items()):
-                v = _add(v, _scale(c, self.kin.yd[j]))
-            return r, v, dict(cols), a_bar
+            return self._state(self.kin[body], p)
         # where the point is now, then the body-frame coordinates of that place: the material
         # point's velocity and acceleration follow from the body's motion alone
         r, _ = self.point(point_frame, p)
@@ -92,11 +97,7 @@ class Frames:
         p_body = _mtv(self.S(body), _sub(r, _vec(bk.r_O)))
         # ṗ_body ≠ 0 in general, but the material point is the one at p_body *now*: its
         # velocity and acceleration are those of the body point p_body held fixed
-        rr, cols, v_bar, a_bar = bk.point(p_body)
-        v = v_bar
-        for j, c in sorted(cols.items()):
-            v = _add(v, _scale(c, self.kin.yd[j]))
-        return rr, v, dict(cols), a_bar
+        return self._state(bk, p_body)
 
 
 class Resolver:
@@ -175,12 +176,6 @@ def _trace(A: Mat3) -> se.Basic:
     return A[0][0] + A[1][1] + A[2][2]
 
 
-def _mtm(A: Mat3, B: Mat3) -> Mat3:
-    """Aᵀ·B"""
-    return tuple(tuple(A[0][i] * B[0][j] + A[1][i] * B[1][j] + A[2][i] * B[2][j]
-                       for j in range(3)) for i in range(3))  # type: ignore[return-value]
-
-
 def relative_rotation_of(frames: Frames, a: str, b: str) -> Mat3:
     """``R = S_aᵀ·S_b``: the axes of b in a's components."""
     if a == WORLD:
@@ -230,8 +225,7 @@ def bushing_deflection(frames: Frames, fe: Bushing
     if Aa != IDENTITY:
         R = _mtm(Aa, R)
     if Ab != IDENTITY:
-        R = tuple(tuple(se.Add(*(R[i][k] * Ab[k][j] for k in range(3))) for j in range(3))
-                  for i in range(3))  # type: ignore[assignment]
+        R = _mm(R, Ab)
     H = rotation_measure_rate_matrix(R)
     w_A = _turn_back(Aa, frames.omega(a))
     w_B = _turn_back(Ab, frames.omega(b))
