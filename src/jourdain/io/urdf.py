@@ -511,6 +511,7 @@ def _build(robot: Any, src: _Source, *, floating_base: bool, g: float, mimic: st
     info: dict[str, UrdfJoint] = {}
     inputs: list[str] = []
     forces: list[Any] = []
+    damping: dict[str, float] = {}        # parameter d_<coordinate> -> <dynamics damping>
 
     if floating_base:
         b = body_names(root)
@@ -597,8 +598,8 @@ def _build(robot: Any, src: _Source, *, floating_base: bool, g: float, mimic: st
             inputs.append(tau)
             forces.append(GeneralizedForce(f"actuator_{qs[0]}", se.Symbol(qs[0]),
                                            se.Symbol(tau)))
-        lim = common
-        if joint_damping and len(qs) == 1 and lim.get("damping"):
+        if joint_damping and len(qs) == 1 and common.get("damping"):
+            damping[f"d_{qs[0]}"] = float(common["damping"])
             forces.append(RotationalSpringDamper(f"damping_{qs[0]}", se.Symbol(qs[0]),
                                                  damping=se.Symbol(f"d_{qs[0]}")))
         info[j.name] = UrdfJoint(**common, body=cb, joint=jn, coordinates=qs, input=tau)
@@ -653,9 +654,7 @@ def _build(robot: Any, src: _Source, *, floating_base: bool, g: float, mimic: st
         except ModelError as exc:
             raise UrdfError(f'link "{urdf_link}": {exc}', path,
                             src.line("link", urdf_link)) from None
-    for j in info.values():
-        if joint_damping and j.damping and len(j.coordinates) == 1:
-            params[f"d_{j.coordinates[0]}"] = float(j.damping)
+    params.update(damping)
 
     units.update(coord_units)
     units.update({tau: "N*m" if coord_units[tau[4:]] == "rad" else "N" for tau in inputs})
