@@ -16,7 +16,7 @@ import symengine as se
 
 from ..errors import ModelError
 from .expressions import Expr, as_expr, as_matrix3, as_vector
-from .joints import IDENTITY, Mat3, Rot, Vec3, orientation_problem, rotation_matrix
+from .joints import IDENTITY, Mat3, Rot, Vec3, _matmul, orientation_problem, rotation_matrix
 
 #: In a :class:`SpringDamper` ``law``: the elongation ``L - L0`` and its rate ``dL/dt``.
 elongation = se.Symbol("elongation")
@@ -243,9 +243,7 @@ def _axes(value: object, where: str) -> Mat3:
     if isinstance(value, list | tuple) and value and all(isinstance(r, Rot) for r in value):
         R = IDENTITY
         for r in value:
-            A = rotation_matrix(r.axis, r.angle)
-            R = tuple(tuple(se.Add(*(R[i][k] * A[k][j] for k in range(3))) for j in range(3))
-                      for i in range(3))  # type: ignore[assignment]
+            R = _matmul(R, rotation_matrix(r.axis, r.angle))
         return R
     R = as_matrix3(value, where)
     if not any(x.free_symbols for row in R for x in row):
