@@ -251,6 +251,12 @@ def _rank_tol(A: np.ndarray) -> float:
     return max(A.shape) * EPS * (np.linalg.norm(A, 2) if A.size else 0.0)
 
 
+def _cond(A: np.ndarray) -> float:
+    """2-norm condition number of ``A`` (inf when singular; 1 when empty)."""
+    s = np.linalg.svd(A, compute_uv=False) if A.size else np.ones(1)
+    return float(s[0] / s[-1]) if s[-1] > 0 else float("inf")
+
+
 def partition(loop: ClosedLoopSystem, Phi_z: np.ndarray,
               independent: Sequence[str] | None = None) -> Partition:
     """Choose ``z = (y, d)`` from the constraint Jacobian ``Phi_z`` (m×n) at a configuration.
@@ -283,9 +289,7 @@ def partition(loop: ClosedLoopSystem, Phi_z: np.ndarray,
                              f"coordinates were chosen ({', '.join(independent)})")
         ind = tuple(sorted(ind))
         dep = tuple(j for j in range(n) if j not in ind)
-    Pd = A[:, list(dep)]
-    s = np.linalg.svd(Pd, compute_uv=False) if Pd.size else np.ones(1)
-    cond = float(s[0] / s[-1]) if s[-1] > 0 else float("inf")
+    cond = _cond(A[:, list(dep)])
     if independent is not None and not cond < 1.0 / (EPS * max(1, r)):
         raise ModelError(f"{loop.name}: the independent coordinates {', '.join(independent)} "
                          f"do not determine the others here: Φ_d (dependent "
@@ -415,12 +419,11 @@ class LoopEvaluator:
         return ", ".join(f"{n} = {v:.6g}" for n, v in zip(self.independent_names, y,
                                                           strict=True))
 
-    def cond(self, z: np.ndarray, t: float) -> float:
-        """Condition number of Φ_d at ``z`` (2-norm)."""
-        Pz = self._con(z, np.zeros(self.n), t)["Phi_z"]
-        Pd = Pz[np.ix_(list(self.part.rows), list(self.part.dependent))]
-        s = np.linalg.svd(Pd, compute_uv=False)
-        return float(s[0] / s[-1]) if s[-1] > 0 else float("inf")
+    def cond(self, z: np.ndarray, t: float, Phi_z: np.ndarray | None = None) -> float:
+        """Condition number of Φ_d at ``z`` (2-norm); ``Phi_z``: Φ_z there, if already
+        evaluated (as :meth:`solve_positions` returns it)."""
+        Pz = self._con(z, np.zeros(self.n), t)["Phi_z"] if Phi_z is None else Phi_z
+        return _cond(Pz[np.ix_(list(self.part.rows), list(self.part.dependent))])
 
     def velocity_map(self, Phi_z: np.ndarray, Phi_t: np.ndarray
                      ) -> tuple[np.ndarray, np.ndarray, Any]:

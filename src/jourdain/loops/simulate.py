@@ -235,9 +235,9 @@ def simulate_loop(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: Any,
                 f = ev.part.f
                 ev.z_guess = z_end
                 ev._last = None
-                z_acc, _, _ = ev.solve_positions(solver.y[:f], solver.t)
+                z_acc, cd, _ = ev.solve_positions(solver.y[:f], solver.t)
                 ev.z_guess = z_acc
-                c_now = ev.cond(z_acc, solver.t)
+                c_now = ev.cond(z_acc, solver.t, cd["Phi_z"])
                 if c_now > cond_limit or (repartition and c_now > 10 * watermark):
                     event = (float(solver.t), solver.y.copy(), c_now)
                     break
