@@ -291,6 +291,7 @@ def _read_xml(path: str) -> tuple[bytes, dict[tuple[str, str], int]]:
     if root.tag != "robot":
         raise UrdfError(f"the root element is <{root.tag}>, expected <robot>", path,
                         root.sourceline)
+    lines: dict[tuple[str, str], int] = {}
     for el in root:
         if not isinstance(el.tag, str):
             continue
@@ -299,9 +300,7 @@ def _read_xml(path: str) -> tuple[bytes, dict[tuple[str, str], int]]:
             raise UrdfError(f'<{el.tag}> "{name}": closed kinematic loops are not supported '
                             "(jourdain models trees; cut the loop or model it in a model "
                             "file)", path, el.sourceline)
-    lines: dict[tuple[str, str], int] = {}
-    for el in root:
-        if isinstance(el.tag, str) and el.tag in ("link", "joint"):
+        if el.tag in ("link", "joint"):
             lines.setdefault((el.tag, el.get("name", "")), el.sourceline)
             mim = el.find("mimic") if el.tag == "joint" else None
             if mim is not None:
