@@ -562,7 +562,8 @@ def _build(robot: Any, src: _Source, *, floating_base: bool, g: float, mimic: st
         pos = tuple(float(x) for x in X[:3, 3])
         R = X[:3, :3]
         ori = None if np.array_equal(R, np.eye(3)) else [[float(x) for x in r] for r in R]
-        ax = _AXIS_NAMES.get(tuple(float(a) for a in axis)) or tuple(float(a) for a in axis)
+        axis_name = _AXIS_NAMES.get(common["axis"])  # "x", "-y", ... or None
+        ax = axis_name or common["axis"]
         try:
             if j.type in ("revolute", "continuous", "prismatic"):
                 q = jn
@@ -573,7 +574,7 @@ def _build(robot: Any, src: _Source, *, floating_base: bool, g: float, mimic: st
                 qs = tuple(f"{jn}_{s}" for s in ("x", "y", "z", "yaw", "pitch", "roll"))
                 joint = Free(jn, _symbols(qs), "zyx", position=pos, orientation=ori)
             else:  # planar: the plane normal to the axis, which must be a frame axis
-                normal = _AXIS_NAMES.get(tuple(float(a) for a in axis))
+                normal = axis_name
                 if normal is None or normal.startswith("-"):
                     raise UrdfError(
                         f'joint "{j.name}": a planar joint is read only with its axis '
