@@ -45,6 +45,7 @@ import numpy as np
 from scipy.integrate import BDF, DOP853, RK45, Radau
 
 from ..errors import EvaluationError
+from ..simulate import check_t_span
 from .closed_loop import ClosedLoopSystem, LoopEvaluator, SingularConfiguration
 
 
@@ -155,9 +156,7 @@ def simulate_loop(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: Any,
     A singular configuration stops the run with ``status="singular"`` and the exception in
     ``singular`` (the results up to there are kept) unless a new partition resolves it.
     """
-    t0, t1 = float(t_span[0]), float(t_span[1])
-    if not (math.isfinite(t0) and math.isfinite(t1) and t1 > t0):
-        raise EvaluationError(f"t_span must be two finite times with t_end > t0, got {t_span}")
+    t0, t1 = check_t_span(t_span)
     if not cond_limit > 1:
         raise EvaluationError(f"cond_limit must be > 1, got {cond_limit}")
     n_u = len(loop.tree.inputs)
@@ -310,9 +309,7 @@ def simulate_redundant(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: 
     """
     from scipy.integrate import solve_ivp
 
-    t0, t1 = float(t_span[0]), float(t_span[1])
-    if not (math.isfinite(t0) and math.isfinite(t1) and t1 > t0):
-        raise EvaluationError(f"t_span must be two finite times with t_end > t0, got {t_span}")
+    t0, t1 = check_t_span(t_span)
     ev = LoopEvaluator(loop, z0, t0, parameters)
     asm = ev.assemble(z0, zd0, t0)
     n = loop.n
@@ -365,9 +362,7 @@ def simulate_penalty(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: An
     from scipy.integrate import solve_ivp
     from scipy.linalg import cho_factor, cho_solve
 
-    t0, t1 = float(t_span[0]), float(t_span[1])
-    if not (math.isfinite(t0) and math.isfinite(t1) and t1 > t0):
-        raise EvaluationError(f"t_span must be two finite times with t_end > t0, got {t_span}")
+    t0, t1 = check_t_span(t_span)
     ev = LoopEvaluator(loop, z0, t0, parameters)
     asm = ev.assemble(z0, zd0, t0)
     n = loop.n
