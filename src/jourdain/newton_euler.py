@@ -16,7 +16,7 @@ import symengine as se
 
 from .errors import ModelError
 from .kinematics import Z3, BodyKinematics, Kinematics, _add, _cross, _dot, _mm, _mtv, _mv, _scale
-from .measures import Frames, Resolver, bushing_deflection, bushing_loads, bushing_wrench
+from .measures import Resolver, bushing_deflection, bushing_loads, bushing_wrench
 from .model.bodies import WORLD, Body
 from .model.forces import (
     Bushing,
@@ -193,16 +193,17 @@ def applied_forces(kin: Kinematics, elements: Sequence[object] | None = None
             _, T_B = acc.to_body(res.resolve_all(fe.vector), fe.frame, fe.body)
             acc.add_torque(fe.body, T_B)
         elif isinstance(fe, SpringDamper):
-            _spring_damper(acc, kin, fe, res)
+            _spring_damper(acc, fe, res)
         elif isinstance(fe, GeneralizedForce):
             _generalized_force(acc, sys, fe, res)
         elif isinstance(fe, Bushing):
-            _bushing(acc, res.frames, fe, res)
+            _bushing(acc, fe, res)
     return acc.result()
 
 
-def _bushing(acc: _Accumulator, frames: Frames, fe: Bushing, res: Resolver) -> None:
+def _bushing(acc: _Accumulator, fe: Bushing, res: Resolver) -> None:
     """A bushing's wrench on its two bodies (see :class:`jourdain.model.forces.Bushing`)."""
+    frames = res.frames
     x, xd, geo = bushing_deflection(frames, fe)
     w = res.resolve_all(bushing_wrench(fe, x, xd))
     for body, F_I, vec, point in bushing_loads(frames, fe, w, geo):
@@ -212,21 +213,9 @@ def _bushing(acc: _Accumulator, frames: Frames, fe: Bushing, res: Resolver) -> N
             acc.add_torque(body, vec)
 
 
-def _point_state(kin: Kinematics, body: str, p: Vec3) -> tuple[Vec3, Vec3]:
-    """Inertial position and velocity of a point (body frame) of ``body`` or of the world."""
-    if body == WORLD:
-        return p, Z3
-    r, cols, v_bar, _ = kin[body].point(p)
-    v = v_bar
-    for j, c in cols.items():
-        v = _add(v, _scale(c, kin.yd[j]))
-    return r, v
-
-
-def _spring_damper(acc: _Accumulator, kin: Kinematics, fe: SpringDamper,
-                   res: Resolver) -> None:
-    ra, va = _point_state(kin, fe.body_a, fe.point_a)
-    rb, vb = _point_state(kin, fe.body_b, fe.point_b)
+def _spring_damper(acc: _Accumulator, fe: SpringDamper, res: Resolver) -> None:
+    ra, va = res.frames.point(fe.body_a, fe.point_a)
+    rb, vb = res.frames.point(fe.body_b, fe.point_b)
     d = (rb[0] - ra[0], rb[1] - ra[1], rb[2] - ra[2])
     L = se.sqrt(_dot(d, d))
     e = _scale(d, 1 / L)
