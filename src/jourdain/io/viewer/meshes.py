@@ -171,11 +171,10 @@ def _dae_geometry(geo: ET.Element, where: str
                 raise ModelError(f"{where}: <p> does not hold whole vertices")
             idx = idx.reshape(-1, n_in)[:, off]
             if prim.tag == "triangles":
-                polys = None
-                faces = idx.reshape(-1, 3) if idx.size % 3 == 0 else None
-                if faces is None:
+                if idx.size % 3:
                     raise ModelError(f"{where}: <triangles> with a corner count not a multiple "
                                      "of 3")
+                polys, faces = None, idx.reshape(-1, 3)
             else:
                 counts = _numbers(prim.find("vcount"), where, int)
                 if counts.sum() != idx.size:
