@@ -189,6 +189,8 @@ def _reaction_names(system: System, reactions: Sequence[str] | str | None
 
 def _tables(joints: list[Any], chosen: list[str], bodies: list[str]) -> tuple[str, list[Any]]:
     """model.h's tables of the reaction outputs and the direction expressions of jd_dirs."""
+    if not chosen:
+        return "", []
     used = [jr for jr in joints if any(n in chosen for n in jr.names)]
     body, ndir, off, exprs = [], [], [0], []
     for jr in used:
@@ -202,8 +204,6 @@ def _tables(joints: list[Any], chosen: list[str], bodies: list[str]) -> tuple[st
         j = next(k for k, jr in enumerate(used) if n in jr.names)
         g_joint.append(j)
         g_dir.append(used[j].names.index(n))
-    if not chosen:
-        return "", []
     text = (f"#define JD_NJ {len(used)}\n#define JD_NE {max(off[-1], 1)}\n"
             + _array("int", "jd_rj_body", body) + _array("int", "jd_rj_ndir", ndir)
             + _array("int", "jd_rj_off", off) + _array("int", "jd_g_joint", g_joint)
