@@ -323,21 +323,12 @@ def simulate_redundant(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: 
     sol = solve_ivp(rhs, (t0, t1), np.concatenate([asm.z, asm.zd]), method="DOP853",
                     rtol=rtol, atol=atol, t_eval=tev)
     wall = time.perf_counter() - started
-    out: dict[str, list] = {k: [] for k in ("z", "zd", "zdd", "Phi", "Phi_dot", "lam", "T",
-                                             "V")}
-    for k in range(len(sol.t)):
-        z, zd, t = sol.y[:n, k], sol.y[n:, k], float(sol.t[k])
+
+    def sample(z: np.ndarray, zd: np.ndarray, t: float) -> tuple[np.ndarray, np.ndarray,
+                                                                dict[str, np.ndarray]]:
         zdd, lam = ev.redundant_accelerations(z, zd, t, alpha, beta)
-        cd = ev._con(np.ascontiguousarray(z), np.ascontiguousarray(zd), t)
-        out["z"].append(z)
-        out["zd"].append(zd)
-        out["zdd"].append(zdd)
-        out["Phi"].append(cd["Phi"][:, 0])
-        out["Phi_dot"].append(cd["Phi_z"] @ zd + cd["Phi_t"][:, 0])
-        out["lam"].append(lam)
-        out["T"].append(float(cd["T"][0, 0]))
-        out["V"].append(float(cd["V"][0, 0]))
-    return _redundant_results(loop, ev, sol, out, t0, wall)
+        return zdd, lam, ev._con(z, zd, t)
+    return _redundant_results(loop, ev, sol, sample, t0, wall)
 
 
 def simulate_penalty(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: Any,
@@ -392,30 +383,38 @@ def simulate_penalty(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: An
     sol = solve_ivp(rhs, (t0, t1), np.concatenate([asm.z, asm.zd]), method="DOP853",
                     rtol=rtol, atol=atol, t_eval=np.linspace(t0, t1, samples))
     wall = time.perf_counter() - started
-    out: dict[str, list] = {k: [] for k in ("z", "zd", "zdd", "Phi", "Phi_dot", "lam", "T",
-                                             "V")}
-    for k in range(len(sol.t)):
-        z, zd, t = sol.y[:n, k], sol.y[n:, k], float(sol.t[k])
+
+    def sample(z: np.ndarray, zd: np.ndarray, t: float) -> tuple[np.ndarray, np.ndarray,
+                                                                dict[str, np.ndarray]]:
         zdd, lam, cd = accel(z, zd, t)
-        out["z"].append(z)
-        out["zd"].append(zd)
-        out["zdd"].append(zdd)
-        out["Phi"].append(cd["Phi"][:, 0])
-        out["Phi_dot"].append(cd["Phi_z"] @ zd + cd["Phi_t"][:, 0])
         # the sign of λ in M·z̈ = … − Φ_zᵀλ: −λ is the multiplier of the other forms
-        out["lam"].append(-lam)
-        out["T"].append(float(cd["T"][0, 0]))
-        out["V"].append(float(cd["V"][0, 0]))
-    return _redundant_results(loop, ev, sol, out, t0, wall)
+        return zdd, -lam, cd
+    return _redundant_results(loop, ev, sol, sample, t0, wall)
 
 
 __all__ = ["LoopResults", "simulate_loop", "simulate_penalty", "simulate_redundant"]
 
 
-def _redundant_results(loop: ClosedLoopSystem, ev: Any, sol: Any, out: dict, t0: float,
+def _redundant_results(loop: ClosedLoopSystem, ev: Any, sol: Any,
+                       sample: Callable[[np.ndarray, np.ndarray, float], tuple], t0: float,
                        wall: float) -> LoopResults:
     """The results of a redundant-coordinate run (``simulate_redundant``,
-    ``simulate_penalty``) from SciPy's solution and the samples collected in ``out``."""
+    ``simulate_penalty``) from SciPy's solution, each sample evaluated by ``sample(z, ż, t)``
+    → ``(z̈, λ, constraint data)``."""
+    n = loop.n
+    out: dict[str, list] = {k: [] for k in ("z", "zd", "zdd", "Phi", "Phi_dot", "lam", "T",
+                                             "V")}
+    for k in range(len(sol.t)):
+        z, zd, t = sol.y[:n, k], sol.y[n:, k], float(sol.t[k])
+        zdd, lam, cd = sample(np.ascontiguousarray(z), np.ascontiguousarray(zd), t)
+        out["z"].append(z)
+        out["zd"].append(zd)
+        out["zdd"].append(zdd)
+        out["Phi"].append(cd["Phi"][:, 0])
+        out["Phi_dot"].append(cd["Phi_z"] @ zd + cd["Phi_t"][:, 0])
+        out["lam"].append(lam)
+        out["T"].append(float(cd["T"][0, 0]))
+        out["V"].append(float(cd["V"][0, 0]))
     status = "finished" if sol.status == 0 else "failed"
     return LoopResults(
         loop, sol.t, np.array(out["z"]), np.array(out["zd"]), np.array(out["zdd"]),
