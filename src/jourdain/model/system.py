@@ -12,7 +12,7 @@ import symengine as se
 
 from ..errors import ModelError
 from .bodies import WORLD, Body, check_values
-from .expressions import as_expr, free_names, t
+from .expressions import as_expr, free_names, t, values_at
 from .forces import (
     RESERVED,
     Bushing,
@@ -508,7 +508,7 @@ def _check_axes(sys: System, b: Body) -> None:
     (:func:`jourdain.model.expressions.unit_axis` divides them by their symbolic length)."""
     j = b.joint
     p_names = {k for k, _ in sys.parameters}
-    subs = {se.Symbol(k): v for k, v in sys.parameters}
+    defaults = dict(sys.parameters)
     for k, step in enumerate(j.steps):
         u = step.axis
         names = free_names(u) if u is not None else set()
@@ -519,11 +519,7 @@ def _check_axes(sys: System, b: Body) -> None:
         bad = names - p_names
         if bad:
             raise ModelError(f"{where} uses {sorted(bad)}; axes may depend on parameters only")
-        try:
-            vals = [float(v) for v in se.DenseMatrix(3, 1, list(u)).subs(subs)]
-        except (RuntimeError, TypeError, ValueError):
-            vals = [math.nan]
-        if not all(math.isfinite(v) for v in vals):
+        if not all(math.isfinite(v) for v in values_at(u, defaults)):  # NaN: no real value
             raise ModelError(f"{where} is the zero vector at the default parameter values")
 
 
