@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from .closed_loop import ClosedLoopSystem, LoopEvaluator
+from .closed_loop import AssemblyError, ClosedLoopSystem, LoopEvaluator
 
 
 @dataclass(frozen=True)
@@ -97,11 +97,10 @@ def equilibrium(loop: ClosedLoopSystem, z_guess: Any, t: float = 0.0,
         lin = linearize_loop(loop, z, None, t, None, parameters)
         if np.max(np.abs(lin.h)) <= tol * (1 + np.max(np.abs(lin.Q))):
             return lin.z_s
-        ev = LoopEvaluator(loop, lin.z_s, t, parameters)
-        ind = list(ev.part.independent)
+        # the Newton step in the coordinates Q and h are in: the linearization's own
+        ind = [loop.coordinate_names.index(c) for c in lin.names]
         z = lin.z_s.copy()
         z[ind] += np.linalg.solve(lin.Q, lin.h)
-    from .closed_loop import AssemblyError
     raise AssemblyError(f"{loop.name}: no equilibrium found near {list(z_guess)}")
 
 
