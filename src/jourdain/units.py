@@ -146,7 +146,6 @@ def input_units(system: System) -> dict[str, str]:
 
     declared = dict(system.units)
     coords = coordinate_units(system)
-    _, length = base_units(declared)
     kinds: dict[str, set[str]] = {}
     for fe in system.forces:
         if isinstance(fe, Force):
@@ -154,9 +153,7 @@ def input_units(system: System) -> dict[str, str]:
         elif isinstance(fe, Torque):
             exprs, kind = list(fe.vector), torque_unit(declared)
         elif isinstance(fe, GeneralizedForce):
-            cu = coords.get(str(fe.coordinate), "")
-            kind = (force_unit(declared) if cu == length else
-                    torque_unit(declared) if cu == ANGLE else "")
+            kind = generalized_force_unit(coords.get(str(fe.coordinate), ""), declared)
             exprs = [fe.value]
         else:
             continue
