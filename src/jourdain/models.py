@@ -120,11 +120,7 @@ def spatial_chain_data(n: int, seed: int = 0) -> list[dict]:
         else:
             axes = ("x", "y", "z")
         # full, non-diagonal inertia: principal moments (triangle inequality) turned by a rotation
-        a, b = rng.uniform(0.02, 0.05, 2)
-        c = rng.uniform(abs(a - b) + 0.005, a + b - 0.005)
-        Qm, _ = np.linalg.qr(rng.normal(size=(3, 3)))
-        I = Qm @ np.diag([a, b, c]) @ Qm.T
-        I = np.round(0.5 * (I + I.T), 6)
+        I = np.round(_random_inertia(rng, 0.02, 0.05, margin=0.005), 6)
         out.append({
             "joint": kind, "axes": axes, "mass": round(float(rng.uniform(0.5, 2.0)), 4),
             "com": np.round(rng.uniform(-0.1, 0.1, 3) + np.array([0.0, 0.0, 0.15]), 4),
@@ -160,13 +156,10 @@ def robot_arm_data(seed: int = 7) -> list[dict]:
     rng = np.random.default_rng(seed)
     out = []
     for i in range(7):
-        a, b = rng.uniform(0.005, 0.03, 2)
-        c = rng.uniform(abs(a - b) + 0.002, a + b - 0.002)
-        Qm, _ = np.linalg.qr(rng.normal(size=(3, 3)))
-        inertia = Qm @ np.diag([a, b, c]) @ Qm.T
+        inertia = _random_inertia(rng, 0.005, 0.03, margin=0.002)
         out.append({"joint": "revolute", "axes": (ARM_AXES[i],), "mass": ARM_MASSES[i],
                     "com": np.round(rng.uniform(-0.05, 0.05, 3), 4),
-                    "inertia": 0.5 * (inertia + inertia.T),
+                    "inertia": inertia,
                     "offset": np.array(ARM_OFFSETS[i], dtype=float)})
     return out
 
@@ -329,11 +322,13 @@ def _unit_vector(rng: np.random.Generator) -> np.ndarray:
     return u / np.linalg.norm(u)
 
 
-def _random_inertia(rng: np.random.Generator, lo: float, hi: float) -> np.ndarray:
-    """A full inertia tensor: principal moments that satisfy the triangle inequality strictly,
-    turned by a random rotation."""
+def _random_inertia(rng: np.random.Generator, lo: float, hi: float,
+                    margin: float | None = None) -> np.ndarray:
+    """A full inertia tensor: principal moments in (lo, hi) that satisfy the triangle
+    inequality by at least ``margin`` (default ``0.1·lo``), turned by a random rotation."""
+    m = 0.1 * lo if margin is None else margin
     a, b = rng.uniform(lo, hi, 2)
-    c = rng.uniform(abs(a - b) + 0.1 * lo, a + b - 0.1 * lo)
+    c = rng.uniform(abs(a - b) + m, a + b - m)
     Qm, _ = np.linalg.qr(rng.normal(size=(3, 3)))
     I = Qm @ np.diag([a, b, c]) @ Qm.T
     return 0.5 * (I + I.T)
