@@ -103,7 +103,7 @@ def run_report(model: Any, out: Path, parameters: Mapping[str, float] | None = N
     import matplotlib.pyplot as plt
 
     from .linearization import equilibrium, linearize_loop
-    from .simulate import simulate_loop
+    from .simulate import SOLVERS, simulate_loop
 
     loop: ClosedLoopSystem = model.loops
     sim = model.simulation
@@ -115,7 +115,7 @@ def run_report(model: Any, out: Path, parameters: Mapping[str, float] | None = N
     # model's (the energy of a conservative loop is reported to 1e-9)
     rtol = sim.rtol if sim.rtol != DEFAULT_RTOL else 1e-10
     atol = sim.atol if sim.atol != DEFAULT_ATOL else 1e-12
-    method = sim.method if sim.method in ("DOP853", "RK45", "Radau", "BDF") else "DOP853"
+    method = sim.method if sim.method in SOLVERS else "DOP853"
     res = simulate_loop(loop, (0.0, t1), sim.y0, sim.yd0, samples=sim.samples,
                         parameters=parameters, rtol=rtol, atol=atol, method=method)
     names = loop.coordinate_names

@@ -48,6 +48,9 @@ from ..errors import EvaluationError
 from ..simulate import check_t_span
 from .closed_loop import ClosedLoopSystem, LoopEvaluator, SingularConfiguration
 
+#: the steppers :func:`simulate_loop` drives, by ``method``
+SOLVERS = {"DOP853": DOP853, "RK45": RK45, "Radau": Radau, "BDF": BDF}
+
 
 @dataclass
 class LoopResults:
@@ -198,15 +201,14 @@ def simulate_loop(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: Any,
             out[k].append(s[k])
         out["lam"].append(ev.multipliers(s))
 
-    solvers = {"DOP853": DOP853, "RK45": RK45, "Radau": Radau, "BDF": BDF}
-    if method not in solvers:
-        raise EvaluationError(f"method must be one of {', '.join(solvers)}, got {method!r}")
+    if method not in SOLVERS:
+        raise EvaluationError(f"method must be one of {', '.join(SOLVERS)}, got {method!r}")
     k_eval = 0
     # a new partition is sought when Φ_d's condition grows tenfold over this mark: the chart
     # (y, ẏ) degrades long before Φ_d is singular (the rates ẏ → 0 at a limit position of y)
     watermark = max(ev.part.cond, 10.0)
     while True:
-        solver = solvers[method](rhs, t, x, t1, rtol=rtol, atol=atol, max_step=max_step)
+        solver = SOLVERS[method](rhs, t, x, t1, rtol=rtol, atol=atol, max_step=max_step)
         if k_eval < len(tev) and tev[k_eval] == t:
             record(t, x)
             k_eval += 1
