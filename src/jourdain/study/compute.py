@@ -229,9 +229,12 @@ def compute_block(spec: StudySpec, start: int, stop: int,
     comp = spec.compute
     if "evaluate" in comp:
         _evaluate(ctx, P, Y, YD, ok, out, errors)
-    if "linearize" in comp:
+    if "linearize" in comp or "frequency_response" in comp:
         idx = np.flatnonzero(ok)
-        lam, maxre, verdict, errs = analyse(ctx, P[idx])
+        # M̃, P, Q, B of the cases: one C call for both outputs
+        nums = linearization_numbers(ctx, P[idx]) if idx.size else None
+    if "linearize" in comp:
+        lam, maxre, verdict, errs = analyse(ctx, P[idx], nums)
         out["eigenvalue_real"][idx] = lam.real
         out["eigenvalue_imag"][idx] = lam.imag
         out["max_real_part"][idx] = maxre
@@ -243,8 +246,7 @@ def compute_block(spec: StudySpec, start: int, stop: int,
         out[f"critical_{comp['critical']['parameter']}"][idx] = crit
         _record(errors, idx, errs, "critical")
     if "frequency_response" in comp:
-        idx = np.flatnonzero(ok)
-        mag, phase, errs = frequency_responses(ctx, P[idx])
+        mag, phase, errs = frequency_responses(ctx, P[idx], nums)
         out["frf_magnitude"][idx] = mag
         out["frf_phase"][idx] = phase
         _record(errors, idx, errs, "frequency_response")
@@ -366,11 +368,20 @@ def _evaluate(ctx: Context, P: np.ndarray, Y: np.ndarray, YD: np.ndarray, ok: np
 
 # --- linearize: state matrices, eigenvalues and verdicts of a stack of cases -----------------
 
-def analyse(ctx: Context, P: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray,
-                                                  dict[int, str]]:
+def linearization_numbers(ctx: Context, P: np.ndarray) -> dict[str, np.ndarray]:
+    """M̃, P, Q, B, ... of the linearization at each row of ``P`` (n ≥ 1), in one C call."""
+    n, f = len(P), ctx.system.f
+    Z = np.zeros((n, f))
+    U = np.zeros((n, len(ctx.system.inputs))) if ctx.system.inputs else None
+    return ctx.compiled_linearization.function.batch(Z, Z, 0.0, P, U)
+
+
+def analyse(ctx: Context, P: np.ndarray, nums: Mapping[str, np.ndarray] | None = None
+            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict[int, str]]:
     """Eigenvalues (n, 2f) sorted as :func:`jourdain.analysis.sweep` sorts them, the largest
     real part (n,) and the verdict code (n,) of the linearization at each row of ``P``; and
-    the errors by row (their outputs NaN / −1)."""
+    the errors by row (their outputs NaN / −1). ``nums``: :func:`linearization_numbers` at
+    ``P`` where already computed."""
     from ..analysis.cyclic import reduced_matrix
     from ..analysis.modes import ZERO_RTOL, _verdict
 
@@ -381,10 +392,8 @@ def analyse(ctx: Context, P: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nda
     errs: dict[int, str] = {}
     if not n:
         return lam, maxre, verdict, errs
-    fn = ctx.compiled_linearization.function
-    Z = np.zeros((n, f))
-    nums = fn.batch(Z, Z, 0.0, P, np.zeros((n, len(ctx.system.inputs))) if ctx.system.inputs
-                    else None)
+    if nums is None:
+        nums = linearization_numbers(ctx, P)
     A, bad = state_matrices(nums["M_tilde"], nums["P"], nums["Q"])
     for i, msg in bad.items():
         errs[i] = msg
@@ -417,13 +426,15 @@ def analyse(ctx: Context, P: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nda
     return lam, maxre, verdict, errs
 
 
-def frequency_responses(ctx: Context, P: np.ndarray
+def frequency_responses(ctx: Context, P: np.ndarray,
+                        nums: Mapping[str, np.ndarray] | None = None
                         ) -> tuple[np.ndarray, np.ndarray, dict[int, str]]:
     """``|η̂|`` and ``arg η̂`` (unwrapped along the frequencies), each (n, n_ω, f, m), of the
     linearization at each row of ``P``: ``η̂ = (Q − Ω²M̃ + iΩP)⁻¹·F`` with ``F = B`` (inputs)
     or the identity (``h``), as :func:`jourdain.analysis.frequency_response` gives it for one
     case; M̃, P, Q, B of all cases from one C call, the complex solves stacked over cases and
-    frequencies. A case whose dynamic stiffness is singular at some Ω records its error."""
+    frequencies. A case whose dynamic stiffness is singular at some Ω records its error.
+    ``nums``: :func:`linearization_numbers` at ``P`` where already computed."""
     fr = ctx.spec.compute["frequency_response"]
     n, f = len(P), ctx.system.f
     w = np.asarray(fr["omega"], dtype=float)
@@ -433,10 +444,8 @@ def frequency_responses(ctx: Context, P: np.ndarray
     errs: dict[int, str] = {}
     if not n:
         return mag, phase, errs
-    fn = ctx.compiled_linearization.function
-    Z0 = np.zeros((n, f))
-    nums = fn.batch(Z0, Z0, 0.0, P, np.zeros((n, len(ctx.system.inputs))) if ctx.system.inputs
-                    else None)
+    if nums is None:
+        nums = linearization_numbers(ctx, P)
     F = nums["B"] if fr["excitation"] == "inputs" else np.broadcast_to(np.eye(f), (n, f, f))
     W = w[None, :, None, None]
     Z = (nums["Q"][:, None] - W**2 * nums["M_tilde"][:, None] + 1j * W * nums["P"][:, None])
