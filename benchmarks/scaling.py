@@ -48,7 +48,6 @@ import math
 import sys
 import time
 from pathlib import Path
-from typing import Any
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
@@ -69,17 +68,6 @@ def _source_bytes() -> int:
     return sum(p.stat().st_size for p in cache_dir().glob("*.c"))
 
 
-def _best(fns: dict[str, Any], repeat: int) -> dict[str, float]:
-    """Best wall time of each callable over ``repeat`` interleaved rounds (A B A B …)."""
-    best = dict.fromkeys(fns, math.inf)
-    for _ in range(repeat):
-        for name, fn in fns.items():
-            t0 = time.perf_counter()
-            fn()
-            best[name] = min(best[name], time.perf_counter() - t0)
-    return best
-
-
 def case(kind: str, n: int, seed: int = 0, n_states: int = 1000, repeat: int = 3) -> dict:
     """One model, measured in this process (which should be fresh, with an empty cache)."""
     t0 = time.perf_counter()
@@ -89,6 +77,8 @@ def case(kind: str, n: int, seed: int = 0, n_states: int = 1000, repeat: int = 3
     from jourdain.numeric import dynamics_function, mkq_function
 
     t_import = time.perf_counter() - t0
+    from benchmarks.per_state import interleaved  # the interleaved best-of timing (not timed)
+
     t0 = time.perf_counter()
     system = spatial_chain(n, seed) if kind == "chain" else random_tree(n, seed)
     t_build = time.perf_counter() - t0
@@ -118,8 +108,8 @@ def case(kind: str, n: int, seed: int = 0, n_states: int = 1000, repeat: int = 3
     # the batch agrees with System.evaluate (same state, different compiled function)
     one = fn.batch(np.full((1, f), 0.1), np.zeros((1, f)), 0.0, p, None)
     m_diff = float(np.abs(one["M"][0] - out["M"]).max() / np.abs(out["M"]).max())
-    best = _best({"batch": lambda: fn.batch(Y, YD, 0.0, p, None, out=buf),
-                  "dynamics": lambda: fd.dynamics(Y, YD, 0.0, p, None)}, repeat)
+    best = interleaved({"batch": lambda: fn.batch(Y, YD, 0.0, p, None, out=buf),
+                        "dynamics": lambda: fd.dynamics(Y, YD, 0.0, p, None)}, repeat)
     del res
     t0 = time.perf_counter()
     system.equations_of_motion()
