@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 from ..model import Body, Gravity, Prismatic, Revolute, System, rod, symbols
-from ..model.forces import GeneralizedForce  # noqa: F401  (re-exported for the examples)
 from .closed_loop import ClosedLoopSystem
 from .constraints import ClosingJoint
 
