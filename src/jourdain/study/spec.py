@@ -404,11 +404,7 @@ class _Reader:
             elif what == "frequency_response":
                 out[what] = self.frequency_response(entry, path, model, nominal_names, defaults)
             elif what in ("linearize", "critical"):
-                about = entry.get("about", nominal_names[0] if nominal_names else None)
-                if about not in nominal_names:
-                    raise self.error((*path, "about"), f"no nominal motion {about!r} in the "
-                                     f"model; it has: {', '.join(nominal_names) or '(none)'}")
-                d: dict[str, Any] = {"about": about}
+                d: dict[str, Any] = {"about": self.about(entry, path, nominal_names)}
                 if what == "critical":
                     par = entry.get("parameter")
                     if par not in defaults:
@@ -437,6 +433,14 @@ class _Reader:
             raise self.error(("compute",), "nothing to compute")
         return out
 
+    def about(self, entry: dict, path: tuple[str | int, ...], nominal_names: list[str]) -> str:
+        """The nominal motion named by ``about`` (the model's first one by default)."""
+        about = entry.get("about", nominal_names[0] if nominal_names else None)
+        if about not in nominal_names:
+            raise self.error((*path, "about"), f"no nominal motion {about!r} in the model; it "
+                             f"has: {', '.join(nominal_names) or '(none)'}")
+        return about
+
     def frequency_response(self, entry: dict, path: tuple[str | int, ...], model: Any,
                            nominal_names: list[str], defaults: Mapping[str, float]
                            ) -> dict[str, Any]:
@@ -445,10 +449,7 @@ class _Reader:
         ``excitation`` (``"inputs"``: the model's inputs through B; ``"h"``: a unit
         generalized force on each coordinate)."""
         system = model.system
-        about = entry.get("about", nominal_names[0] if nominal_names else None)
-        if about not in nominal_names:
-            raise self.error((*path, "about"), f"no nominal motion {about!r} in the model; it "
-                             f"has: {', '.join(nominal_names) or '(none)'}")
+        about = self.about(entry, path, nominal_names)
         w = entry.get("omega")
         if isinstance(w, list) and w:
             omega = tuple(self.number(v, (*path, "omega", i), defaults) for i, v in enumerate(w))
