@@ -150,7 +150,7 @@ class ClosedLoopSystem:
     def coordinate_names(self) -> list[str]:
         return self.tree.coordinate_names
 
-    def grubler(self) -> int | None:
+    def grubler(self) -> int:
         """Degrees of freedom by the Grübler–Kutzbach count (spatial: 6 per body)."""
         return grubler(len(self.tree.bodies), [len(b.joint.coordinates)
                                                for b in self.tree.bodies], self.closing)

@@ -254,9 +254,9 @@ def constraint_rows(kin: object, closing: Sequence[ClosingJoint]) -> list[Constr
 
 
 def grubler(n_bodies: int, tree_joint_dofs: Sequence[int], closing: Sequence[ClosingJoint]
-            ) -> int | None:
-    """Grübler–Kutzbach count ``6·n − Σ(6 − f_j)`` over the tree and closing joints (None
-    when a general constraint has no joint count: then ``6·n − Σ(6 − f_j) − rows``)."""
+            ) -> int:
+    """Grübler–Kutzbach count ``6·n − Σ(6 − f_j)`` over the tree and closing joints (a
+    general constraint, which has no joint count, takes away one per expression)."""
     total = 6 * n_bodies - sum(6 - f for f in tree_joint_dofs)
     for cj in closing:
         if cj.joint_dof is None:
