@@ -314,9 +314,6 @@ class Assembly:
     iterations: int
     independent: tuple[str, ...]
 
-    def y(self, part: Partition) -> np.ndarray:
-        return self.z[list(part.independent)]
-
 
 class LoopEvaluator:
     """Numeric evaluation of a :class:`ClosedLoopSystem` in its independent coordinates.
