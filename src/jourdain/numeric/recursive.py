@@ -126,12 +126,11 @@ def recursive_units(system: System, full: bool = False, directions: tuple | None
     articulated-body recursion does not apply; where it does, the engine's own ``jd_accel``
     (O(f) per evaluation) is compiled instead.
     """
-    src = recursive_source(system, full, directions)
-    local, engine = src.split("\n/* ---- engine ---- */\n")
+    local, engine, aba = _parts(system, full, directions)
     decl = ("void jd_local(const double *y, const double *yd, double t, const double *p,\n"
             "              const double *u, double *out);\n")
     if accel_template is not None:
-        if "#define JD_ABA 1\n" in engine:
+        if aba:
             engine = "#define JD_ACCEL_ABA 1\n" + engine
         else:
             extra_source = accel_template + extra_source
@@ -144,6 +143,13 @@ def recursive_source(system: System, full: bool = False, directions: tuple | Non
     with ``full`` ``out = [M_bar, J_bar, q_c, q_e, M, k, q]`` (the layout of
     :func:`jourdain.numeric.evaluate`), followed by ``Q_bar`` (6p×q) when ``directions`` (per
     body, the unit wrenches of its joint) are given; plus ``jd_fn_batch``."""
+    local, engine, _ = _parts(system, full, directions)
+    return local + "\n/* ---- engine ---- */\n" + engine
+
+
+def _parts(system: System, full: bool, directions: tuple | None) -> tuple[str, str, bool]:
+    """The generated per-joint code, the engine with its tables, and whether the
+    articulated-body recursion applies (every coordinate belongs to one joint)."""
     lay = layout(system, directions)
     p = len(lay.parent)
     f = system.f
@@ -156,6 +162,7 @@ def recursive_source(system: System, full: bool = False, directions: tuple | Non
         col_coord.extend(c)
         col_start.append(col_start[-1] + len(c))
     n_q = sum(lay.directions)
+    aba = _disjoint(lay.columns)
     dir_start = [0]
     for nd in lay.directions:
         dir_start.append(dir_start[-1] + nd)
@@ -167,15 +174,14 @@ def recursive_source(system: System, full: bool = False, directions: tuple | Non
             f"#define JD_DIRS {p * BODY_BLOCK + COLUMN_BLOCK * len(col_coord)}\n"
             f"#define JD_SIZE {size}\n#define JD_FULL {1 if full else 0}\n"
             f"#define JD_Q {n_q}\n#define JD_QBAR {1 if lay.directions else 0}\n"
-            f"#define JD_ABA {1 if _disjoint(lay.columns) else 0}\n"
+            f"#define JD_ABA {1 if aba else 0}\n"
             # the work of the recursion on the stack when small (no malloc per evaluation)
             f"#define JD_WORK_STACK {1 if 8 * (58 * p + 6 * len(col_coord)) <= 65536 else 0}\n"
             + _table("jd_parent", list(lay.parent))
             + _table("jd_col_start", col_start)
             + _table("jd_col_coord", col_coord)
             + _table("jd_dir_start", dir_start if lay.directions else [0]))
-    return (local + "\n/* ---- engine ---- */\n" + head
-            + ENGINE.replace("/* LDL_SOLVE */\n", LDL_SOLVE))
+    return local, head + ENGINE.replace("/* LDL_SOLVE */\n", LDL_SOLVE), aba
 
 
 #: ÿ = M⁻¹(q − k) by LDLᵀ for f = JD_F (the integrator's jd_accel of the symbolic code and the
