@@ -45,7 +45,7 @@ from __future__ import annotations
 import json
 import os
 import re
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from functools import lru_cache
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -314,15 +314,21 @@ class Results:
         if fn is None or len(self.t) < 2:
             W = np.zeros(len(self.t))
         else:
-            T = self.t
-            h = np.diff(T)
-            tq = (T[:-1, None] + h[:, None] * _GAUSS_S[None, :]).reshape(-1)
-            m = self.interpolate(tq)
             p = np.array([self.parameters[k] for k, _ in system.parameters])
-            rate = fn.batch(m["y"], m["yd"], tq, p, None)["dVdt"][:, 0, 0].reshape(-1, 3)
-            W = np.concatenate([[0.0], np.cumsum(h * (rate @ _GAUSS_W))])
+            W = self._integral(lambda tq, m: fn.batch(m["y"], m["yd"], tq, p, None)["dVdt"]
+                               [:, 0, 0])
         self._energies["W_Vt"] = W
         return W
+
+    def _integral(self, rate: Callable[[np.ndarray, dict[str, np.ndarray]], np.ndarray]
+                  ) -> np.ndarray:
+        """``∫ rate dt`` since t0 at the samples, (N,): three-point Gauss–Legendre per step,
+        ``rate(t, motion)`` evaluated at the nodes ``t`` on :meth:`interpolate`'s motion."""
+        T = self.t
+        h = np.diff(T)
+        tq = (T[:-1, None] + h[:, None] * _GAUSS_S[None, :]).reshape(-1)
+        r = rate(tq, self.interpolate(tq)).reshape(-1, 3)
+        return np.concatenate([[0.0], np.cumsum(h * (r @ _GAUSS_W))])
 
     @property
     def conservative(self) -> bool:
@@ -364,11 +370,7 @@ class Results:
             self._energies["W_drive"] = np.zeros(len(self.t))
             return self._energies["W_drive"]
         system = self._need_system("the work of a prescribed motion")
-        T = self.t
-        h = np.diff(T)
-        tq = (T[:-1, None] + h[:, None] * _GAUSS_S[None, :]).reshape(-1)
-        P = self._drive_power(system, tq, **self.interpolate(tq)).reshape(-1, 3)
-        W = np.concatenate([[0.0], np.cumsum(h * (P @ _GAUSS_W))])
+        W = self._integral(lambda tq, m: self._drive_power(system, tq, **m))
         self._energies["W_drive"] = W
         return W
 
