@@ -103,8 +103,8 @@ def stability_map(n: int, loop_cases: int) -> dict:
     spec = loads_study(_map_spec(n))
     t_setup, ctx = _timed(lambda: context(spec))
     system, model = ctx.system, ctx.model
-    lin = system.linearize(nominal_mapping(system, model.nominal_motion()))
-    clin = lin.compile()
+    # about the model's first nominal motion, as the study's default: the context's own
+    lin, clin = ctx.linearization, ctx.compiled_linearization
     cases = ctx.cases
     rng = np.random.default_rng(0)
     pick = np.sort(rng.choice(len(cases), size=min(loop_cases, len(cases)), replace=False))
