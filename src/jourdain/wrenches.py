@@ -125,12 +125,13 @@ def joint_wrenches(system: System, g: Any, y: Any, yd: Any = None, t: float = 0.
     """
     from .differentiate import evaluate_float
     from .numeric import state_vectors
+    from .numeric.diagnose import state_values
 
     joints, names, mats = _layout(system)
     # the directions and orientations do not depend on the inputs: zeros stand for them (None
     # is refused for a model with inputs)
-    yv, ydv, tv, pv, _ = state_vectors(system, y, np.zeros(system.f) if yd is None else yd, t,
-                                       parameters, np.zeros(len(system.inputs)))
+    args = state_vectors(system, y, np.zeros(system.f) if yd is None else yd, t, parameters,
+                         np.zeros(len(system.inputs)))
     gv = np.asarray(g, dtype=float).reshape(-1)
     q = sum(len(jr.columns) for jr in joints)
     if gv.size != q:
@@ -138,10 +139,8 @@ def joint_wrenches(system: System, g: Any, y: Any, yd: Any = None, t: float = 0.
 
         raise EvaluationError(f"joint_wrenches: g must have {q} components (g_names), got "
                               f"{gv.size}")
-    values = {"t": tv}
-    for syms, vals in ((system.y, yv), (system.yd, ydv), (system.parameter_symbols, pv)):
-        values.update({str(s): float(v) for s, v in zip(syms, vals, strict=True)})
-    flat = evaluate_float([e for n in names for e in mats[n].entries()], values)
+    flat = evaluate_float([e for n in names for e in mats[n].entries()],
+                          state_values(system, *args))
     nums: dict[str, np.ndarray] = {}
     i = 0
     for n in names:

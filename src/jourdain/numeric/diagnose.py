@@ -25,8 +25,10 @@ if TYPE_CHECKING:
     from ..model.system import System
 
 
-def _values(system: System, y: np.ndarray, yd: np.ndarray, t: float, p: np.ndarray,
-            u: np.ndarray) -> dict[str, float]:
+def state_values(system: System, y: np.ndarray, yd: np.ndarray, t: float, p: np.ndarray,
+                 u: np.ndarray) -> dict[str, float]:
+    """The numbers of one state by symbol name (parameters, y, ẏ, inputs and t), as
+    :func:`jourdain.differentiate.evaluate_float` takes them."""
     vals = {str(s): float(v) for s, v in zip(system.parameter_symbols, p, strict=True)}
     vals.update({str(s): float(v) for s, v in zip(system.y, y, strict=True)})
     vals.update({str(s): float(v) for s, v in zip(system.yd, yd, strict=True)})
@@ -50,7 +52,7 @@ def nonfinite_sources(system: System, y: np.ndarray, yd: np.ndarray, t: float, p
                       u: np.ndarray) -> list[str]:
     """The joints, bodies and force elements whose numbers are not finite at this state, each
     as ``'force "spring" (SpringDamper): 0.0**-0.5: division by zero or overflow'``."""
-    values = _values(system, y, yd, t, p, u)
+    values = state_values(system, y, yd, t, p, u)
     out: list[str] = []
     for body, jm in zip(system.bodies, joint_motions(system), strict=True):
         exprs = [x for row in jm.A for x in row]
