@@ -833,12 +833,11 @@ def check_orthogonality(r: Reactions, samples: int = 3, seed: int = 7, fn: Any =
         from .numeric import lambdify
 
         fn = lambdify(system, {"J_bar": r.newton_euler.J_bar, "Q_bar": r.Q_bar})
-    lay = ReactionLayout(r.joints, r.g_names, r.singular_rows, ())
-    return _check_assembled(system, lay, fn, samples, seed)
+    return _check_assembled(system, r.joints, fn, samples, seed)
 
 
-def _check_assembled(system: System, lay: ReactionLayout, fn: Any, samples: int = 3,
-                     seed: int = 7) -> float:
+def _check_assembled(system: System, joints: Sequence[JointReactions], fn: Any,
+                     samples: int = 3, seed: int = 7) -> float:
     rng = np.random.default_rng(seed)
     pv = np.array(list(system.parameter_values.values()), dtype=float)
     worst = 0.0
@@ -864,7 +863,7 @@ def _check_assembled(system: System, lay: ReactionLayout, fn: Any, samples: int 
         bad = np.nonzero(rel > 1e-9)[0]
         if bad.size:
             c = int(bad[0])
-            jr = next(j for j in lay.joints if c in j.columns)
+            jr = next(j for j in joints if c in j.columns)
             raise ModelError(
                 f'joint "{jr.joint.name}" (body "{jr.child}"): its constrained direction '
                 f'"{jr.names[jr.columns.index(c)]}" does work in an admissible motion (relative '
@@ -1002,7 +1001,7 @@ def _reactions_function(system: System) -> tuple[ReactionLayout, Any]:
             touching[index[b.parent]].extend(jr.columns)
     lay = ReactionLayout(joints, tuple(n for jr in joints for n in jr.names),
                          _singular_rows(system)[0], tuple(tuple(sorted(t)) for t in touching))
-    _check_assembled(system, lay, fn)
+    _check_assembled(system, joints, fn)
     return lay, fn
 
 
