@@ -355,7 +355,7 @@ def cmd_check(args: argparse.Namespace) -> int:
         print(f"  cyclic coordinates: {', '.join(s['cyclic_coordinates'])} (in no equation, only "
               "their rates; stability verdicts are taken in Routh's sense without them)")
     if loops is not None:
-        for line in check_lines(model):
+        for line in check_lines(s["loops"]):
             print(line)
     return EXIT_OK
 

@@ -73,8 +73,8 @@ def _planar_grubler(loop: ClosedLoopSystem) -> int | None:
     return total
 
 
-def check_lines(model: Any) -> list[str]:
-    s = loop_summary(model)
+def check_lines(s: Mapping[str, Any]) -> list[str]:
+    """The lines of ``jourdain check`` for a loop model's :func:`loop_summary` ``s``."""
     lines = [f"  loops: {len(s['closing_joints'])} closing joint(s), "
              f"{len(s['constraint_rows'])} constraint equations Φ = 0 "
              f"({', '.join(s['constraint_rows'])})"]
