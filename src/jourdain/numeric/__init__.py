@@ -174,10 +174,6 @@ class CompiledFunction:
         n, Y, YD, T, P, ps, U, us = self._states("dynamics", y, yd, t, p, u)
         ydd = np.empty((n, self.f))
         W = np.empty((n, self.n_bodies, 6))
-        vp = ctypes.c_void_p
-        fn.restype = ctypes.c_long
-        fn.argtypes = [ctypes.c_long, ctypes.c_long, vp, vp, vp, vp, ctypes.c_long, vp,
-                       ctypes.c_long, vp, vp]
         bad = fn(n, self.f, Y.ctypes.data, YD.ctypes.data, T.ctypes.data, P.ctypes.data, ps,
                  U.ctypes.data, us, ydd.ctypes.data, W.ctypes.data)
         if bad >= 0:
@@ -295,6 +291,10 @@ def _load(system: System, names: tuple[str, ...], shapes: tuple[tuple[int, int],
     lib.jd_fn_batch.restype = None
     lib.jd_fn_batch.argtypes = [ctypes.c_long, ctypes.c_long, vp, vp, vp, vp, ctypes.c_long, vp,
                                 ctypes.c_long, vp]
+    if n_bodies:  # the recursion's engine: ÿ and the joint wrenches of a batch
+        lib.jd_dynamics_batch.restype = ctypes.c_long
+        lib.jd_dynamics_batch.argtypes = [ctypes.c_long, ctypes.c_long, vp, vp, vp, vp,
+                                          ctypes.c_long, vp, ctypes.c_long, vp, vp]
     return CompiledFunction(names, shapes, arguments(system), key, system.f,
                             len(system.parameters), len(system.inputs), lib, n_bodies=n_bodies)
 
