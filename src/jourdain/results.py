@@ -723,6 +723,10 @@ class Results:
                                        self.u if self.u.shape[1] else None)["q"][:, :, 0]
         W = _hermite(self.t, self.W, np.einsum("ni,ni->n", self.yd, q), None, tp)[0][:, 0]
         W_nc = W + V - self.potential_energy[0]
+        dVdt = _potential_rate_function(system)
+        if dVdt is not None:  # − ∫∂V/∂t dt, as work_nonconservative (the drive's work)
+            rate = dVdt.batch(self.y, self.yd, self.t, p, None)["dVdt"][:, 0, 0]
+            W_nc = W_nc - _hermite(self.t, self._potential_time_work(), rate, None, tp)[0][:, 0]
         W_drive = np.zeros_like(tp)
         if self.rheonomic:
             P = self._drive_power(system, self.t, self.y, self.yd, self.ydd)
