@@ -60,7 +60,8 @@ class LoopResults:
     ``Phi_dot`` (N, m): the constraint residuals; ``lam`` (N, m): the closing joints'
     multipliers (labels in ``labels``); ``T``, ``V`` (N,): kinetic and potential energy;
     ``partitions``: ``[(t_start, independent names), ...]``; ``status``, ``message``;
-    ``singular``: the :class:`SingularConfiguration` that stopped the run, or None.
+    ``singular``: the :class:`SingularConfiguration` that stopped the run, or None;
+    ``method``: the integrator that ran.
     """
 
     loop: ClosedLoopSystem
@@ -81,6 +82,7 @@ class LoopResults:
     wall_time: float = 0.0
     singular: SingularConfiguration | None = None
     parameters: dict[str, float] = field(default_factory=dict)
+    method: str = "DOP853"
 
     @property
     def coordinate_names(self) -> list[str]:
@@ -140,7 +142,7 @@ class LoopResults:
         tree = self.loop.tree
         n_u = len(tree.inputs)
         return Results(tree, self.t, self.z, self.zd, self.zdd, np.zeros((len(self.t), n_u)),
-                       np.zeros(len(self.t)), dict(self.parameters), method="DOP853",
+                       np.zeros(len(self.t)), dict(self.parameters), method=self.method,
                        status=self.status, message=self.message, nfev=self.nfev,
                        wall_time=self.wall_time)
 
@@ -293,7 +295,8 @@ def simulate_loop(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: Any,
         loop, np.array(out["t"]), arr("z", n), arr("zd", n), arr("zdd", n), arr("Phi", m),
         arr("Phi_dot", m), arr("lam", m), np.array(out["T"]), np.array(out["V"]),
         list(ev.labels), partitions, status, message, nfev, time.perf_counter() - started,
-        singular, dict(zip([k for k, _ in loop.tree.parameters], ev.p.tolist(), strict=True)))
+        singular, dict(zip([k for k, _ in loop.tree.parameters], ev.p.tolist(), strict=True)),
+        method)
 
 
 
@@ -423,4 +426,5 @@ def _redundant_results(loop: ClosedLoopSystem, ev: Any, sol: Any,
         np.array(out["Phi"]), np.array(out["Phi_dot"]), np.array(out["lam"]),
         np.array(out["T"]), np.array(out["V"]), list(ev.labels), [(t0, ())], status,
         str(sol.message), int(sol.nfev), wall, None,
-        dict(zip([k for k, _ in loop.tree.parameters], ev.p.tolist(), strict=True)))
+        dict(zip([k for k, _ in loop.tree.parameters], ev.p.tolist(), strict=True)),
+        "scipy:DOP853")
