@@ -66,8 +66,9 @@ class TreeIndex:
 
 def chain_index(data: list[dict]) -> TreeIndex:
     """The :class:`TreeIndex` of :func:`chain_model` (same order as jourdain's)."""
-    nq = {"revolute": 1, "universal": 2, "spherical": 3}
-    counts = [nq[d["joint"]] for d in data]
+    from jourdain.models import TREE_JOINTS
+
+    counts = [TREE_JOINTS[d["joint"]] for d in data]
     return TreeIndex(np.arange(sum(counts)), tuple(int(k) for k in np.cumsum(counts)),
                      tuple(range(len(data))))
 
@@ -95,13 +96,15 @@ def tree_model(data: list[dict], depth_first: bool = True):
     """
     import pinocchio as pin
 
-    f = sum(_TREE_NQ[d["joint"]] for d in data)
+    from jourdain.models import TREE_JOINTS
+
+    f = sum(TREE_JOINTS[d["joint"]] for d in data)
     children: list[list[int]] = [[] for _ in data]
     roots = []
     for i, d in enumerate(data):
         (roots if d["parent"] < 0 else children[d["parent"]]).append(i)
     # jourdain coordinate offsets, body by body in jourdain's order
-    first = np.concatenate([[0], np.cumsum([_TREE_NQ[d["joint"]] for d in data])])
+    first = np.concatenate([[0], np.cumsum([TREE_JOINTS[d["joint"]] for d in data])])
     model = pin.Model()
     v = np.full(f, -1)
     last = [0] * len(data)
@@ -126,9 +129,6 @@ def tree_model(data: list[dict], depth_first: bool = True):
     model.gravity.linear = np.array([0.0, 0.0, -9.81])
     assert model.nq == model.nv == f and sorted(v) == list(range(f))
     return model, TreeIndex(v, tuple(last), tuple(order))
-
-
-_TREE_NQ = {"revolute": 1, "prismatic": 1, "universal": 2, "spherical": 3, "free": 6}
 
 
 def _elementary_joints(d: dict) -> list:
