@@ -101,9 +101,14 @@ def _linearization_of(lin: Any) -> Linearization | NumericLinearization:
     return lin.linearization if isinstance(lin, CompiledLinearization) else lin
 
 
+#: ``nominal_check`` of :func:`state_space` when not given: computed there
+_COMPUTED = object()
+
+
 def state_space(lin: AnyLinearization, t: float | None = None,
                 parameters: Mapping[str, float] | None = None,
-                allow_time_variant: bool = False) -> StateSpace:
+                allow_time_variant: bool = False, nominal_check: Any = _COMPUTED
+                ) -> StateSpace:
     """State-space matrices of a linearization for numeric parameter values.
 
     Parameters
@@ -117,6 +122,10 @@ def state_space(lin: AnyLinearization, t: float | None = None,
     allow_time_variant : bool
         A time-variant result is refused (its eigenvalues at a frozen time say nothing about
         stability) unless this is True.
+    nominal_check : NominalCheck or None, optional
+        The check of the nominal motion at these ``t`` and ``parameters`` where the caller has
+        it (or None where it wants none); by default it is computed (``lin.check_nominal``,
+        most of the time of this function for a symbolic linearization).
 
     Raises
     ------
@@ -137,6 +146,8 @@ def state_space(lin: AnyLinearization, t: float | None = None,
         ss = _from_numbers(base, num, base.t, base.parameters)
         return replace(ss, nominal_check=base.nominal_check)
     ss = _from_numbers(base, num, 0.0 if t is None else float(t), parameters)
+    if nominal_check is not _COMPUTED:
+        return replace(ss, nominal_check=nominal_check)
     try:
         check = base.check_nominal(ss.t, parameters)
     except JourdainError:  # the matrices have numbers, so this is not expected; no verdict on h

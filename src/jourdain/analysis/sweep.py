@@ -65,7 +65,8 @@ def sweep(lin: Linearization | CompiledLinearization, parameter: str,
     base = _linearization_of(lin)
     _check_parameter(base, parameter)
     vals = np.asarray(values, dtype=float).reshape(-1)
-    state_space(lin, t, parameters)  # refuses time-variant results with a clear message
+    # refuses time-variant results with a clear message (the nominal check is not needed)
+    state_space(lin, t, parameters, nominal_check=None)
     cyclic = _cyclic_of(lin)
     eigs, maxre, verdicts = [], [], []
     for v in vals:
@@ -101,7 +102,7 @@ def stability_boundary(lin: Linearization | CompiledLinearization, parameter: st
         st = stability(ss, cyclic=cyclic)
         return st.verdict, st.max_real_part
 
-    state_space(lin, t, parameters)
+    state_space(lin, t, parameters, nominal_check=None)  # refuses time-variant ones
     cyclic = _cyclic_of(lin)
     a, b = float(lower), float(upper)
     va, vb = analyse(a)[0], analyse(b)[0]

@@ -161,7 +161,8 @@ def _analyse(lin: Any, num: dict[str, np.ndarray], check: Any,
             from ..analysis.modes import modes, stability
             from ..analysis.state_space import state_space
 
-            ss = state_space(lin, t, params, allow_time_variant=True)
+            ss = state_space(lin, t, params, allow_time_variant=True,
+                             nominal_check=check)  # computed above
             res["modes"] = modes(ss)
             res["stability"] = stability(ss, cyclic=res["cyclic"])
         except ImportError:
