@@ -425,7 +425,7 @@ def clear_cache(disk: bool = False) -> None:
         d = cache_dir()
         if d.is_dir():
             for p in d.iterdir():
-                if p.suffix in (".so", ".c") or p.name.endswith(".so.tmp"):
+                if p.suffix in (".so", ".c") or p.name.endswith((".so.tmp", ".c.tmp")):
                     p.unlink(missing_ok=True)
 
 

@@ -178,9 +178,11 @@ def build(key: str, source: str | Sequence[str], extra_flags: Sequence[str] = ()
                                   capture_output=True, text=True)
             if link.returncode != 0:
                 failed.append(link.stderr)
-        # kept for reading, also when the compiler fails
-        with open(src, "w") as fh:
+        # kept for reading, also when the compiler fails; renamed into place like the library
+        fd, tmp_src = tempfile.mkstemp(suffix=".c.tmp", dir=d)
+        with os.fdopen(fd, "w") as fh:
             fh.write("\n".join(units))
+        os.replace(tmp_src, src)
         if failed:
             raise CompilerError(f"compiling {src} failed:\n{failed[0][-4000:]}")
         os.chmod(tmp, 0o700)  # this user's alone, whatever the umask
