@@ -40,8 +40,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import jourdain as jd  # noqa: E402
 from jourdain.cse import tree_ops  # noqa: E402
-from jourdain.linearization import linearization_general  # noqa: E402
 from jourdain.models import n_link_pendulum_on_cart, spatial_chain  # noqa: E402
+from jourdain.stages.linearization import linearization_general  # noqa: E402
 from jourdain.symbolic import count_ops  # noqa: E402
 
 

@@ -32,7 +32,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from jourdain.models import spatial_chain, spatial_chain_data  # noqa: E402
-from jourdain.reactions import (  # noqa: E402
+from jourdain.stages.reactions import (  # noqa: E402
     evaluate_reactions,
     graph_values,
     joint_reactions,

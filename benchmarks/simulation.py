@@ -56,7 +56,7 @@ from jourdain.models import (  # noqa: E402
     spatial_chain_data,
 )
 from jourdain.numeric import toolchain  # noqa: E402
-from jourdain.simulate import integrator_library  # noqa: E402
+from jourdain.simulation.simulate import integrator_library  # noqa: E402
 
 TOL = 1e-8
 T_END = 10.0

@@ -1,5 +1,5 @@
 """Finite-difference reference for the kinematics: velocities and accelerations from r(y, t) and
-S(y, t) alone, independent of the recursive formulas of jourdain.kinematics."""
+S(y, t) alone, independent of the recursive formulas of jourdain.stages.kinematics."""
 
 from __future__ import annotations
 

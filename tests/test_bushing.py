@@ -457,7 +457,7 @@ def test_kinematic_quantities_against_closed_forms():
 
 def applied(system, name, y, yd, t):
     """The inertial force of one element on the rotor, evaluated from q̄^e of that element."""
-    from jourdain.newton_euler import applied_forces
+    from jourdain.stages.newton_euler import applied_forces
 
     fe = next(f for f in system.forces if f.name == name)
     bf = applied_forces(system.kinematics(), [fe])[1]

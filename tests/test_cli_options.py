@@ -111,7 +111,7 @@ def test_api_bounds(tmp_path):
     with pytest.raises(jd.EvaluationError, match="the span is below the round-off of t"):
         s.simulate((1e8, 1e8 + 1e-6), y0, yd0)
     # the results of a model with many coordinates are bounded by their memory as well
-    from jourdain.simulate import MAX_OUTPUT_BYTES, check_samples, max_samples
+    from jourdain.simulation.simulate import MAX_OUTPUT_BYTES, check_samples, max_samples
 
     n = max_samples(200)
     assert n < 10**7 and n * 8 * (2 * 401 + 2 * 604) <= MAX_OUTPUT_BYTES
@@ -121,7 +121,7 @@ def test_api_bounds(tmp_path):
 
 def test_one_set_of_defaults():
     """System.simulate had rtol 1e-6, atol 1e-8, model files 1e-8, 1e-10."""
-    from jourdain.simulate import (
+    from jourdain.simulation.simulate import (
         DEFAULT_ATOL,
         DEFAULT_METHOD,
         DEFAULT_RTOL,
@@ -139,7 +139,7 @@ def test_one_set_of_defaults():
     assert res.method == DEFAULT_METHOD
     same = jd.simulate(s, (0, 1), [0.5], [0.0])
     np.testing.assert_array_equal(same.y, res.y)
-    # documented once, with the numbers of jourdain.simulate
+    # documented once, with the numbers of jourdain.simulation.simulate
     assert (DEFAULT_RTOL, DEFAULT_ATOL) == (1e-8, 1e-10)
     docs = (ROOT / "docs" / "model-format.md").read_text()
     assert "| `rtol`, `atol` | tolerances" in docs and "1e-8, 1e-10" in docs

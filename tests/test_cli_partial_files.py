@@ -7,7 +7,7 @@ import pytest
 
 import jourdain as jd
 from jourdain.models import n_link_pendulum_on_cart
-from jourdain.results import append_incremental, open_incremental
+from jourdain.simulation.results import append_incremental, open_incremental
 
 
 def _run():

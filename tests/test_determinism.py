@@ -17,7 +17,7 @@ import jourdain as jd
 from jourdain import models
 from jourdain.numeric import argument_names, function_source
 from jourdain.numeric.recursive import recursive_source
-from jourdain.reactions import joint_directions
+from jourdain.stages.reactions import joint_directions
 
 def sha(text):
     return hashlib.sha256(text.encode()).hexdigest()

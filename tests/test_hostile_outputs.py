@@ -20,7 +20,7 @@ from jourdain.io import export, loads_model
 from jourdain.io.report import write_report
 from jourdain.numeric import toolchain
 from jourdain.numeric.ccode import function_source
-from jourdain.results import Results
+from jourdain.simulation.results import Results
 
 EVIL = "pendulum\n\\immediate\\write18{touch pwned}\r\\input{/etc/passwd}\u2028\\def\\x{1}"
 

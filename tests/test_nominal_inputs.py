@@ -9,8 +9,8 @@ import pytest
 import jourdain as jd
 from jourdain.cli import main
 from jourdain.io import capabilities, load_model
-from jourdain.linearization import NOMINAL_RTOL, NominalMotionWarning
 from jourdain.models import double_pendulum
+from jourdain.stages.linearization import NOMINAL_RTOL, NominalMotionWarning
 
 D, J, OMEGA = 0.4, 0.05, 3.0
 

@@ -8,7 +8,7 @@ import sympy
 
 import jourdain as jd
 from jourdain.models import double_pendulum, n_link_pendulum_on_cart, spatial_chain
-from jourdain.reactions import check_orthogonality, graph_values
+from jourdain.stages.reactions import check_orthogonality, graph_values
 from tests.tolerance import (
     eom_terms,
     eval_tol,

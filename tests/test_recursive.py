@@ -15,7 +15,7 @@ import pytest
 import jourdain as jd
 from jourdain import models
 from jourdain.numeric import _eom_function, dynamics_function, lambdify, mkq_function
-from jourdain.reactions import reactions
+from jourdain.stages.reactions import reactions
 from tests.tolerance import assert_close_eval, newton_euler_tol, ydd_of
 
 EXAMPLES = sorted((Path(__file__).parent.parent / "examples").glob("*.toml"))
@@ -184,7 +184,7 @@ def test_joint_wrenches_equal_reaction_components(make, rng):
     the sub-tree's Newton–Euler sums); ÿ must solve M·ÿ = q − k, and the reaction components g
     of N̂·g = k̂ − q̂ (METHOD.md §4, no ÿ) along the joint's constrained directions w_k must
     compose the same wrench, Σ g_k·w_k."""
-    from jourdain.reactions import graph_values, joint_directions
+    from jourdain.stages.reactions import graph_values, joint_directions
     from tests.tolerance import subtree_tol, tree_extent, ydd_tol
 
     system = make()

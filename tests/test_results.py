@@ -175,7 +175,7 @@ def test_default_run_plots_smooth_curves():
     """Without t_eval the results hold the integrator's steps (here about 0.2 s apart, a
     tenth of the period: straight lines between them miss the curve by 4 % of the amplitude).
     The plot draws the interpolated motion on PLOT_POINTS times plus the steps."""
-    from jourdain.results import PLOT_POINTS
+    from jourdain.simulation.results import PLOT_POINTS
 
     s = pendulum()
     res = s.simulate((0, 10), [1.0], [0.0])

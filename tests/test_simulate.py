@@ -10,7 +10,7 @@ from scipy.special import ellipk
 
 import jourdain as jd
 from jourdain.models import n_link_pendulum_on_cart, spatial_chain
-from jourdain.simulate import Event, IntegrationError
+from jourdain.simulation.simulate import Event, IntegrationError
 from tests.tolerance import assert_residual_small, eom_terms, norm
 
 
@@ -262,7 +262,7 @@ def test_progress_and_chunked_output(tmp_path):
 
 def test_partial_file_of_a_killed_run_is_readable(tmp_path):
     """What a run killed by the system (no chance to finish the file) leaves behind."""
-    from jourdain.results import append_incremental, open_incremental
+    from jourdain.simulation.results import append_incremental, open_incremental
 
     s = n_link_pendulum_on_cart(1)
     res = s.simulate((0, 1), [0.0, 3.0], [0, 0], inputs={"F": 0.0})
@@ -326,7 +326,7 @@ def test_steps_do_not_depend_on_how_the_run_is_split(method, monkeypatch):
     with a collapsed step)."""
     import importlib
 
-    sim = importlib.import_module("jourdain.simulate")  # the package re-exports a function
+    sim = importlib.import_module("jourdain.simulation.simulate")  # the package re-exports a function
     s = spatial_chain(3)
     rng = np.random.default_rng(3)
     y0, yd0 = rng.uniform(-1, 1, s.f), rng.uniform(-1, 1, s.f)

@@ -25,7 +25,7 @@ from .analysis import (
     sweep,
     to_control,
 )
-from .energy import Energy, energy
+from .analysis.energy import Energy, energy
 from .equilibrium import Equilibrium, NoEquilibrium, find_equilibria, find_equilibrium
 from .errors import (
     EvaluationError,
@@ -37,19 +37,6 @@ from .errors import (
 from .io import ModelFile, ModelFileError, load_model
 from .io.urdf import load_urdf
 from .io.viewer import MeshVisual, View, view
-from .kinematics import BodyKinematics, Kinematics, kinematics
-from .linearization import (
-    CompiledLinearization,
-    GeneralLinearization,
-    Linearization,
-    NominalCheck,
-    NominalMotionWarning,
-    NumericLinearization,
-    TimeVariantError,
-    linearization,
-    linearization_general,
-    linearize_numeric,
-)
 from .model import (
     WORLD,
     Body,
@@ -96,11 +83,30 @@ from .model import (
     t,
     velocity,
 )
-from .newton_euler import NewtonEuler, newton_euler
-from .projection import EquationsOfMotion, projection
-from .reactions import JointReactions, Reactions, evaluate_reactions, joint_reactions, reactions
-from .results import Results
-from .simulate import Event, IntegrationError, simulate
+from .simulation.results import Results
+from .simulation.simulate import Event, IntegrationError, simulate
+from .stages.kinematics import BodyKinematics, Kinematics, kinematics
+from .stages.linearization import (
+    CompiledLinearization,
+    GeneralLinearization,
+    Linearization,
+    NominalCheck,
+    NominalMotionWarning,
+    NumericLinearization,
+    TimeVariantError,
+    linearization,
+    linearization_general,
+    linearize_numeric,
+)
+from .stages.newton_euler import NewtonEuler, newton_euler
+from .stages.projection import EquationsOfMotion, projection
+from .stages.reactions import (
+    JointReactions,
+    Reactions,
+    evaluate_reactions,
+    joint_reactions,
+    reactions,
+)
 from .symbolic import SymMatrix
 from .wrenches import JointWrench, joint_wrenches
 

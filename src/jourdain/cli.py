@@ -27,7 +27,7 @@ import numpy as np
 from .differentiate import evaluate_float
 from .errors import JourdainError
 from .model.expressions import values_at
-from .reactions import check_reactions
+from .stages.reactions import check_reactions
 
 EXIT_OK, EXIT_MODEL, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 #: seconds between two progress lines of a long simulation
@@ -596,9 +596,9 @@ def _state_text(system: Any, y: np.ndarray, yd: np.ndarray, t: float,
 def _display_scales(values: dict[str, np.ndarray]) -> dict[str, Any]:
     """What the round-off of each quantity is judged against: the symmetric and skew parts
     against P and Q, the generalized forces k, q, h against the forces at work
-    (:func:`jourdain.linearization.force_scale`, which stays large where q itself cancels to
+    (:func:`jourdain.stages.linearization.force_scale`, which stays large where q itself cancels to
     round-off, as for a pendulum standing upright); the others against themselves."""
-    from .linearization import force_scale
+    from .stages.linearization import force_scale
 
     out: dict[str, Any] = {"D": values.get("P"), "G": values.get("P"), "K": values.get("Q"),
                            "N": values.get("Q")}
@@ -652,10 +652,10 @@ def cmd_linearize(args: argparse.Namespace) -> int:
 
 def _sim_options(model: Any, args: argparse.Namespace) -> dict[str, Any]:
     """The simulation options given on the command line (those of ``args`` that the command
-    has), checked against the bounds of :mod:`jourdain.simulate` before any work: a value out
+    has), checked against the bounds of :mod:`jourdain.simulation.simulate` before any work: a value out
     of range is a usage error naming the option."""
     from .errors import EvaluationError
-    from .simulate import check_atol, check_rtol, check_samples, check_t_end
+    from .simulation.simulate import check_atol, check_rtol, check_samples, check_t_end
 
     system = model.system
     opts: dict[str, Any] = {}
@@ -820,7 +820,7 @@ def _samples(n: int) -> str:
 
 
 def cmd_simulate(args: argparse.Namespace) -> int:
-    from .simulate import OUTPUT_SUFFIXES
+    from .simulation.simulate import OUTPUT_SUFFIXES
 
     model = _load(args.model)
     _tree_only(model, "simulate")
@@ -1004,11 +1004,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", help=set_help)
     p.add_argument("--json", action="store_true", help="print JSON")
 
-    import importlib
-
     from .io.capabilities import SIM_METHODS
-
-    sim = importlib.import_module(".simulate", __package__)  # (the package exports a function)
+    from .simulation import simulate as sim
 
     default = "(default: the model's [simulation] {}, else {})".format
     t_end_help = (f"end time, at most {sim.MAX_TIME:g} {default('t_end', sim.DEFAULT_T_END)}")

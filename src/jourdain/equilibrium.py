@@ -21,7 +21,7 @@ from .errors import EvaluationError, JourdainError
 
 if TYPE_CHECKING:
     from .model.system import System
-    from .projection import EquationsOfMotion
+    from .stages.projection import EquationsOfMotion
 
 
 class NoEquilibrium(JourdainError, ArithmeticError):

@@ -1,6 +1,6 @@
 """Kinematic quantities of points and bodies as expressions of y, ẏ, t, for force laws.
 
-Built from the kinematics of the bodies (:mod:`jourdain.kinematics`, METHOD.md §1): positions
+Built from the kinematics of the bodies (:mod:`jourdain.stages.kinematics`, METHOD.md §1): positions
 ``r = r_O + S·p``, velocities ``v = J_T·ẏ + v̄``, angular velocities ``ω = J_R·ẏ + ω̄`` (body
 frame). :class:`Resolver` replaces the symbols of the :mod:`kinematic quantities
 <jourdain.model.quantities>` in force expressions by these expressions, so q̄^e, q and the
@@ -15,7 +15,11 @@ from collections.abc import Mapping
 import symengine as se
 
 from .errors import ModelError
-from .kinematics import (
+from .model.bodies import WORLD
+from .model.forces import BUSHING_COMPONENTS, Bushing, deflection, deflection_d
+from .model.joints import IDENTITY, Mat3, Vec3
+from .model.quantities import Quantity
+from .stages.kinematics import (
     Z3,
     BodyKinematics,
     Kinematics,
@@ -29,10 +33,6 @@ from .kinematics import (
     _scale,
     _vec,
 )
-from .model.bodies import WORLD
-from .model.forces import BUSHING_COMPONENTS, Bushing, deflection, deflection_d
-from .model.joints import IDENTITY, Mat3, Vec3
-from .model.quantities import Quantity
 
 ZERO = se.Integer(0)
 HALF = se.Rational(1, 2)

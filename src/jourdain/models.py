@@ -355,7 +355,7 @@ def tree_from_data(data: Sequence[Mapping[str, Any]], name: str = "tree") -> Sys
     parent's body frame; mass ``m{i}``, centre of mass ``(cx{i}, cy{i}, cz{i})`` and inertia
     entries ``I{i}xx, I{i}xy, …`` in its body frame; gravity ``g`` along -z. All of these are
     parameters with the data's values as defaults. The joint axes stay numbers: the reaction
-    forces need numeric axes (:func:`jourdain.reactions.constrained_directions`). Coordinates
+    forces need numeric axes (:func:`jourdain.stages.reactions.constrained_directions`). Coordinates
     ``q0, q1, …`` body by body in list order, in each joint's own order:
 
     * revolute, prismatic: the angle about, the distance along ``axes[0]``;

@@ -1,6 +1,6 @@
 """Joint wrenches as numbers: the force and torque each joint transmits, by joint name.
 
-The reactions ``g`` (METHOD.md §4, :mod:`jourdain.reactions`) are the magnitudes of the
+The reactions ``g`` (METHOD.md §4, :mod:`jourdain.stages.reactions`) are the magnitudes of the
 reaction forces and torques along each joint's constrained directions ``w_k`` (unit wrenches in
 the child body frame at its origin, the joint point). The joint's wrench is their sum
 
@@ -77,7 +77,7 @@ class JointWrench:
 def _layout(system: System) -> tuple[tuple[Any, ...], list[Any], dict[str, SymMatrix]]:
     """The joints' constrained directions, and per joint with directions its matrix
     ``E_k`` (6 × n_k, the unit wrenches as columns) and its child's orientation ``S_k``."""
-    from .reactions import joint_directions
+    from .stages.reactions import joint_directions
 
     joints = joint_directions(system)
     kin = system.kinematics()

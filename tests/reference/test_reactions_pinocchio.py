@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from jourdain.models import spatial_chain, spatial_chain_data
-from jourdain.reactions import graph_values
+from jourdain.stages.reactions import graph_values
 from tests.reference.pinocchio_models import pin, spatial_chain_model
 from tests.tolerance import eom_terms, norm, residual_bound, subtree_tol, tree_extent
 

@@ -37,7 +37,7 @@ pin = pytest.importorskip("pinocchio")
 pytest.importorskip("yourdfpy", reason="the URDF reader needs jourdain[urdf] (yourdfpy)")
 
 from jourdain.io.urdf import ROOT_JOINT, load_urdf  # noqa: E402
-from jourdain.reactions import graph_values  # noqa: E402
+from jourdain.stages.reactions import graph_values  # noqa: E402
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "urdf"
 

@@ -30,7 +30,7 @@ from ..errors import JourdainError
 
 if TYPE_CHECKING:
     from ..model.system import System
-    from ..projection import EquationsOfMotion
+    from ..stages.projection import EquationsOfMotion
 
 #: a derivative ``∂e/∂y_c`` counts as zero below this fraction of the largest value or
 #: derivative of M, k, q at the trial state (an identity test: round-off of terms that cancel,
@@ -53,8 +53,8 @@ def cyclic_coordinates(source: System | EquationsOfMotion) -> tuple[str, ...]:
     the model, for all parameter values.
     """
     from ..differentiate import evaluate_float
-    from ..linearization import _perturbed
-    from ..projection import EquationsOfMotion
+    from ..stages.linearization import _perturbed
+    from ..stages.projection import EquationsOfMotion
 
     eom = source if isinstance(source, EquationsOfMotion) else source.equations_of_motion()
     system = eom.system
@@ -130,8 +130,8 @@ def _screen_compiled(system: System, candidates: list[int]) -> set[int] | None:
     :data:`CYCLIC_RTOL` of the largest. This takes microseconds where the exact derivatives of
     the expression graph in Python took 0.3–0.5 s for a 7-joint arm. None (the caller then
     differentiates) when there is no compiler or a state has no real value."""
-    from ..linearization import _perturbed
     from ..numeric import mkq_function, parameter_vector
+    from ..stages.linearization import _perturbed
 
     try:
         fn = mkq_function(system)

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import EvaluationError, warn
-from ..linearization import CompiledLinearization, Linearization, NominalMotionWarning
+from ..stages.linearization import CompiledLinearization, Linearization, NominalMotionWarning
 from .modes import ASYMPTOTICALLY_STABLE, MARGINALLY_STABLE, UNSTABLE
 
 #: default relative tolerance of the integration of Φ̇ = A(t)·Φ

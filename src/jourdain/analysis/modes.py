@@ -18,8 +18,8 @@ treated so (``Stability.cyclic``; ``cyclic=()`` asks for the full system).
 
 The verdict is about the linear system. Where the nominal motion it came from is an equilibrium
 or a steady motion that does not solve the equations of motion (``h ≠ 0``,
-:class:`jourdain.linearization.NominalCheck`), the reason says so and a
-:class:`jourdain.linearization.NominalMotionWarning` is issued.
+:class:`jourdain.stages.linearization.NominalCheck`), the reason says so and a
+:class:`jourdain.stages.linearization.NominalMotionWarning` is issued.
 """
 
 from __future__ import annotations
@@ -30,7 +30,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..errors import warn
-from ..linearization import NominalMotionWarning
+from ..stages.linearization import NominalMotionWarning
 from .cyclic import check_cyclic, cyclic_coordinates, reduced_matrix
 from .state_space import AnyLinearization, StateSpace, state_space
 

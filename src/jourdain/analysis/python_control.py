@@ -1,5 +1,5 @@
 """Bridge to python-control: a linearization as a named ``control.StateSpace``, and a state
-feedback law ``Δu = −K·x`` as input expressions for :func:`jourdain.simulate.simulate`.
+feedback law ``Δu = −K·x`` as input expressions for :func:`jourdain.simulation.simulate.simulate`.
 
 The state-space form is that of :mod:`jourdain.analysis.state_space` (METHOD.md §6): with the
 state ``x = [η; η̇]`` (2f) and the input deviations ``Δu`` (m),
@@ -11,7 +11,7 @@ after the coordinates and their rates (``phi``, ``phi_d``), the inputs after the
 inputs, so that python-control's block diagrams (``interconnect``) connect by name. The
 excitation ``E·h`` is not part of it: about an equilibrium or a steady motion that solves the
 equations of motion ``h = 0`` (the linearization warns with a
-:class:`~jourdain.linearization.NominalMotionWarning` where it does not).
+:class:`~jourdain.stages.linearization.NominalMotionWarning` where it does not).
 
 python-control is an optional dependency: ``pip install "jourdain[control]"``.
 """
@@ -124,7 +124,7 @@ def state_names(system: System) -> list[str]:
 def state_feedback(system: System, K: Any, nominal: Mapping[Any, Any] | Any,
                    inputs: Mapping[Any, Any] | None = None) -> dict[str, se.Basic]:
     """The law ``u = u_s − K·(x − x_s)``, ``x = [y; ẏ]``, as one expression per input: the
-    form :func:`jourdain.simulate.simulate` (``inputs=``) compiles into its C loop.
+    form :func:`jourdain.simulation.simulate.simulate` (``inputs=``) compiles into its C loop.
 
     Parameters
     ----------
@@ -134,7 +134,7 @@ def state_feedback(system: System, K: Any, nominal: Mapping[Any, Any] | Any,
         :attr:`StateSpace.state_names` (``control.lqr``'s K for :func:`to_control`'s system).
     nominal : mapping coordinate -> value or expression in t and parameters, or a Linearization
         The nominal motion ``y_s`` (every coordinate, as for :meth:`System.linearize`); its
-        rates are its time derivatives. A symbolic :class:`~jourdain.linearization.Linearization`
+        rates are its time derivatives. A symbolic :class:`~jourdain.stages.linearization.Linearization`
         gives its own nominal motion and inputs.
     inputs : mapping input -> value or expression, optional
         The nominal inputs ``u_s`` (zero for inputs left out; a Linearization's own otherwise).
@@ -150,7 +150,7 @@ def state_feedback(system: System, K: Any, nominal: Mapping[Any, Any] | Any,
     ModelError
         A nominal motion that names unknown coordinates or leaves some out.
     """
-    from ..linearization import Linearization, _nominal
+    from ..stages.linearization import Linearization, _nominal
 
     f, names = system.f, system.input_names
     try:

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import EvaluationError, JourdainError, SingularMassMatrix
-from ..linearization import (
+from ..stages.linearization import (
     CompiledLinearization,
     Linearization,
     NominalCheck,

@@ -59,7 +59,7 @@ def linearization_at(model: ModelFile, y: Any, yd: Any, t: float,
                      ) -> dict[str, np.ndarray]:
     """``M_tilde, P, Q, h`` about the state (y, ẏ) at time t (nominal ÿ_s = 0), and ``D, G, K,
     N``, the symmetric and skew parts of P and Q at that instant."""
-    from ..linearization import NominalMotionWarning
+    from ..stages.linearization import NominalMotionWarning
 
     system = model.system
     with warnings.catch_warnings():
@@ -85,7 +85,7 @@ def linear_analysis(model: ModelFile, about: str | None,
     Returns a dict: ``nominal`` (the NominalMotion), ``linearization``, ``numbers`` (M_tilde, P,
     Q, h, B and, time-invariant, D, G, K, N at ``t``), ``time_invariant``, ``conservative``
     (None when time-variant), ``modes`` and ``stability`` (None when time-variant or not
-    available), ``h_norm``, ``nominal_check`` (:class:`~jourdain.linearization.NominalCheck`
+    available), ``h_norm``, ``nominal_check`` (:class:`~jourdain.stages.linearization.NominalCheck`
     at ``t``), ``cyclic`` (the cyclic coordinates) and ``floquet``
     (:class:`~jourdain.analysis.floquet.Floquet` over one period from ``t`` for a periodic
     nominal motion: ``period`` given, a number or an expression in the parameters, or the
@@ -94,7 +94,7 @@ def linear_analysis(model: ModelFile, about: str | None,
     The warnings of a nominal motion that is not a solution are not issued here: they are in
     ``nominal_check`` and the stability verdict, which the text and the report show.
     """
-    from ..linearization import NominalMotionWarning
+    from ..stages.linearization import NominalMotionWarning
 
     system = model.system
     nominal = model.nominal_motion(about)
@@ -284,16 +284,16 @@ def simulate(model: ModelFile, parameters: Mapping[str, float] | None = None,
              inputs: Mapping[str, Any] | None = None, progress: Any = False,
              output: str | Path | None = None) -> Any:
     """Integrate the model from its [simulation] initial state; returns a
-    :class:`jourdain.results.Results`.
+    :class:`jourdain.simulation.results.Results`.
 
     Each option left out (None) is the model's ``[simulation]`` value, whose own defaults are
-    those of :mod:`jourdain.simulate`; ``y0``, ``yd0`` (by coordinate name) and ``inputs`` (by
+    those of :mod:`jourdain.simulation.simulate`; ``y0``, ``yd0`` (by coordinate name) and ``inputs`` (by
     input name: a number or an expression in t and the parameters) replace the model's values
     they name. ``progress`` and ``output`` (a results file written as the run goes) are passed
-    to :func:`jourdain.simulate.simulate`. The options are checked against the bounds of
-    :mod:`jourdain.simulate` before anything is computed (:class:`EvaluationError`).
+    to :func:`jourdain.simulation.simulate.simulate`. The options are checked against the bounds of
+    :mod:`jourdain.simulation.simulate` before anything is computed (:class:`EvaluationError`).
     """
-    from ..simulate import check_samples, check_t_end
+    from ..simulation.simulate import check_samples, check_t_end
 
     system = model.system
     sim = model.simulation
@@ -326,5 +326,5 @@ def simulate(model: ModelFile, parameters: Mapping[str, float] | None = None,
 
 
 def write_csv(results: Any, system: Any, path: Path) -> Path:
-    """Save a simulation as CSV (the format of :meth:`jourdain.results.Results.save`)."""
+    """Save a simulation as CSV (the format of :meth:`jourdain.simulation.results.Results.save`)."""
     return results.save(path)

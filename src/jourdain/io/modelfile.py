@@ -56,7 +56,7 @@ from ..model.joints import orientation_problem
 from ..model.quantities import KINDS as QUANTITY_KINDS
 from ..model.quantities import declare as declare_quantity
 from ..model.quantities import quantity as make_quantity
-from ..simulate import (
+from ..simulation.simulate import (
     DEFAULT_ATOL,
     DEFAULT_METHOD,
     DEFAULT_RTOL,
@@ -1278,7 +1278,7 @@ class _Loader:
         for k, check in checks.items():
             if k in spec:
                 v = self.number(spec[k], (*p, k), positive=True, integer=k == "samples")
-                try:  # the bounds of jourdain.simulate, one place for the API and the files
+                try:  # the bounds of jourdain.simulation.simulate, one place for the API and the files
                     kw[k] = check(v, k)
                 except JourdainError as exc:
                     raise self.fail((*p, k), str(exc)) from None

@@ -215,7 +215,7 @@ def constraints(loop: ClosedLoopSystem) -> Constraints:
 @lru_cache(maxsize=16)
 def constraint_function(loop: ClosedLoopSystem) -> Any:
     """Compiled ``Phi, Phi_z, Phi_t, c`` and the tree's energies ``T, V`` (memoized)."""
-    from ..energy import energy
+    from ..analysis.energy import energy
 
     con = constraints(loop)
     e = energy(loop.tree.kinematics())

@@ -42,8 +42,8 @@ from dataclasses import dataclass
 import symengine as se
 
 from ..errors import ModelError
-from ..kinematics import _cross, _dot, _mv
 from ..model.expressions import as_expr, as_vector, axis_vector, free_names
+from ..stages.kinematics import _cross, _dot, _mv
 
 Expr = se.Basic
 Vec3 = tuple[Expr, Expr, Expr]
@@ -202,7 +202,7 @@ class ConstraintRow:
 
 def constraint_rows(kin: object, closing: Sequence[ClosingJoint]) -> list[ConstraintRow]:
     """The scalar rows Φ_i of the closing joints from the tree's kinematics ``kin``
-    (:func:`jourdain.kinematics.kinematics`), identically zero rows dropped."""
+    (:func:`jourdain.stages.kinematics.kinematics`), identically zero rows dropped."""
     def frame(body: str) -> tuple[Vec3, tuple]:
         if body == "world":
             return ZERO3, _IDENT

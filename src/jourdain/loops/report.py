@@ -109,7 +109,7 @@ def run_report(model: Any, out: Path, parameters: Mapping[str, float] | None = N
     sim = model.simulation
     t1 = float(t_end if t_end is not None else sim.t_end)
     out.mkdir(parents=True, exist_ok=True)
-    from ..simulate import DEFAULT_ATOL, DEFAULT_RTOL
+    from ..simulation.simulate import DEFAULT_ATOL, DEFAULT_RTOL
 
     # the file's method and tolerances where it sets them; else tighter defaults than a tree
     # model's (the energy of a conservative loop is reported to 1e-9)

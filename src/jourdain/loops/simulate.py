@@ -45,7 +45,7 @@ import numpy as np
 from scipy.integrate import BDF, DOP853, RK45, Radau
 
 from ..errors import EvaluationError
-from ..simulate import check_t_span
+from ..simulation.simulate import check_t_span
 from .closed_loop import ClosedLoopSystem, LoopEvaluator, SingularConfiguration
 
 #: the steppers :func:`simulate_loop` drives, by ``method``
@@ -137,7 +137,7 @@ class LoopResults:
     def tree_results(self) -> Any:
         """The motion as :class:`jourdain.Results` of the tree (its coordinates z), for the
         report, CSV/HDF5 and the plots of tree models."""
-        from ..results import Results
+        from ..simulation.results import Results
 
         tree = self.loop.tree
         n_u = len(tree.inputs)

@@ -33,11 +33,11 @@ from .joints import orientation_problem
 from .quantities import Quantity, quantities_in
 
 if TYPE_CHECKING:
-    from ..kinematics import Kinematics
-    from ..linearization import Linearization
-    from ..newton_euler import NewtonEuler
-    from ..projection import EquationsOfMotion
-    from ..reactions import Reactions
+    from ..stages.kinematics import Kinematics
+    from ..stages.linearization import Linearization
+    from ..stages.newton_euler import NewtonEuler
+    from ..stages.projection import EquationsOfMotion
+    from ..stages.reactions import Reactions
 
 
 def _symbol_list(items: Iterable[object] | str, what: str) -> tuple[se.Symbol, ...]:
@@ -205,26 +205,26 @@ class System:
 
     # --- the stages, for convenience -------------------------------------------------------
     def kinematics(self) -> Kinematics:
-        """Kinematics of every body (METHOD §1); see :func:`jourdain.kinematics.kinematics`."""
-        from ..kinematics import kinematics
+        """Kinematics of every body (METHOD §1); see :func:`jourdain.stages.kinematics.kinematics`."""
+        from ..stages.kinematics import kinematics
 
         return kinematics(self)
 
     def newton_euler(self) -> NewtonEuler:
         """Newton–Euler equations M̄·J̄·ÿ + q̄^c = q̄^e + Q̄·g (METHOD §2)."""
-        from ..newton_euler import newton_euler
+        from ..stages.newton_euler import newton_euler
 
         return newton_euler(self.kinematics())
 
     def equations_of_motion(self) -> EquationsOfMotion:
         """Equations of motion M·ÿ + k = q by projection with J̄ᵀ (METHOD §3)."""
-        from ..projection import projection
+        from ..stages.projection import projection
 
         return projection(self.newton_euler())
 
     def reactions(self) -> Reactions:
         """Reaction forces: Q̄ from the joints, N̂·g = k̂ − q̂ (METHOD §4)."""
-        from ..reactions import reactions
+        from ..stages.reactions import reactions
 
         return reactions(self.newton_euler())
 
@@ -232,8 +232,8 @@ class System:
                   inputs: Mapping[Any, Any] | None = None) -> Linearization:
         """Linearization M̃·η̈ + P·η̇ + Q·η = h + B·Δu about a nominal motion (METHOD §5), with
         nominal ``inputs`` ``{input: u_s}`` where given (zero otherwise); see
-        :func:`jourdain.linearization.linearization`."""
-        from ..linearization import linearization
+        :func:`jourdain.stages.linearization.linearization`."""
+        from ..stages.linearization import linearization
 
         return linearization(self.equations_of_motion(), nominal, inputs)
 
@@ -242,13 +242,13 @@ class System:
         """Numbers at one state: a dict from the seed's names to NumPy arrays.
 
         Keys: ``M_bar, J_bar, q_c, q_e, M, k, q``, and the reactions ``Q_bar, N_hat, k_hat,
-        q_hat, g, g_names, g_undetermined`` (:func:`jourdain.reactions.evaluate_reactions`;
+        q_hat, g, g_names, g_undetermined`` (:func:`jourdain.stages.reactions.evaluate_reactions`;
         only ``reactions_error`` where the model's reactions cannot be formed).
         ``parameters`` overrides default values by name; ``inputs`` gives the inputs by name (or
         in the order of :attr:`input_names`).
         """
         from ..numeric import evaluate
-        from ..reactions import evaluate_keys
+        from ..stages.reactions import evaluate_keys
 
         out = evaluate(self, y, yd, t=t, parameters=parameters, inputs=inputs)
         out.update(evaluate_keys(self, y, yd, t, parameters, inputs, eom=out))
@@ -260,10 +260,10 @@ class System:
                  rtol: float | None = None, atol: Any = None, t_eval: Any = None,
                  **options: Any) -> Any:
         """Integrate the equations of motion from ``y0, ẏ0`` over ``t_span``; returns a
-        :class:`jourdain.results.Results` (see :func:`jourdain.simulate.simulate` for the
+        :class:`jourdain.simulation.results.Results` (see :func:`jourdain.simulation.simulate.simulate` for the
         methods, inputs, events and options). ``method``, ``rtol``, ``atol`` left out: the
-        defaults of :mod:`jourdain.simulate` (DOP853, 1e-8, 1e-10), the same as model files'."""
-        from ..simulate import DEFAULT_ATOL, DEFAULT_METHOD, DEFAULT_RTOL, simulate
+        defaults of :mod:`jourdain.simulation.simulate` (DOP853, 1e-8, 1e-10), the same as model files'."""
+        from ..simulation.simulate import DEFAULT_ATOL, DEFAULT_METHOD, DEFAULT_RTOL, simulate
 
         return simulate(self, t_span, y0, yd0, parameters=parameters, inputs=inputs,
                         method=DEFAULT_METHOD if method is None else method,

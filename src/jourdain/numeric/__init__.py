@@ -6,7 +6,7 @@
 cached on disk by content hash (:func:`cache_dir`, safe to delete; :mod:`.toolchain`). Parameter
 values are arguments, so changing them never recompiles. Many states evaluate in one call with
 :meth:`CompiledFunction.batch` (the loop runs in C). :func:`mkq_function` adds ``jd_accel``
-(``ÿ = M⁻¹(q − k)`` by an LDLᵀ factorization) for the integrator of :mod:`jourdain.simulate`.
+(``ÿ = M⁻¹(q − k)`` by an LDLᵀ factorization) for the integrator of :mod:`jourdain.simulation.simulate`.
 :func:`evaluate` gives the numbers of the Newton–Euler equations and the equations of motion at
 one state. Compiled functions are memoized per (immutable, content-compared) system;
 :func:`clear_cache` empties that memo (and, with ``disk=True``, the on-disk cache). Without a C
@@ -28,7 +28,7 @@ import symengine as se
 from ..cse import count_nodes
 from ..errors import EvaluationError, JourdainError, ModelError, SingularMassMatrix
 from ..model.bodies import check_values
-from ..reactions import joint_directions, reactions
+from ..stages.reactions import joint_directions, reactions
 from ..symbolic import SymMatrix
 from .ccode import HEADER, argument_names, function_source
 from .diagnose import nonfinite_message
@@ -345,7 +345,7 @@ def _recursive(system: System, full: bool, extra_source: str = "",
 @lru_cache(maxsize=32)
 def _eom_function(system: System) -> CompiledFunction:
     """M̄, J̄, q̄^c, q̄^e, M, k, q and, where the joints' constrained directions can be formed,
-    Q̄ (:func:`jourdain.reactions.joint_directions`), compiled by the recursion."""
+    Q̄ (:func:`jourdain.stages.reactions.joint_directions`), compiled by the recursion."""
     try:
         directions = tuple(jr.wrenches for jr in joint_directions(system))
     except JourdainError:  # the equations of motion exist; the reactions report the reason

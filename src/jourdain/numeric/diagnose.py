@@ -18,8 +18,8 @@ import numpy as np
 
 from ..differentiate import evaluate_float
 from ..errors import JourdainError
-from ..kinematics import joint_motions, kinematics
-from ..newton_euler import applied_forces
+from ..stages.kinematics import joint_motions, kinematics
+from ..stages.newton_euler import applied_forces
 
 if TYPE_CHECKING:
     from ..model.system import System

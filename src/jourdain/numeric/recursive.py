@@ -5,11 +5,11 @@ with f coordinates those expressions hold O(f³) operations, and compiling them 
 f = 63. Here the same products are formed numerically in the order of the tree, in generated C
 whose size grows with the number of bodies, not with f²:
 
-1. **Per joint, symbolic and short** (:func:`jourdain.kinematics.joint_motions`): the relative
+1. **Per joint, symbolic and short** (:func:`jourdain.stages.kinematics.joint_motions`): the relative
    rotation ``A`` and position ``d`` of the child frame, the relative Jacobian columns
    ``J_T``, ``J_R``, and the rheonomic and ÿ-free relative velocities and accelerations; per
    body its mass data and the resultant applied force ``f`` (inertial) and torque ``l`` (body
-   frame) of :func:`jourdain.newton_euler.applied_forces`. These are compiled as one function
+   frame) of :func:`jourdain.stages.newton_euler.applied_forces`. These are compiled as one function
    of (y, ẏ, t, p, u) with the graph CSE of :mod:`jourdain.numeric.ccode`.
 2. **Forward pass** (generic C, parents first): S_i = S_λ·A_i, the origin r_O,i = r_O,λ + S_λ·d_i,
    ω_i, v_i, and the local accelerations ᾱ_i, ā_i (METHOD.md §1) composed from the parent's;
@@ -30,7 +30,7 @@ whose size grows with the number of bodies, not with f²:
 
 The cost per state is O(Σ_b columns·depth), like Pinocchio's CRBA, and the generated source is a
 few hundred bytes per body plus a fixed engine. The symbolic equations stay what
-:func:`jourdain.projection.projection` gives, for display and export; tests compare both, and
+:func:`jourdain.stages.projection.projection` gives, for display and export; tests compare both, and
 both with Pinocchio.
 """
 
@@ -41,9 +41,9 @@ from typing import TYPE_CHECKING
 
 import symengine as se
 
-from ..kinematics import joint_motions, kinematics
 from ..model.forces import Gravity
-from ..newton_euler import applied_forces
+from ..stages.kinematics import joint_motions, kinematics
+from ..stages.newton_euler import applied_forces
 from .ccode import HEADER, argument_names, function_source
 
 if TYPE_CHECKING:
@@ -70,7 +70,7 @@ class RecursiveLayout:
 def layout(system: System, directions: tuple | None = None) -> RecursiveLayout:
     """The local expressions of every joint and body, in the order of the C arrays;
     ``directions``: per body the unit wrenches of its joint's constrained directions
-    (:func:`jourdain.reactions.joint_directions`), for Q̄."""
+    (:func:`jourdain.stages.reactions.joint_directions`), for Q̄."""
     motions = joint_motions(system)
     index = {b.name: i for i, b in enumerate(system.bodies)}
     # the symbolic kinematics of every body is needed only for loads that depend on it
@@ -404,7 +404,7 @@ static void jd_project(const jd_work *W, double *M, double *k, double *q) {
 }
 
 #if JD_FULL
-/* M_bar, J_bar, q_c, q_e in the row order of jourdain.newton_euler */
+/* M_bar, J_bar, q_c, q_e in the row order of jourdain.stages.newton_euler */
 static void jd_newton_euler(const double *L, const jd_work *W, double *out) {
     const long n = 6 * JD_P;
     double *Mb = out, *Jb = out + n * n, *qc = Jb + n * JD_F, *qe = qc + n;

@@ -17,7 +17,7 @@ with). A block of cases then only evaluates numbers:
 - ``critical``: bisection on the verdict for all cases of the block together, then the
   crossing of the largest real part through zero (as
   :func:`jourdain.analysis.stability_boundary`);
-- ``simulate``: one run per case (:func:`jourdain.simulate.simulate`).
+- ``simulate``: one run per case (:func:`jourdain.simulation.simulate.simulate`).
 
 A case that fails records its error (a string) and NaN outputs; it never stops the block.
 """
@@ -603,7 +603,7 @@ def critical(ctx: Context, P: np.ndarray) -> tuple[np.ndarray, dict[int, str]]:
 
 def _simulate(ctx: Context, P: np.ndarray, Y: np.ndarray, YD: np.ndarray, ok: np.ndarray,
               out: dict[str, np.ndarray], errors: list[str]) -> None:
-    from ..simulate import simulate
+    from ..simulation.simulate import simulate
 
     s = ctx.spec.compute["simulate"]
     system = ctx.system

@@ -481,7 +481,7 @@ class _Reader:
         return {"about": about, "omega": omega, "excitation": exc}
 
     def simulate(self, entry: dict, path: tuple[str | int, ...], model: Any) -> dict[str, Any]:
-        from ..simulate import MAX_SAMPLES, check_atol, check_rtol, check_t_end
+        from ..simulation.simulate import MAX_SAMPLES, check_atol, check_rtol, check_t_end
 
         system = model.system
         settings = model.simulation

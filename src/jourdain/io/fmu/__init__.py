@@ -161,7 +161,7 @@ def _reaction_names(system: System, reactions: Sequence[str] | str | None
     """The joints with their constrained directions, and the chosen components by name."""
     if reactions is None or (not isinstance(reactions, str) and not list(reactions)):
         return [], []
-    from ...reactions import check_reactions, joint_directions
+    from ...stages.reactions import check_reactions, joint_directions
 
     try:
         joints = list(joint_directions(system))

@@ -30,7 +30,7 @@ The motion
 ----------
 Per frame and body, the inertial position ``r_O`` of the body frame's origin and its rotation
 ``S`` (body → inertial) as a quaternion, at evenly spaced times on
-:meth:`~jourdain.results.Results.interpolate`'s motion: each joint's relative rotation and
+:meth:`~jourdain.simulation.results.Results.interpolate`'s motion: each joint's relative rotation and
 position compiled (:func:`pose_function`, evaluated for all frames in one call) and composed
 along the tree (:func:`body_poses`); stored as float32 (base64).
 
@@ -59,7 +59,7 @@ from .meshes import Mesh, read_mesh
 
 if TYPE_CHECKING:
     from ...model.system import System
-    from ...results import Results
+    from ...simulation.results import Results
 
 #: format tag of the scene JSON embedded in the page
 SCENE_FORMAT = "jourdain-view/1"
@@ -171,14 +171,14 @@ class View:
 
 @lru_cache(maxsize=32)
 def pose_function(system: System) -> Any:
-    """Compiled relative motion of every joint (:func:`jourdain.kinematics.joint_motions`):
+    """Compiled relative motion of every joint (:func:`jourdain.stages.kinematics.joint_motions`):
     ``"A<i>"`` (3×3, the child axes in the parent frame) and ``"d<i>"`` (3×1, the child origin in
     the parent frame) of body ``i``, as functions of (y, ẏ, t, parameters, inputs). Short
     expressions, one joint each: cheap to compile however deep the tree (composing the poses
     symbolically, as ``kinematics().bodies[i].S`` does, costs seconds of compilation for a chain
     of 60 bodies)."""
-    from ...kinematics import joint_motions
     from ...numeric import lambdify
+    from ...stages.kinematics import joint_motions
     from ...symbolic import SymMatrix
 
     mats = {}
@@ -620,7 +620,7 @@ def view(results: Results, *, visuals: Any = None,
 
     Parameters
     ----------
-    results : the :class:`~jourdain.results.Results` of a simulation (with its system)
+    results : the :class:`~jourdain.simulation.results.Results` of a simulation (with its system)
     visuals : per body name a list of :class:`Visual` (meshes, boxes, cylinders, spheres), or
         a URDF model's ``visuals`` (``view(res, visuals=model.visuals)``); default: the
         system's ``visuals`` attribute where it has one, else none

@@ -47,16 +47,16 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import symengine as se
 
-from .errors import EvaluationError, JourdainError, ModelError
+from ..errors import EvaluationError, JourdainError, ModelError
+from ..model.bodies import WORLD
+from ..model.expressions import values_at
+from ..model.joints import IDENTITY, Joint, Mat3, Rot, Vec3, rotation_matrix
+from ..symbolic import SymMatrix
 from .kinematics import Z3, _add, _cross, _dot, _mm, _mtv, _mv, _scale
-from .model.bodies import WORLD
-from .model.expressions import values_at
-from .model.joints import IDENTITY, Joint, Mat3, Rot, Vec3, rotation_matrix
 from .newton_euler import NewtonEuler, joint_transform
-from .symbolic import SymMatrix
 
 if TYPE_CHECKING:
-    from .model.system import System
+    from ..model.system import System
 
 ZERO = se.Integer(0)
 ONE = se.Integer(1)
@@ -220,7 +220,7 @@ def _user_directions(joint: Joint) -> list[tuple[str, Wrench]]:
         name, vec = item
         if not name.isidentifier():
             raise ModelError(f"{where}: name {name!r} must be an identifier")
-        from .model.expressions import as_vector
+        from ..model.expressions import as_vector
 
         w = as_vector(vec, where, n=6)
         if all(c == 0 for c in w):
@@ -498,7 +498,7 @@ class Reactions:
             )
         ne = self.newton_euler
         memo: dict = {}
-        from .symbolic import to_sympy
+        from ..symbolic import to_sympy
 
         N = sympy.Matrix(q + s, q + s, lambda i, j: 0)
         rhs = sympy.zeros(q + s, 1)
@@ -830,7 +830,7 @@ def check_orthogonality(r: Reactions, samples: int = 3, seed: int = 7, fn: Any =
     """
     system = r.system
     if fn is None:
-        from .numeric import lambdify
+        from ..numeric import lambdify
 
         fn = lambdify(system, {"J_bar": r.newton_euler.J_bar, "Q_bar": r.Q_bar})
     return _check_assembled(system, r.joints, fn, samples, seed)
@@ -989,7 +989,7 @@ def _reactions_function(system: System) -> tuple[ReactionLayout, Any]:
     """The compiled Newton–Euler matrices with Q̄ (:func:`jourdain.numeric.recursive`), after
     the joint-by-joint check and the check of the assembled J̄ᵀ·Q̄ = 0; ModelError when the
     model's reactions cannot be formed."""
-    from .numeric import _eom_function
+    from ..numeric import _eom_function
 
     joints = joint_directions(system)
     _checked_joints(system)
@@ -1098,7 +1098,7 @@ def evaluate_reactions(system: System, y: Any, yd: Any, t: float = 0.0,
     of undetermined components; empty for a well-posed model). ``eom``: the output of
     :func:`jourdain.numeric.evaluate` at the same state, if already at hand.
     """
-    from .numeric import evaluate as evaluate_eom
+    from ..numeric import evaluate as evaluate_eom
 
     lay, _ = _reactions_function(system)
     if eom is None or "Q_bar" not in eom:
@@ -1124,7 +1124,7 @@ def evaluate_reactions(system: System, y: Any, yd: Any, t: float = 0.0,
 def _joint_function(system: System, joints: tuple[str, ...]) -> tuple[list, Any]:
     """Compiled M, k, q and, per joint, ``Eᵀ·W0``, ``Eᵀ·W_y`` and ``EᵀE`` (E: its constrained
     directions), so that ``EᵀE·g_j = Eᵀ·(W0 + W_y·ÿ)``."""
-    from .numeric import lambdify
+    from ..numeric import lambdify
 
     eom = system.equations_of_motion()
     ne = eom.newton_euler
@@ -1164,7 +1164,7 @@ def joint_reactions(system: System, joints: str | Sequence[str], y: Any, yd: Any
     Returns ``{"<joint>.<direction>": value}``; directions that others of the same joint repeat
     share their force and come back as NaN (undetermined).
     """
-    from .numeric import state_vectors
+    from ..numeric import state_vectors
 
     if isinstance(joints, str):
         joints = [joints]
@@ -1178,7 +1178,7 @@ def joint_reactions(system: System, joints: str | Sequence[str], y: Any, yd: Any
     try:
         ydd = np.linalg.solve(np.atleast_2d(out_["M"]), (out_["q"] - out_["k"]).reshape(-1))
     except np.linalg.LinAlgError:
-        from .errors import SingularMassMatrix
+        from ..errors import SingularMassMatrix
 
         raise SingularMassMatrix("the mass matrix M is singular at this state") from None
     out: dict[str, float] = {}
@@ -1215,7 +1215,7 @@ def evaluate_keys(system: System, y: Any, yd: Any, t: float, parameters: Any, in
         out = evaluate_reactions(system, y, yd, t, parameters, inputs, eom=eom)
     except JourdainError as exc:
         return {"reactions_error": str(exc)}
-    from .wrenches import joint_wrenches
+    from ..wrenches import joint_wrenches
 
     out["joint_wrenches"] = joint_wrenches(system, out["g"], y, yd, t, parameters)
     return out

@@ -1,7 +1,7 @@
 """Time integration of the equations of motion ``M(y,t)·ÿ + k(y,ẏ,t) = q(y,ẏ,t)``.
 
 :func:`simulate` integrates from ``y(t0) = y0, ẏ(t0) = ẏ0`` and returns a
-:class:`~jourdain.results.Results`. The default methods ``"DOP853"`` and ``"RK45"``
+:class:`~jourdain.simulation.results.Results`. The default methods ``"DOP853"`` and ``"RK45"``
 (Dormand–Prince 8(5,3) and 5(4), adaptive steps, continuous extension) and the stiff method
 ``"Radau"`` (Radau IIA, order 5) run their step loop in C (:mod:`jourdain.numeric.integrator_c`),
 calling the generated ``M, k, q`` code and a Cholesky factorization of ``M`` in every
@@ -45,17 +45,17 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import symengine as se
 
-from .errors import EvaluationError, JourdainError, SingularMassMatrix
-from .model.expressions import as_expr
-from .numeric import CompiledFunction, lambdify, mkq_function, parameter_vector
-from .numeric.diagnose import nonfinite_sources
-from .numeric.integrator_c import source as integrator_source
-from .numeric.toolchain import build, content_key
+from ..errors import EvaluationError, JourdainError, SingularMassMatrix
+from ..model.expressions import as_expr
+from ..numeric import CompiledFunction, lambdify, mkq_function, parameter_vector
+from ..numeric.diagnose import nonfinite_sources
+from ..numeric.integrator_c import source as integrator_source
+from ..numeric.toolchain import build, content_key
+from ..symbolic import SymMatrix
 from .results import Results
-from .symbolic import SymMatrix
 
 if TYPE_CHECKING:
-    from .model.system import System
+    from ..model.system import System
 
 #: methods whose step loop runs in C, and their codes in the C library
 C_METHODS = {"DOP853": 1, "RK45": 0, "DOPRI5": 0, "Radau": 2}
@@ -561,7 +561,7 @@ def simulate(system: System, t_span: tuple[float, float], y0: Any, yd0: Any,
     EvaluationError
         bad arguments (wrong sizes, NaN initial values, unknown names).
     """
-    from .numeric import _vector
+    from ..numeric import _vector
 
     f = system.f
     t0, t1 = check_t_span(t_span)

@@ -20,11 +20,10 @@ from dataclasses import dataclass
 
 import symengine as se
 
-from .kinematics import Kinematics
-from .measures import Frames, bushing_deflection
-from .model.bodies import WORLD
-from .model.expressions import free_names
-from .model.forces import (
+from ..measures import Frames, bushing_deflection
+from ..model.bodies import WORLD
+from ..model.expressions import free_names
+from ..model.forces import (
     Bushing,
     Force,
     GeneralizedForce,
@@ -35,6 +34,7 @@ from .model.forces import (
     deflection_d,
     rate,
 )
+from ..stages.kinematics import Kinematics
 
 ZERO = se.Integer(0)
 
@@ -155,7 +155,7 @@ def _point(kin: Kinematics, body: str, p: tuple) -> tuple:
 
 def _has_quantities(fe: object) -> bool:
     """True when a force law uses kinematic quantities (treated as non-conservative)."""
-    from .model.system import _force_expressions
+    from ..model.system import _force_expressions
 
     return any(hasattr(s, "quantity") for e in _force_expressions(fe) for s in e.free_symbols)
 

@@ -14,11 +14,11 @@ from dataclasses import dataclass
 
 import symengine as se
 
-from .identity import IdentityMap
+from ..identity import IdentityMap
+from ..model.joints import Mat3
+from ..symbolic import SymMatrix
 from .kinematics import ROOT, FrameTag, _add, _cross, _dot, _mv, _scale, relative_rotation
-from .model.joints import Mat3
 from .newton_euler import NewtonEuler
-from .symbolic import SymMatrix
 
 ZERO = se.Integer(0)
 

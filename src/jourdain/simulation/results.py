@@ -53,8 +53,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import symengine as se
 
-from .errors import EvaluationError, JourdainError
-from .units import (
+from ..errors import EvaluationError, JourdainError
+from ..units import (
     axis_label,
     base_units,
     energy_unit,
@@ -66,7 +66,7 @@ from .units import (
 )
 
 if TYPE_CHECKING:
-    from .model.system import System
+    from ..model.system import System
 
 FORMAT = "jourdain-results"
 VERSION = 1
@@ -81,9 +81,9 @@ _GAUSS_W = np.array([5.0, 8.0, 5.0]) / 18.0
 
 @lru_cache(maxsize=32)
 def _energy_function(system: System) -> tuple[Any, bool, tuple[str, ...], bool]:
-    from .energy import energy
-    from .numeric import lambdify
-    from .symbolic import SymMatrix
+    from ..analysis.energy import energy
+    from ..numeric import lambdify
+    from ..symbolic import SymMatrix
 
     e = energy(system.kinematics())
     fn = lambdify(system, {"T": SymMatrix.column([e.T]), "V": SymMatrix.column([e.V])})
@@ -94,9 +94,9 @@ def _energy_function(system: System) -> tuple[Any, bool, tuple[str, ...], bool]:
 def _potential_rate_function(system: System) -> Any:
     """Compiled ``∂V/∂t`` (the explicit change of the potential with t), or None where V does
     not depend on t."""
-    from .energy import energy
-    from .numeric import lambdify
-    from .symbolic import SymMatrix
+    from ..analysis.energy import energy
+    from ..numeric import lambdify
+    from ..symbolic import SymMatrix
 
     rate = se.diff(energy(system.kinematics()).V, system.t)
     if rate.is_Number and rate == 0:
@@ -115,9 +115,9 @@ def _drive_power_function(system: System) -> Any:
     work), so ``d(T + V)/dt − ẏᵀq_nc − P = ẏᵀ·(Mÿ + k − q)``: with P the balance checks the
     equations of motion along ẏ just as it does for a scleronomic model, where ṽ = 0.
     """
-    from .energy import energy
-    from .numeric import lambdify
-    from .symbolic import SymMatrix
+    from ..analysis.energy import energy
+    from ..numeric import lambdify
+    from ..symbolic import SymMatrix
 
     kin = system.kinematics()
     ne = system.newton_euler()
@@ -136,7 +136,7 @@ def _drive_power_function(system: System) -> Any:
 
 @lru_cache(maxsize=32)
 def _positions_function(system: System) -> Any:
-    from .numeric import lambdify
+    from ..numeric import lambdify
 
     kin = system.kinematics()
     mats = {}
@@ -147,7 +147,7 @@ def _positions_function(system: System) -> Any:
 
 
 class Results:
-    """Time histories of a simulation (see :func:`jourdain.simulate.simulate`).
+    """Time histories of a simulation (see :func:`jourdain.simulation.simulate.simulate`).
 
     Attributes
     ----------
@@ -161,7 +161,7 @@ class Results:
         exception in an input function), "failed" (on the exception's ``results``)
     message : what happened, in words
     events : dict
-        One entry per :class:`jourdain.simulate.Event` of the run, keyed by its label (its
+        One entry per :class:`jourdain.simulation.simulate.Event` of the run, keyed by its label (its
         ``name``, else its expression as text), also where it never fired:
         ``{"t": (m,), "y": (m, f), "yd": (m, f)}``, the times of its zero crossings in the
         direction asked for (located on the integrator's continuous extension, in order) and
@@ -448,7 +448,7 @@ class Results:
 
     def _reactions(self) -> None:
         system = self._need_system("the reaction forces")
-        from .reactions import _reactions_function, projected_reactions, solve_g
+        from ..stages.reactions import _reactions_function, projected_reactions, solve_g
 
         lay, fn = _reactions_function(system)
         p = np.array([self.parameters[k] for k, _ in system.parameters])
@@ -476,7 +476,7 @@ class Results:
         arrays: force and torque (about the joint point) on the child body, in the joint frame
         and in the inertial frame (:mod:`jourdain.wrenches`; from :attr:`g`)."""
         if "joint_wrenches" not in self._energies:
-            from .wrenches import joint_wrenches_along
+            from ..wrenches import joint_wrenches_along
 
             system = self._need_system("the joint wrenches")
             p = np.array([self.parameters[k] for k, _ in system.parameters])
@@ -487,7 +487,7 @@ class Results:
     def joint_wrench_table(self, joint: str) -> tuple[list[str], np.ndarray]:
         """One joint's wrench along the motion as a table: column names and an (N, 13) array
         (t; ``<joint>.F_x`` … ``<joint>.T_z`` in the joint frame; the same with ``_inertial``)."""
-        from .wrenches import wrench_table
+        from ..wrenches import wrench_table
 
         wrenches = self.joint_wrenches
         if joint not in wrenches:
@@ -536,7 +536,7 @@ class Results:
     def to_xarray(self) -> Any:
         """These results as an ``xarray.Dataset`` (time, coordinate; units and the model's
         hash as attributes; ``jourdain[study]``): :func:`jourdain.study.results_dataset`."""
-        from .study.dataset import results_dataset
+        from ..study.dataset import results_dataset
 
         return results_dataset(self)
 
@@ -710,7 +710,7 @@ class Results:
         if self.system is None or len(self.t) < 2:
             return (self.t, self.kinetic_energy, self.potential_energy,
                     self.work_nonconservative, self.work_drive)
-        from .numeric import mkq_function
+        from ..numeric import mkq_function
 
         system = self.system
         tp = self._plot_times()

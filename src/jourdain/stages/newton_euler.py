@@ -14,11 +14,10 @@ from typing import TYPE_CHECKING
 
 import symengine as se
 
-from .errors import ModelError
-from .kinematics import Z3, BodyKinematics, Kinematics, _add, _cross, _dot, _mm, _mtv, _mv, _scale
-from .measures import Resolver, bushing_deflection, bushing_loads, bushing_wrench
-from .model.bodies import WORLD, Body
-from .model.forces import (
+from ..errors import ModelError
+from ..measures import Resolver, bushing_deflection, bushing_loads, bushing_wrench
+from ..model.bodies import WORLD, Body
+from ..model.forces import (
     Bushing,
     Force,
     GeneralizedForce,
@@ -29,11 +28,12 @@ from .model.forces import (
     deflection_d,
     rate,
 )
-from .model.joints import IDENTITY, Joint, Mat3, Rot, Vec3, rotation_matrix
-from .symbolic import SymMatrix
+from ..model.joints import IDENTITY, Joint, Mat3, Rot, Vec3, rotation_matrix
+from ..symbolic import SymMatrix
+from .kinematics import Z3, BodyKinematics, Kinematics, _add, _cross, _dot, _mm, _mtv, _mv, _scale
 
 if TYPE_CHECKING:
-    from .model.system import System
+    from ..model.system import System
 
 ZERO = se.Integer(0)
 

@@ -29,13 +29,13 @@ from typing import TYPE_CHECKING
 
 import symengine as se
 
-from .identity import IdentityMap
-from .model.forces import acceleration, rate
-from .model.joints import IDENTITY, Joint, Mat3, Rot, Trans, Vec3, rotation_matrix
-from .symbolic import SymMatrix
+from ..identity import IdentityMap
+from ..model.forces import acceleration, rate
+from ..model.joints import IDENTITY, Joint, Mat3, Rot, Trans, Vec3, rotation_matrix
+from ..symbolic import SymMatrix
 
 if TYPE_CHECKING:
-    from .model.system import System
+    from ..model.system import System
 
 ZERO = se.Integer(0)
 Z3: Vec3 = (ZERO, ZERO, ZERO)
@@ -291,7 +291,7 @@ def _translate(F: _Frame, d: Vec3, ctx: _Context) -> None:
             newJT[j] = F.JT.get(j, Z3)
             continue
         # remember the column as pieces S_k·v_k: dot products of columns are then formed from
-        # the local vectors (no sin² + cos² of components, see jourdain.projection)
+        # the local vectors (no sin² + cos² of components, see jourdain.stages.projection)
         old = F.JT.get(j)
         if old is None:
             col, pieces = toI(local), ((F.tag, local),)

@@ -41,14 +41,14 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import symengine as se
 
-from .differentiate import Graph, evaluate_float, free_symbol_names, jet, jet_float
-from .errors import EvaluationError, JourdainError, JourdainWarning, ModelError, warn
-from .model.expressions import as_expr
-from .symbolic import SymMatrix
+from ..differentiate import Graph, evaluate_float, free_symbol_names, jet, jet_float
+from ..errors import EvaluationError, JourdainError, JourdainWarning, ModelError, warn
+from ..model.expressions import as_expr
+from ..symbolic import SymMatrix
 
 if TYPE_CHECKING:
-    from .model.system import System
-    from .numeric import CompiledFunction
+    from ..model.system import System
+    from ..numeric import CompiledFunction
     from .projection import EquationsOfMotion
 
 ZERO = se.Integer(0)
@@ -324,7 +324,7 @@ class Linearization:
                       parameters: Mapping[str, float] | None = None) -> NominalCheck:
         """``h`` at time ``t`` against the forces at work at the nominal state
         (:class:`NominalCheck`; ``check.is_solution``, ``check.message()``)."""
-        from .numeric import parameter_vector, time_value
+        from ..numeric import parameter_vector, time_value
 
         system = self.system
         f, m = system.f, len(system.inputs)
@@ -373,7 +373,7 @@ class Linearization:
         expression graph once in floating point (no compilation); for many evaluations use
         :meth:`compile`.
         """
-        from .numeric import parameter_vector, time_value
+        from ..numeric import parameter_vector, time_value
 
         tv = time_value(t)
         p = parameter_vector(self.system, parameters)
@@ -400,7 +400,7 @@ class Linearization:
         """Machine code for ``M_tilde, P, Q, h, B`` as functions of t and the parameters
         (:func:`jourdain.numeric.lambdify`), for repeated evaluation (sweeps, time-variant
         systems)."""
-        from .numeric import lambdify
+        from ..numeric import lambdify
 
         return CompiledLinearization(self, lambdify(self.system, self._blocks()))
 
@@ -442,7 +442,7 @@ class CompiledLinearization:
 
     def __call__(self, t: float = 0.0,
                  parameters: Mapping[str, float] | None = None) -> dict[str, np.ndarray]:
-        from .numeric import parameter_vector, time_value
+        from ..numeric import parameter_vector, time_value
 
         system = self.linearization.system
         p = parameter_vector(system, parameters)
@@ -480,7 +480,7 @@ def linearization(eom: EquationsOfMotion, nominal: Mapping[Any, Any] | Any,
     Parameters
     ----------
     eom : EquationsOfMotion
-        Result of :func:`jourdain.projection`.
+        Result of :func:`jourdain.stages.projection`.
     nominal : mapping
         ``{coordinate: y_s}`` for every coordinate (names or symbols as keys), each a number or
         an expression in ``t`` and the system's parameters: constants for an equilibrium,
@@ -792,7 +792,7 @@ def linearize_numeric(source: System | EquationsOfMotion, nominal: Mapping[Any, 
     matrices: the way to eigenvalues of large systems (a spatial chain of 16 bodies in well
     under a second, derivation included).
     """
-    from .numeric import parameter_vector, time_value
+    from ..numeric import parameter_vector, time_value
     from .projection import EquationsOfMotion
 
     eom = source if isinstance(source, EquationsOfMotion) else source.equations_of_motion()
@@ -896,7 +896,7 @@ class GeneralLinearization:
                  parameters: Mapping[str, float] | None = None,
                  inputs: Mapping[str, float] | None = None) -> dict[str, np.ndarray]:
         """Arrays of ``M_tilde, P, Q, h, B`` at one state."""
-        from .numeric import state_vectors
+        from ..numeric import state_vectors
 
         system = self.system
         yv, ydv, tv, pv, uv = state_vectors(system, y, yd, t, parameters, inputs)

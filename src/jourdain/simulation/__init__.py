@@ -1,0 +1,6 @@
+"""Simulation of the equations of motion (``docs/method.md`` §7): :mod:`.simulate` integrates
+``M·ÿ + k = q`` (compiled step loops or SciPy), :mod:`.results` holds the motion.
+
+This package re-exports nothing, so ``jourdain.simulation.simulate`` is the module (the
+function is ``jourdain.simulate``).
+"""
