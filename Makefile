@@ -2,13 +2,15 @@
 #   make run   - create .venv, install jourdain, run the main job on the default example
 #   make test  - create .venv, install jourdain with test extras, run ruff and the test suite
 #                (twice: PYTHONHASHSEED=0 with OPENBLAS_NUM_THREADS=1, and PYTHONHASHSEED=12345)
+#   make docs  - install jourdain with the docs extra and build the documentation site into
+#                site/ (mkdocs build --strict: offline, warnings are errors; see mkdocs.yml)
 #   make bench - every benchmark script in its quick mode (not part of make test; the full runs
 #                and their options are in each script's docstring)
 PYTHON ?= python3
 VENV   ?= .venv
 BIN    := $(VENV)/bin
 
-.PHONY: run test lint clean browser bench viewer-assets
+.PHONY: run test lint clean browser bench viewer-assets docs
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -52,6 +54,17 @@ test: lint browser
 	PYTHONHASHSEED=12345 JOURDAIN_TEST_CACHE=$(CURDIR)/.jourdain-test-cache \
 	  $(BIN)/python -m pytest -q
 
+# the documentation site (mkdocs.yml): tutorials executed and every example run for the gallery
+# at each build, so a change of the code that breaks either fails here; compiled libraries in a
+# cache of the project (removed by make clean); MkDocs' own notices about its future silenced
+$(BIN)/.installed-docs: pyproject.toml | $(BIN)/python
+	$(BIN)/python -m pip install --quiet -e ".[docs]"
+	touch $@ $(BIN)/.installed-run
+
+docs: $(BIN)/.installed-docs
+	NO_MKDOCS_2_WARNING=1 DISABLE_MKDOCS_2_WARNING=true \
+	  JOURDAIN_CACHE=$(CURDIR)/.jourdain-docs-cache $(BIN)/mkdocs build --strict
+
 # quick modes only: a few minutes in all; timings from a quick run are not the reported numbers
 bench: $(BIN)/.installed
 	$(BIN)/python benchmarks/derivation.py --quick
@@ -68,4 +81,4 @@ viewer-assets:
 	tools/build_viewer.sh
 
 clean:
-	rm -rf $(VENV) .pytest_cache .ruff_cache .jourdain-test-cache
+	rm -rf $(VENV) .pytest_cache .ruff_cache .jourdain-test-cache .jourdain-docs-cache site
