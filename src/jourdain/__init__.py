@@ -57,7 +57,6 @@ from .model import (
     RotationalSpringDamper,
     Spherical,
     SpringDamper,
-    System,
     Torque,
     Trans,
     Universal,
@@ -83,6 +82,7 @@ from .model import (
     t,
     velocity,
 )
+from .pipeline import System
 from .simulation.results import Results
 from .simulation.simulate import Event, IntegrationError, simulate
 from .stages.kinematics import BodyKinematics, Kinematics, kinematics

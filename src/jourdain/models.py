@@ -18,12 +18,12 @@ from .model import (
     Revolute,
     Rot,
     Spherical,
-    System,
     Universal,
     point_mass,
     rod,
     symbols,
 )
+from .pipeline import System
 
 
 def n_link_pendulum_on_cart(n: int) -> System:

@@ -1,0 +1,107 @@
+"""``jourdain.System``: the model description with the stages of the method as cached methods.
+
+Each symbolic stage runs at most once per system and is kept on the instance (the system is
+immutable, so are the stages' results): ``kinematics`` (``docs/method.md`` §2),
+``newton_euler`` (§3), ``equations_of_motion`` (§4, the projection), ``reactions`` (§4). The
+numeric methods (``evaluate``, ``linearize``, ``simulate``) call the memoized compiled code of
+:mod:`jourdain.numeric`. The kept stages belong to one process: a pickled system (sent to a
+study's worker) travels without them and derives its own, and a lock per system makes
+concurrent first calls from threads compute each stage once.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any, TypeVar
+
+import numpy as np
+
+from ..model.system import System as Model
+from ..numeric import evaluate as evaluate_eom
+from ..simulation.results import Results
+from ..simulation.simulate import DEFAULT_ATOL, DEFAULT_METHOD, DEFAULT_RTOL, simulate
+from ..stages.kinematics import Kinematics, kinematics
+from ..stages.linearization import Linearization, linearization
+from ..stages.newton_euler import NewtonEuler, newton_euler
+from ..stages.projection import EquationsOfMotion, projection
+from ..stages.reactions import Reactions, evaluate_keys, reactions
+
+_T = TypeVar("_T")
+_LOCKS = threading.Lock()  # guards the creation of the per-system locks
+
+
+class System(Model):
+    """A multibody system (:class:`jourdain.model.System`: coordinates, bodies, force elements,
+    parameters, inputs) with the method's stages as methods, each computed once and kept.
+
+    Equal to another ``jourdain.System`` with the same description; the kept stages take no
+    part in equality, hashing or pickling.
+    """
+
+    def _stage(self, key: str, compute: Callable[[], _T]) -> _T:
+        d = self.__dict__
+        if key in d:
+            return d[key]  # type: ignore[no-any-return]  # the value compute() stored
+        with _LOCKS:
+            lock = d.setdefault("_lock", threading.RLock())
+        with lock:  # reentrant: equations_of_motion asks for newton_euler inside its own
+            if key not in d:
+                d[key] = compute()
+            return d[key]  # type: ignore[no-any-return]
+
+    def kinematics(self) -> Kinematics:
+        """Kinematics of every body (METHOD §1); see :func:`jourdain.stages.kinematics.kinematics`."""
+        return self._stage("_kinematics", lambda: kinematics(self))
+
+    def newton_euler(self) -> NewtonEuler:
+        """Newton–Euler equations M̄·J̄·ÿ + q̄^c = q̄^e + Q̄·g (METHOD §2)."""
+        return self._stage("_newton_euler", lambda: newton_euler(self.kinematics()))
+
+    def equations_of_motion(self) -> EquationsOfMotion:
+        """Equations of motion M·ÿ + k = q by projection with J̄ᵀ (METHOD §3)."""
+        return self._stage("_equations_of_motion", lambda: projection(self.newton_euler()))
+
+    def reactions(self) -> Reactions:
+        """Reaction forces: Q̄ from the joints, N̂·g = k̂ − q̂ (METHOD §4)."""
+        return self._stage("_reactions", lambda: reactions(self.newton_euler()))
+
+    def linearize(self, nominal: Mapping[Any, Any] | Any,
+                  inputs: Mapping[Any, Any] | None = None) -> Linearization:
+        """Linearization M̃·η̈ + P·η̇ + Q·η = h + B·Δu about a nominal motion (METHOD §5), with
+        nominal ``inputs`` ``{input: u_s}`` where given (zero otherwise); see
+        :func:`jourdain.stages.linearization.linearization`."""
+        return linearization(self.equations_of_motion(), nominal, inputs)
+
+    def evaluate(self, y: Any, yd: Any, t: float = 0.0,
+                 parameters: Mapping[str, float] | None = None,
+                 inputs: Mapping[str, float] | Sequence[float] | None = None
+                 ) -> dict[str, Any]:
+        """Numbers at one state: a dict from the seed's names to NumPy arrays.
+
+        Keys: ``M_bar, J_bar, q_c, q_e, M, k, q``, and the reactions ``Q_bar, N_hat, k_hat,
+        q_hat, g, g_names, g_undetermined`` and ``joint_wrenches``
+        (:func:`jourdain.stages.reactions.evaluate_reactions`; only ``reactions_error`` where
+        the model's reactions cannot be formed). ``parameters`` overrides default values by
+        name; ``inputs`` gives the inputs by name (or in the order of :attr:`input_names`).
+        """
+        out: dict[str, Any] = dict(evaluate_eom(self, y, yd, t=t, parameters=parameters,
+                                                inputs=inputs))
+        eom: dict[str, np.ndarray] = dict(out)
+        out.update(evaluate_keys(self, y, yd, t, parameters, inputs, eom=eom))
+        return out
+
+    def simulate(self, t_span: tuple[float, float], y0: Any, yd0: Any,
+                 parameters: Mapping[str, float] | None = None,
+                 inputs: Mapping[str, Any] | None = None, method: str | None = None,
+                 rtol: float | None = None, atol: Any = None, t_eval: Any = None,
+                 **options: Any) -> Results:
+        """Integrate the equations of motion from ``y0, ẏ0`` over ``t_span``; returns a
+        :class:`jourdain.simulation.results.Results` (see
+        :func:`jourdain.simulation.simulate.simulate` for the methods, inputs, events and
+        options). ``method``, ``rtol``, ``atol`` left out: the defaults of
+        :mod:`jourdain.simulation.simulate` (DOP853, 1e-8, 1e-10), the same as model files'."""
+        return simulate(self, t_span, y0, yd0, parameters=parameters, inputs=inputs,
+                        method=DEFAULT_METHOD if method is None else method,
+                        rtol=DEFAULT_RTOL if rtol is None else rtol,
+                        atol=DEFAULT_ATOL if atol is None else atol, t_eval=t_eval, **options)
