@@ -66,8 +66,8 @@ from ..model import (
     Prismatic,
     Revolute,
     RotationalSpringDamper,
-    System,
 )
+from ..pipeline import System  # jourdain.System: the model with its stages (issue 16)
 from .expressions import RESERVED_NAMES
 from .modelfile import (
     MAX_FILE_BYTES,
