@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from ..model import Body, Gravity, Prismatic, Revolute, System, rod, symbols
+from ..model import Body, Gravity, Prismatic, Revolute, rod, symbols
+from ..pipeline import System  # jourdain.System: the model with its stages (issue 16)
 from .closed_loop import ClosedLoopSystem
 from .constraints import ClosingJoint
 
