@@ -52,6 +52,7 @@ from ..errors import JourdainError, ModelError
 from ..model import System
 from ..model.forces import rate
 from ..numeric import _vector, lambdify, mkq_function, parameter_vector, time_value
+from ..stages.kinematics import kinematics  # the model has no stage methods (issue 16)
 from ..symbolic import SymMatrix
 from .constraints import ClosingJoint, ConstraintRow, constraint_rows, grubler
 
@@ -191,7 +192,7 @@ class Constraints:
 def constraints(loop: ClosedLoopSystem) -> Constraints:
     """Φ, Φ_z, Φ_t and the convective term c of ``loop`` from the tree's kinematics."""
     tree = loop.tree
-    rows = constraint_rows(tree.kinematics(), loop.closing)
+    rows = constraint_rows(kinematics(tree), loop.closing)
     if not rows:
         raise ModelError(f"{loop.name}: the closing joints give no constraint equation (every "
                          "row vanishes identically)")
@@ -218,7 +219,7 @@ def constraint_function(loop: ClosedLoopSystem) -> Any:
     from ..analysis.energy import energy
 
     con = constraints(loop)
-    e = energy(loop.tree.kinematics())
+    e = energy(kinematics(loop.tree))
     return lambdify(loop.tree, {"Phi": con.Phi, "Phi_z": con.Phi_z, "Phi_t": con.Phi_t,
                                 "c": con.c, "T": SymMatrix.column([e.T]),
                                 "V": SymMatrix.column([e.V])})
