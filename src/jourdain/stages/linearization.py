@@ -45,6 +45,9 @@ from ..differentiate import Graph, evaluate_float, free_symbol_names, jet, jet_f
 from ..errors import EvaluationError, JourdainError, JourdainWarning, ModelError, warn
 from ..model.expressions import as_expr
 from ..symbolic import SymMatrix
+from .kinematics import kinematics  # the model has no stage methods (issue 16)
+from .newton_euler import newton_euler
+from .projection import projection
 
 if TYPE_CHECKING:
     from ..model.system import System
@@ -795,7 +798,7 @@ def linearize_numeric(source: System | EquationsOfMotion, nominal: Mapping[Any, 
     from ..numeric import parameter_vector, time_value
     from .projection import EquationsOfMotion
 
-    eom = source if isinstance(source, EquationsOfMotion) else source.equations_of_motion()
+    eom = source if isinstance(source, EquationsOfMotion) else projection(newton_euler(kinematics(source)))
     system = eom.system
     tv = time_value(t)
     y_s, u_s = _nominal(system, nominal, inputs)
