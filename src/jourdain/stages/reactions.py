@@ -52,8 +52,9 @@ from ..model.bodies import WORLD
 from ..model.expressions import values_at
 from ..model.joints import IDENTITY, Joint, Mat3, Rot, Vec3, rotation_matrix
 from ..symbolic import SymMatrix
-from .kinematics import Z3, _add, _cross, _dot, _mm, _mtv, _mv, _scale
-from .newton_euler import NewtonEuler, joint_transform
+from .kinematics import Z3, _add, _cross, _dot, _mm, _mtv, _mv, _scale, kinematics
+from .newton_euler import NewtonEuler, joint_transform, newton_euler
+from .projection import projection  # the model has no stage methods (issue 16)
 
 if TYPE_CHECKING:
     from ..model.system import System
@@ -1126,7 +1127,7 @@ def _joint_function(system: System, joints: tuple[str, ...]) -> tuple[list, Any]
     directions), so that ``EᵀE·g_j = Eᵀ·(W0 + W_y·ÿ)``."""
     from ..numeric import lambdify
 
-    eom = system.equations_of_motion()
+    eom = projection(newton_euler(kinematics(system)))
     ne = eom.newton_euler
     by_joint = {b.joint.name: b for b in system.bodies}
     params = system.parameter_values
