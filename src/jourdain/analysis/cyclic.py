@@ -27,6 +27,9 @@ import numpy as np
 
 from ..differentiate import Graph, free_symbol_names, jet_float
 from ..errors import JourdainError
+from ..stages.kinematics import kinematics  # the model has no stage methods (issue 16)
+from ..stages.newton_euler import newton_euler
+from ..stages.projection import projection
 
 if TYPE_CHECKING:
     from ..model.system import System
@@ -56,7 +59,7 @@ def cyclic_coordinates(source: System | EquationsOfMotion) -> tuple[str, ...]:
     from ..stages.linearization import _perturbed
     from ..stages.projection import EquationsOfMotion
 
-    eom = source if isinstance(source, EquationsOfMotion) else source.equations_of_motion()
+    eom = source if isinstance(source, EquationsOfMotion) else projection(newton_euler(kinematics(source)))
     system = eom.system
     f = system.f
     ne = eom.newton_euler
