@@ -54,6 +54,8 @@ import numpy as np
 import symengine as se
 
 from ..errors import EvaluationError, JourdainError
+from ..stages.kinematics import kinematics  # the model has no stage methods (issue 16)
+from ..stages.newton_euler import newton_euler
 from ..units import (
     axis_label,
     base_units,
@@ -85,7 +87,7 @@ def _energy_function(system: System) -> tuple[Any, bool, tuple[str, ...], bool]:
     from ..numeric import lambdify
     from ..symbolic import SymMatrix
 
-    e = energy(system.kinematics())
+    e = energy(kinematics(system))
     fn = lambdify(system, {"T": SymMatrix.column([e.T]), "V": SymMatrix.column([e.V])})
     return fn, e.conservative, e.nonconservative, e.rheonomic
 
@@ -98,7 +100,7 @@ def _potential_rate_function(system: System) -> Any:
     from ..numeric import lambdify
     from ..symbolic import SymMatrix
 
-    rate = se.diff(energy(system.kinematics()).V, system.t)
+    rate = se.diff(energy(kinematics(system)).V, system.t)
     if rate.is_Number and rate == 0:
         return None
     return lambdify(system, {"dVdt": SymMatrix.column([rate])})
@@ -119,8 +121,8 @@ def _drive_power_function(system: System) -> Any:
     from ..numeric import lambdify
     from ..symbolic import SymMatrix
 
-    kin = system.kinematics()
-    ne = system.newton_euler()
+    kin = kinematics(system)
+    ne = newton_euler(kin)
     zero = se.Integer(0)
     v = [e for bk in kin.bodies for e in bk.v_bar.entries()]
     v += [e for bk in kin.bodies for e in bk.omega_bar.entries()]
@@ -138,7 +140,7 @@ def _drive_power_function(system: System) -> Any:
 def _positions_function(system: System) -> Any:
     from ..numeric import lambdify
 
-    kin = system.kinematics()
+    kin = kinematics(system)
     mats = {}
     for bk in kin.bodies:
         mats[f"{bk.name}.r_O"] = bk.r_O
