@@ -28,6 +28,9 @@ import symengine as se
 from ..cse import count_nodes
 from ..errors import EvaluationError, JourdainError, ModelError, SingularMassMatrix
 from ..model.bodies import check_values
+from ..stages.kinematics import kinematics  # the model has no stage methods (issue 16)
+from ..stages.newton_euler import newton_euler
+from ..stages.projection import projection
 from ..stages.reactions import joint_directions, reactions
 from ..symbolic import SymMatrix
 from .ccode import HEADER, argument_names, function_source
@@ -329,7 +332,7 @@ def _recursive(system: System, full: bool, extra_source: str = "",
     try:
         compiler()
     except CompilerError:
-        eom = system.equations_of_motion()
+        eom = projection(newton_euler(kinematics(system)))
         mats = {"M": eom.M, "k": eom.k, "q": eom.q}
         if full:
             ne = eom.newton_euler
@@ -372,7 +375,7 @@ def mkq_function(system: System) -> CompiledFunction:
     with LDLᵀ for small graphs (:data:`SYMBOLIC_NODES`), else the recursion (its
     articulated-body ÿ where every coordinate belongs to one joint)."""
     if system.f <= SYMBOLIC_MAX_F:
-        eom = system.equations_of_motion()
+        eom = projection(newton_euler(kinematics(system)))
         exprs = [*eom.M.entries(), *eom.k.entries(), *eom.q.entries()]
         if count_nodes(exprs, SYMBOLIC_NODES) <= SYMBOLIC_NODES:
             return lambdify(system, {"M": eom.M, "k": eom.k, "q": eom.q},
