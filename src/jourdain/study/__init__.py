@@ -13,8 +13,9 @@ runs the blocks on this machine's cores or on a Dask cluster, saves them as they
 
 from .compute import VERDICTS, compute_block
 from .dataset import open_study, results_dataset, to_dataset, write_netcdf
+from .reader import load_study, loads_study
 from .runner import Progress, run_study
-from .spec import DESIGNS, DISTRIBUTIONS, StudyError, StudySpec, load_study, loads_study
+from .spec import DESIGNS, DISTRIBUTIONS, StudyError, StudySpec
 
 __all__ = ["DESIGNS", "DISTRIBUTIONS", "VERDICTS", "Progress", "StudyError", "StudySpec",
            "compute_block", "load_study", "loads_study", "open_study", "results_dataset",

@@ -210,13 +210,12 @@ def results_dataset(results: Any) -> Any:
         if arr is None:
             continue
         cu = [per_time(units.get(c, ""), order) if units.get(c) else "" for c in coords]
-        attrs = {"long_name": {"y": "coordinates", "yd": "rates",
-                               "ydd": "accelerations"}[name]}
+        va = {"long_name": {"y": "coordinates", "yd": "rates", "ydd": "accelerations"}[name]}
         if len(set(cu)) == 1 and cu[0]:
-            attrs["units"] = cu[0]
+            va["units"] = cu[0]
         else:
-            attrs["coordinate_units"] = json.dumps(cu)
-        data[name] = xr.Variable(("time", "coordinate"), np.asarray(arr, dtype=float), attrs)
+            va["coordinate_units"] = json.dumps(cu)
+        data[name] = xr.Variable(("time", "coordinate"), np.asarray(arr, dtype=float), va)
     if results.u is not None and len(results.input_names):
         data["u"] = xr.Variable(("time", "input"), np.asarray(results.u, dtype=float),
                                 {"long_name": "inputs"})

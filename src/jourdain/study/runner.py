@@ -153,9 +153,9 @@ def _init_worker() -> None:
     """A fresh worker process: forget what it inherited, so that it rebuilds the model from
     the study's model text and loads the compiled functions from the disk cache."""
     from .. import numeric
-    from . import compute
+    from .context import forget_contexts
 
-    compute._CONTEXTS.clear()
+    forget_contexts()
     numeric.clear_cache()
 
 
@@ -189,6 +189,32 @@ def _run_local(spec: StudySpec, todo: list[tuple[int, int]], workers: int,
                 fut.cancel()
 
 
+def _run_threads(spec: StudySpec, todo: list[tuple[int, int]], workers: int,
+                 keys: dict[str, str]) -> Iterator[dict[str, Any]]:
+    """The blocks on threads of this process: for work that releases the GIL (the ensembles of
+    simulations run in C), with no worker start and no model rebuilt."""
+    import concurrent.futures as cf
+
+    with cf.ThreadPoolExecutor(max_workers=workers) as pool:
+        futures = [pool.submit(compute_block, spec, s, e, keys) for s, e in todo]
+        try:
+            for fut in cf.as_completed(futures):
+                yield _result(fut, spec)
+        finally:
+            for fut in futures:
+                fut.cancel()
+
+
+#: how local workers run: ``auto`` picks threads where the work releases the GIL
+POOLS = ("auto", "processes", "threads")
+
+
+def _releases_gil(ctx: Any) -> bool:
+    """True when a block's work is C that releases the GIL: only ``simulate``, advanced as an
+    ensemble (the linearizations and evaluations spend much of their time in Python)."""
+    return set(ctx.spec.compute) == {"simulate"} and ctx.ensemble is not None
+
+
 def _run_dask(spec: StudySpec, todo: list[tuple[int, int]], scheduler: Any,
               keys: dict[str, str]) -> Iterator[dict[str, Any]]:
     try:
@@ -219,7 +245,7 @@ def _run_dask(spec: StudySpec, todo: list[tuple[int, int]], scheduler: Any,
 
 def run_study(spec: StudySpec, out: str | Path | None = None, *, workers: int | None = None,
               scheduler: Any = None, quiet: bool = False, force: bool = False,
-              on_block: Callable[[dict[str, Any]], None] | None = None) -> Any:
+              pool: str = "auto", on_block: Callable[[dict[str, Any]], None] | None = None) -> Any:
     """Run ``spec`` and return its results as an ``xarray.Dataset``
     (:func:`jourdain.study.dataset.to_dataset`).
 
@@ -228,8 +254,11 @@ def run_study(spec: StudySpec, out: str | Path | None = None, *, workers: int | 
     spec : StudySpec (:func:`jourdain.study.load_study`)
     out : path of the NetCDF file to write (``.nc``); blocks are saved as they finish in
         ``<out>.parts/`` and a study run again with the same ``out`` resumes from them
-    workers : processes on this machine (None, the default: one per core; 1: in this
+    workers : workers on this machine (None, the default: one per core; 1: in this
         process; a study of one block always runs in this process)
+    pool : how the local workers run: ``"processes"`` (each rebuilds the model),
+        ``"threads"`` (for work that releases the GIL) or ``"auto"`` (the default: threads for
+        a study that only simulates with ensembles, processes otherwise)
     scheduler : address of a ``dask.distributed`` scheduler (``"tcp://host:8786"``) or a
         ``distributed.Client``: the blocks run on that cluster (``workers`` is then ignored)
     quiet : no progress bar (:class:`Progress`: on stderr, or in the notebook's cell)
@@ -268,8 +297,15 @@ def run_study(spec: StudySpec, out: str | Path | None = None, *, workers: int | 
         n = (os.cpu_count() or 1) if workers is None else int(workers)
         if n < 1:
             raise StudyError(f"workers must be ≥ 1, got {workers}", spec.filename)
-        stream = (_run_local(spec, todo, min(n, len(todo)), keys) if n > 1 and len(todo) > 1
-                  else (compute_block(spec, s, e, keys) for s, e in todo))
+        if pool not in POOLS:
+            raise StudyError(f"pool must be one of {', '.join(POOLS)}, got {pool!r}",
+                             spec.filename)
+        threads = pool == "threads" or (pool == "auto" and _releases_gil(ctx))
+        if n > 1 and len(todo) > 1:
+            stream = (_run_threads if threads else _run_local)(spec, todo, min(n, len(todo)),
+                                                               keys)
+        else:
+            stream = (compute_block(spec, s, e, keys) for s, e in todo)
     for block in stream:
         if parts is not None:
             parts.save(block)
@@ -279,7 +315,7 @@ def run_study(spec: StudySpec, out: str | Path | None = None, *, workers: int | 
             on_block(block)
     bar.close()
     ds = to_dataset(ctx, [results[s] for s, _ in blocks])
-    if out is not None:
+    if out is not None and parts is not None:
         from .dataset import write_netcdf
 
         write_netcdf(ds, out)
