@@ -18,6 +18,9 @@ import mkdocs_gen_files
 
 ROOT = Path(__file__).resolve().parents[2]
 
+# the repository's files that are pages of the site, by their path in the repository
+PAGES = {"CONTRIBUTING.md": "contributing.md", "CHANGELOG.md": "changelog.md"}
+
 _LINK = re.compile(r"(?<!!)\[(?P<text>[^\]]+)\]\((?P<target>[^)\s]+)\)")
 
 
@@ -27,6 +30,8 @@ def _site_links(markdown: str) -> str:
         if re.match(r"[a-z]+:|#", target):                 # web address, mail, anchor
             return m.group(0)
         path, _, anchor = target.partition("#")
+        if path in PAGES:
+            return f"[{text}]({PAGES[path]}{'#' + anchor if anchor else ''})"
         if path.startswith("docs/") and path.endswith(".md"):
             return f"[{text}]({path[len('docs/'):]}{'#' + anchor if anchor else ''})"
         if text.startswith("`"):
@@ -35,7 +40,7 @@ def _site_links(markdown: str) -> str:
     return _LINK.sub(repl, markdown)
 
 
-for source, page in (("CONTRIBUTING.md", "contributing.md"), ("CHANGELOG.md", "changelog.md")):
+for source, page in PAGES.items():
     with mkdocs_gen_files.open(page, "w") as f:
         f.write(_site_links((ROOT / source).read_text(encoding="utf-8")))
 
