@@ -35,6 +35,7 @@ from ..stages.reactions import joint_directions, reactions
 from ..symbolic import SymMatrix
 from .ccode import HEADER, argument_names, function_source
 from .diagnose import nonfinite_message
+from .integrator_ldl import ldl_source  # the solve written out per f (H1)
 from .recursive import LDL_SOLVE, recursive_units
 from .toolchain import CompilerError, build, cache_dir, compiler, content_key
 
@@ -395,7 +396,9 @@ def dynamics_function(system: System) -> CompiledFunction:
 def _accel_source(f: int) -> str:
     """The integrator's ``jd_accel`` by LDLᵀ of M for ``f`` coordinates ("" above ACCEL_MAX_F:
     its work arrays live on the stack)."""
-    return ACCEL_TEMPLATE.replace("JD_F_VALUE", str(f)) if f <= ACCEL_MAX_F else ""
+    # ldl_source: the solve written out for small f (integrator_ldl), else LDL_SOLVE's loop
+    return (ldl_source(f) + ACCEL_TEMPLATE.replace("JD_F_VALUE", str(f))
+            if f <= ACCEL_MAX_F else "")
 
 
 # ÿ = M⁻¹(q − k) with the size known to the compiler, which unrolls the small loops and
