@@ -16,11 +16,15 @@
    The batched verdicts are compared with the loop's on the cases the loop ran.
 
 2. A Monte-Carlo run of ``examples/quarter_car.toml`` (``--mc`` runs, 1 000 by default): body
-   and wheel masses, stiffnesses and damping drawn from normal distributions, 4 s of road
-   excitation each, the largest body displacement per run; 1 process against 2.
+   mass, stiffnesses and damping drawn from normal distributions, 4 s of road excitation each,
+   the largest body displacement per run; runs per second of per-case runs (one
+   ``simulate()`` each, ``ensemble = false``) against ensembles (a block's runs in one C call,
+   :mod:`jourdain.study.ensemble`), on 1 and 2 workers (processes; threads for the ensembles,
+   which release the GIL), side by side; the C integration alone, for the share left to it.
 
     python benchmarks/study.py             # 10 000 cases, 1 000 runs (about a minute)
     python benchmarks/study.py --quick     # 40 × 40 cases, 200 runs
+    python benchmarks/study.py --only mc   # the Monte-Carlo part alone
 """
 
 from __future__ import annotations
@@ -41,7 +45,7 @@ sys.path.insert(0, str(ROOT))
 from jourdain.analysis import stability  # noqa: E402
 from jourdain.io.capabilities import nominal_mapping  # noqa: E402
 from jourdain.study import VERDICTS, loads_study, run_study  # noqa: E402
-from jourdain.study.compute import context  # noqa: E402
+from jourdain.study.compute import case_arrays, context  # noqa: E402
 
 ROTOR = ROOT / "examples" / "rotor_internal_damping.toml"
 CAR = ROOT / "examples" / "quarter_car.toml"
@@ -172,20 +176,59 @@ def _dask(spec: object, ref: object, var: str = "max_real_part") -> dict:
     return out
 
 
-def monte_carlo(n: int) -> dict:
-    spec = loads_study(_mc_spec(n))
-    context(spec)
-    run_study(loads_study(_mc_spec(4)), workers=1, quiet=True)  # imports and first calls, not counted
-    t1, ds1 = _timed(lambda: run_study(spec, workers=1, quiet=True))
-    t2, ds2 = _timed(lambda: run_study(spec, workers=2, quiet=True))
-    z = ds1["max_abs_z_b"].values
-    return {"runs": n, "1_process_s": t1, "2_processes_s": t2, "speedup": t1 / t2,
-            **_dask(spec, ds1, "max_abs_z_b"),
-            "runs_per_s_1": n / t1, "runs_per_s_2": n / t2,
-            "identical": bool(np.array_equal(z, ds2["max_abs_z_b"].values, equal_nan=True)),
-            "failed": int(ds1.attrs["n_failed"]),
-            "max_abs_z_b_mean_mm": float(np.nanmean(z) * 1e3),
-            "max_abs_z_b_std_mm": float(np.nanstd(z, ddof=1) * 1e3)}
+def _best(fn, repeat: int):
+    """The fastest of ``repeat`` timed calls (the machine is shared: the least disturbed)."""
+    return min((_timed(fn) for _ in range(repeat)), key=lambda r: r[0])
+
+
+def monte_carlo(n: int, repeat: int = 3) -> dict:
+    """The quarter-car Monte-Carlo, per-case runs (``ensemble = false``: one
+    ``simulate()`` per case) against ensembles (a block's runs in one C call), on 1 and 2
+    workers; every variant's numbers compared with the per-case serial run's."""
+    from jourdain.study.ensemble import Ensemble
+
+    text = _mc_spec(n)
+    ens = loads_study(text)
+    per = loads_study(text.replace("final = false", "final = false\nensemble = false"))
+    for spec in (ens, per):
+        context(spec)
+        run_study(loads_study(_mc_spec(4)), workers=1, quiet=True)  # imports, first calls
+    variants = {
+        "per_case_1": (per, {"workers": 1}),
+        "per_case_2_processes": (per, {"workers": 2, "pool": "processes"}),
+        "ensemble_1": (ens, {"workers": 1}),
+        "ensemble_2_threads": (ens, {"workers": 2, "pool": "threads"}),
+        "ensemble_2_processes": (ens, {"workers": 2, "pool": "processes"}),
+    }
+    out: dict = {"runs": n, "repeat": repeat}
+    ref = None
+    for name, (spec, kw) in variants.items():
+        t, ds = _best(lambda spec=spec, kw=kw: run_study(spec, quiet=True, **kw), repeat)
+        z = ds["max_abs_z_b"].values
+        if ref is None:
+            ref = z
+        out[f"{name}_s"] = t
+        out[f"{name}_runs_per_s"] = n / t
+        out[f"{name}_identical"] = bool(np.array_equal(z, ref, equal_nan=True))
+    # the C integration alone: the ensemble's runs of all cases in one call, no study around
+    ctx = context(ens)
+    P, Y, YD = case_arrays(ctx, 0, n)
+    for threads in (1, 2):
+        t, _ = _best(lambda threads=threads: ctx.ensemble.run(P, Y, YD, threads=threads),
+                     repeat)
+        out[f"c_only_{threads}_s"] = t
+    out["ensemble_vs_per_case_1"] = out["per_case_1_s"] / out["ensemble_1_s"]
+    out["ensemble_vs_per_case_2"] = out["per_case_2_processes_s"] / out["ensemble_2_threads_s"]
+    out["per_case_1_to_2"] = out["per_case_1_s"] / out["per_case_2_processes_s"]
+    out["ensemble_1_to_2_threads"] = out["ensemble_1_s"] / out["ensemble_2_threads_s"]
+    out["ensemble_1_to_2_processes"] = out["ensemble_1_s"] / out["ensemble_2_processes_s"]
+    out["c_share_of_ensemble_1"] = out["c_only_1_s"] / out["ensemble_1_s"]
+    out.update(_dask(ens, run_study(ens, workers=1, quiet=True), "max_abs_z_b"))
+    z = ref if ref is not None else np.zeros(1)
+    out.update(failed=int(np.isnan(z).sum()), max_abs_z_b_mean_mm=float(np.nanmean(z) * 1e3),
+               max_abs_z_b_std_mm=float(np.nanstd(z, ddof=1) * 1e3),
+               ensemble_supported=Ensemble.supports("DOP853", None))
+    return out
 
 
 def _busy(_: int) -> int:
@@ -214,16 +257,34 @@ def main() -> None:
     ap.add_argument("--loop-cases", type=int, default=300, help="cases timed in the loop")
     ap.add_argument("--mc", type=int, default=1000, help="Monte-Carlo runs")
     ap.add_argument("--quick", action="store_true", help="40 × 40 map, 200 runs")
+    ap.add_argument("--repeat", type=int, default=3, help="Monte-Carlo timings: best of N")
+    ap.add_argument("--only", choices=("map", "mc"), help="run one of the two parts")
     ap.add_argument("--json", metavar="FILE", help="also write the figures as JSON")
     args = ap.parse_args()
     if args.quick:
         args.n, args.loop_cases, args.mc = 40, 100, 200
     with tempfile.TemporaryDirectory() as tmp:
         os.chdir(tmp)
-        res = {"cpus": os.cpu_count(), "ceiling_before": machine_ceiling(),
-               "stability_map": stability_map(args.n, args.loop_cases),
-               "monte_carlo": monte_carlo(args.mc), "ceiling_after": machine_ceiling()}
-    m, c = res["stability_map"], res["monte_carlo"]
+        res = {"cpus": os.cpu_count(), "load_before": os.getloadavg(),
+               "ceiling_before": machine_ceiling()}
+        if args.only != "mc":
+            res["stability_map"] = stability_map(args.n, args.loop_cases)
+        if args.only != "map":
+            res["monte_carlo"] = monte_carlo(args.mc, args.repeat)
+        res.update(ceiling_after=machine_ceiling(), load_after=os.getloadavg())
+    if "stability_map" in res:
+        _print_map(res["stability_map"])
+    if "monte_carlo" in res:
+        _print_mc(res["monte_carlo"])
+    print(f"this machine's own ceiling for 2 processes (pure-Python busy loop): "
+          f"{res['ceiling_before']:.2f}x before, {res['ceiling_after']:.2f}x after "
+          f"({res['cpus']} CPUs; load average {res['load_before'][0]:.1f} before, "
+          f"{res['load_after'][0]:.1f} after)")
+    if args.json:
+        Path(args.json).write_text(json.dumps(res, indent=1))
+
+
+def _print_map(m: dict) -> None:
     print(f"stability map, {m['cases']} cases of {ROTOR.name} (set-up {m['setup_s']:.2f} s):")
     print(f"  loop over stability(lin):          {m['loop_cases_per_s']:10.0f} cases/s")
     print(f"  loop over the compiled lin:        {m['compiled_loop_cases_per_s']:10.0f} cases/s")
@@ -239,19 +300,30 @@ def main() -> None:
         print(f"  Dask LocalCluster (warm): 1 worker {m['dask_1_workers_s']:.3f} s, 2 workers "
               f"{m['dask_2_workers_s']:.3f} s: {m['dask_speedup']:.2f}x (identical: "
               f"{m['dask_1_identical']}, {m['dask_2_identical']})")
-    print(f"Monte-Carlo, {c['runs']} runs of {CAR.name}: 1 process {c['1_process_s']:.2f} s "
-          f"({c['runs_per_s_1']:.0f} runs/s), 2 processes {c['2_processes_s']:.2f} s "
-          f"({c['runs_per_s_2']:.0f} runs/s): {c['speedup']:.2f}x (identical: {c['identical']}); "
+
+
+def _print_mc(c: dict) -> None:
+    print(f"Monte-Carlo, {c['runs']} runs of {CAR.name} (best of {c['repeat']}), runs per second; "
+          f"identical to the per-case serial run:")
+    print(f"  {'':28s}{'1 worker':>12s}{'2 workers':>12s}{'1 -> 2':>8s}")
+    print(f"  {'per case (simulate() each)':28s}{c['per_case_1_runs_per_s']:12.0f}"
+          f"{c['per_case_2_processes_runs_per_s']:12.0f}{c['per_case_1_to_2']:7.2f}x"
+          f"  (2 processes; identical: {c['per_case_2_processes_identical']})")
+    print(f"  {'ensemble, threads':28s}{c['ensemble_1_runs_per_s']:12.0f}"
+          f"{c['ensemble_2_threads_runs_per_s']:12.0f}{c['ensemble_1_to_2_threads']:7.2f}x"
+          f"  (identical: {c['ensemble_1_identical']}, {c['ensemble_2_threads_identical']})")
+    print(f"  {'ensemble, processes':28s}{c['ensemble_1_runs_per_s']:12.0f}"
+          f"{c['ensemble_2_processes_runs_per_s']:12.0f}{c['ensemble_1_to_2_processes']:7.2f}x"
+          f"  (identical: {c['ensemble_2_processes_identical']})")
+    print(f"  ensemble / per case: {c['ensemble_vs_per_case_1']:.2f}x on 1 worker, "
+          f"{c['ensemble_vs_per_case_2']:.2f}x on 2 (threads against processes); the C "
+          f"integration alone: {c['c_only_1_s']:.2f} s on 1 thread, {c['c_only_2_s']:.2f} s "
+          f"on 2 ({100 * c['c_share_of_ensemble_1']:.0f} % of the 1-worker ensemble study); "
           f"max |z_b| {c['max_abs_z_b_mean_mm']:.2f} ± {c['max_abs_z_b_std_mm']:.2f} mm")
     if "dask_2_workers_s" in c:
-        print(f"  Dask LocalCluster (warm): 1 worker {c['dask_1_workers_s']:.2f} s, 2 workers "
-              f"{c['dask_2_workers_s']:.2f} s: {c['dask_speedup']:.2f}x (identical: "
+        print(f"  ensembles on a Dask LocalCluster (warm): 1 worker {c['dask_1_workers_s']:.2f} s, "
+              f"2 workers {c['dask_2_workers_s']:.2f} s: {c['dask_speedup']:.2f}x (identical: "
               f"{c['dask_1_identical']}, {c['dask_2_identical']})")
-    print(f"this machine's own ceiling for 2 processes (pure-Python busy loop): "
-          f"{res['ceiling_before']:.2f}x before, {res['ceiling_after']:.2f}x after "
-          f"({res['cpus']} CPUs)")
-    if args.json:
-        Path(args.json).write_text(json.dumps(res, indent=1))
 
 
 if __name__ == "__main__":
