@@ -18,6 +18,10 @@ import numpy as np
 
 from .differentiate import Graph, jet_float
 from .errors import EvaluationError, JourdainError
+from .numeric import parameter_vector
+from .stages.kinematics import kinematics
+from .stages.newton_euler import newton_euler
+from .stages.projection import projection
 
 if TYPE_CHECKING:
     from .model.system import System
@@ -27,6 +31,11 @@ if TYPE_CHECKING:
 class NoEquilibrium(JourdainError, ArithmeticError):
     """Newton's method did not reach an equilibrium from the guess given."""
 
+
+
+def equations_of_motion(system: System) -> EquationsOfMotion:
+    """M·ÿ + k = q of ``system`` by the stages (kinematics → Newton–Euler → projection)."""
+    return projection(newton_euler(kinematics(system)))
 
 @dataclass(frozen=True)
 class Equilibrium:
@@ -112,8 +121,6 @@ def find_equilibrium(system: System, guess: Mapping[str, float] | Sequence[float
     NoEquilibrium
         When the iteration ends away from an equilibrium (with the last residual and position).
     """
-    from .numeric import parameter_vector
-
     names = system.coordinate_names
     f = system.f
     y0 = _start(guess, names)
@@ -129,7 +136,7 @@ def find_equilibrium(system: System, guess: Mapping[str, float] | Sequence[float
         if k not in uvals:
             raise EvaluationError(f"unknown input {k!r}; inputs are {u_names}")
         uvals[k] = float(v)
-    eom = eom if eom is not None else system.equations_of_motion()
+    eom = eom if eom is not None else equations_of_motion(system)
     # the graph of k − q is built once and evaluated (values and exact Jacobian, in floating
     # point) at every iterate
     graph = Graph([*eom.k.entries(), *eom.q.entries()])
@@ -230,7 +237,7 @@ def find_equilibria(system: System, guesses: Sequence[Mapping[str, float] | Sequ
                     distinct: float = 1e-6, method: str = "any") -> list[Equilibrium]:
     """The distinct equilibria reached from several guesses (guesses that fail are skipped);
     two are the same when their coordinates differ by less than ``distinct``."""
-    eom = system.equations_of_motion()
+    eom = equations_of_motion(system)
     found: list[Equilibrium] = []
     for g in guesses:
         try:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import sys
 import warnings
 from pathlib import Path
+from types import FrameType
 
 
 class JourdainError(Exception):
@@ -33,7 +34,7 @@ _PACKAGE = str(Path(__file__).resolve().parent)
 
 def warn(message: str, category: type[Warning] = JourdainWarning) -> None:
     """``warnings.warn`` attributed to the first caller outside jourdain (the user's line)."""
-    frame = sys._getframe(1)  # the caller of warn(), which warnings.warn calls stacklevel 2
+    frame: FrameType | None = sys._getframe(1)  # the caller of warn(), which warnings.warn calls stacklevel 2
     level = 2
     while frame is not None and str(Path(frame.f_code.co_filename).resolve()).startswith(_PACKAGE):
         frame = frame.f_back

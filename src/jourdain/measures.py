@@ -272,7 +272,7 @@ def bushing_loads(frames: Frames, fe: Bushing, w: tuple, geo: dict
     f, m = tuple(w[:3]), tuple(w[3:])
     R, H, d = geo["R"], geo["H"], geo["d"]
     minus = se.Integer(-1)
-    f_body = _turn(A_F, f)  # type: ignore[arg-type]
+    f_body = _turn(A_F, f)
     f_I = frames.to_inertial(f_body, body_F)
     out: list[tuple[str, Vec3 | None, Vec3, Vec3]] = []
     if b != WORLD:
@@ -281,8 +281,8 @@ def bushing_loads(frames: Frames, fe: Bushing, w: tuple, geo: dict
         f_a = f_body if body_F == a else frames.to_frame(f_I, a)
         out.append((a, _scale(f_I, minus), _scale(f_a, minus), fe.point_a))
     if body_F != WORLD:
-        out.append((body_F, None, _turn(A_F, _scale(_cross(d, f), minus)), Z3))  # type: ignore
-    Hm = _mtv(H, m)  # type: ignore[arg-type]
+        out.append((body_F, None, _turn(A_F, _scale(_cross(d, f), minus)), Z3))
+    Hm = _mtv(H, m)
     if any(v != 0 for v in Hm):
         if b != WORLD:
             out.append((b, None, _turn(fe.axes_b, _mtv(R, Hm)), Z3))

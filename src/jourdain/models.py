@@ -113,6 +113,7 @@ def spatial_chain_data(n: int, seed: int = 0) -> list[dict]:
     out = []
     for i in range(n):
         kind = kinds[i % 3]
+        axes: tuple[str, ...]
         if kind == "revolute":
             axes = (rev_axes[(i // 3) % 3],)
         elif kind == "universal":
@@ -294,7 +295,7 @@ def random_tree_data(
             axes = (u1, u2)
         seq = ""
         if kind in ("spherical", "free"):
-            seq = str(sequences[rng.integers(0, len(sequences))])
+            seq = str(sequences[int(rng.integers(0, len(sequences)))])
         bodies.append({
             "parent": parent, "joint": kind, "axes": axes, "sequence": seq,
             "position": rng.uniform(-position, position, 3),

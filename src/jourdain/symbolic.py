@@ -19,11 +19,12 @@ import re
 import time
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, TypeAlias, cast
 
 import symengine as se
 
-Expr = se.Basic
+#: a SymEngine expression (SymEngine has no type information: to the type checker, Any)
+Expr: TypeAlias = se.Basic
 
 #: Matrices whose entries need more operations (after CSE) are summarized, not printed.
 MAX_DISPLAY_OPS = 600
@@ -258,8 +259,8 @@ def to_sympy_many(exprs: Sequence[Expr]) -> list[Any]:
     g = Graph(list(exprs))
     memo: dict[int, Any] = {}
     for i in g.order:
-        node = g.node[i]
-        args = [a._sympy_() if ia is None else memo[ia]
+        node: Any = g.node[i]  # SymEngine objects (no type information)
+        args = [cast(Any, a)._sympy_() if ia is None else memo[ia]
                 for a, ia in zip(g.args[i], g.arg_ids[i], strict=True)]
         name = type(node).__name__
         if name in _SYMPY_FUNCS:

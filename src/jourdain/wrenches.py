@@ -27,6 +27,12 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .differentiate import evaluate_float
+from .errors import EvaluationError
+from .numeric import lambdify, state_vectors
+from .numeric.diagnose import state_values
+from .stages.kinematics import kinematics
+from .stages.reactions import joint_directions
 from .symbolic import SymMatrix
 
 if TYPE_CHECKING:
@@ -77,10 +83,8 @@ class JointWrench:
 def _layout(system: System) -> tuple[tuple[Any, ...], list[Any], dict[str, SymMatrix]]:
     """The joints' constrained directions, and per joint with directions its matrix
     ``E_k`` (6 × n_k, the unit wrenches as columns) and its child's orientation ``S_k``."""
-    from .stages.reactions import joint_directions
-
     joints = joint_directions(system)
-    kin = system.kinematics()
+    kin = kinematics(system)
     mats: dict[str, SymMatrix] = {}
     for k, jr in enumerate(joints):
         if not jr.wrenches:
@@ -92,8 +96,6 @@ def _layout(system: System) -> tuple[tuple[Any, ...], list[Any], dict[str, SymMa
 
 @lru_cache(maxsize=32)
 def _compiled(system: System) -> Any:
-    from .numeric import lambdify
-
     return lambdify(system, _layout(system)[2])
 
 
@@ -123,20 +125,14 @@ def joint_wrenches(system: System, g: Any, y: Any, yd: Any = None, t: float = 0.
     The constrained directions and the orientations are evaluated once in floating point
     (no compilation); :meth:`System.evaluate` returns these as ``joint_wrenches``.
     """
-    from .differentiate import evaluate_float
-    from .numeric import state_vectors
-    from .numeric.diagnose import state_values
-
     joints, names, mats = _layout(system)
     # the directions and orientations do not depend on the inputs: zeros stand for them (None
     # is refused for a model with inputs)
     args = state_vectors(system, y, np.zeros(system.f) if yd is None else yd, t, parameters,
-                         np.zeros(len(system.inputs)))
+                         [0.0] * len(system.inputs))
     gv = np.asarray(g, dtype=float).reshape(-1)
     q = sum(len(jr.columns) for jr in joints)
     if gv.size != q:
-        from .errors import EvaluationError
-
         raise EvaluationError(f"joint_wrenches: g must have {q} components (g_names), got "
                               f"{gv.size}")
     flat = evaluate_float([e for n in names for e in mats[n].entries()],

@@ -191,8 +191,8 @@ def cylinder(mass: object, radius: object, length: object, axis: str = "z") -> M
 def box(mass: object, a: object, b: object, c: object) -> Mat3:
     """Solid cuboid with edge lengths a, b, c along x, y, z."""
     m = as_expr(mass, "box mass")
-    a, b, c = (as_expr(v, "box edge") for v in (a, b, c))
-    return _diag(m * (b**2 + c**2) / 12, m * (a**2 + c**2) / 12, m * (a**2 + b**2) / 12)
+    ea, eb, ec = (as_expr(v, "box edge") for v in (a, b, c))
+    return _diag(m * (eb**2 + ec**2) / 12, m * (ea**2 + ec**2) / 12, m * (ea**2 + eb**2) / 12)
 
 
 def _axis_diag(axis: str, along: object, across: object, what: str) -> Mat3:

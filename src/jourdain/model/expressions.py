@@ -10,12 +10,18 @@ from __future__ import annotations
 import math
 import numbers
 from collections.abc import Iterable, Mapping, Sequence
+from typing import Any, TypeAlias
 
 import symengine as se
 
 from ..errors import ModelError
 
-Expr = se.Basic
+#: a SymEngine expression (SymEngine has no type information: to the type checker, Any)
+Expr: TypeAlias = se.Basic
+
+#: a vector and a matrix of three components / rows (joint frames, axes, inertia tensors)
+Vec3: TypeAlias = tuple[Expr, Expr, Expr]
+Mat3: TypeAlias = tuple[Vec3, Vec3, Vec3]
 
 #: time, shared by every model
 t = se.Symbol("t")
@@ -47,7 +53,7 @@ def symbols(names: str | Sequence[str], *, seq: bool = False
     """
     if isinstance(names, (list, tuple)):
         out = [symbols(n, seq=seq) for n in names]
-        return tuple(out) if isinstance(names, tuple) else out  # type: ignore[return-value]
+        return tuple(out) if isinstance(names, tuple) else out
     if not isinstance(names, str):
         raise ModelError(f"symbols: expected a string of names, got {type(names).__name__}")
     text = names.strip()
@@ -169,13 +175,14 @@ def as_vector(value: object, where: str, n: int = 3) -> tuple[Expr, ...]:
     if isinstance(value, str):
         return axis_vector(value, where)
     if hasattr(value, "shape") and not isinstance(value, se.Basic):
+        array: Any = value  # NumPy, SymPy or SymEngine matrices
         try:
-            value = list(value.reshape(-1)) if hasattr(value, "reshape") else list(value)
+            value = list(array.reshape(-1)) if hasattr(array, "reshape") else list(array)
         except Exception:  # noqa: BLE001
-            value = list(value)  # type: ignore[arg-type]
+            value = list(array)
     if not isinstance(value, Iterable):
         raise ModelError(f"{where}: expected a {n}-vector, got {value!r}")
-    items = list(value)  # type: ignore[arg-type]
+    items = list(value)
     if len(items) != n:
         raise ModelError(f"{where}: expected a {n}-vector, got {len(items)} components")
     return tuple(as_expr(v, f"{where}[{i}]") for i, v in enumerate(items))
@@ -238,7 +245,7 @@ def _simplifies_to_one(e: Expr) -> bool:
     return sympy.simplify(sympy.sympify(e) - 1) == 0
 
 
-def as_matrix3(value: object, where: str) -> tuple[tuple[Expr, ...], ...]:
+def as_matrix3(value: object, where: str) -> Mat3:
     """A 3x3 matrix from nested sequences (or a SymPy/NumPy matrix)."""
     try:
         rows = [list(value[i]) if not hasattr(value, "shape") else [value[i, j] for j in range(3)]  # type: ignore[index]
@@ -252,7 +259,8 @@ def as_matrix3(value: object, where: str) -> tuple[tuple[Expr, ...], ...]:
             raise ModelError(f"{where}: expected a 3x3 matrix")
     except TypeError:
         pass
-    return tuple(tuple(as_expr(rows[i][j], f"{where}[{i},{j}]") for j in range(3)) for i in range(3))
+    e = [[as_expr(rows[i][j], f"{where}[{i},{j}]") for j in range(3)] for i in range(3)]
+    return (e[0][0], e[0][1], e[0][2]), (e[1][0], e[1][1], e[1][2]), (e[2][0], e[2][1], e[2][2])
 
 
 def free_names(exprs: Sequence[Expr]) -> set[str]:

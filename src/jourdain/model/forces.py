@@ -11,6 +11,7 @@ spring–damper between two body frames; :class:`GeneralizedForce` and
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import symengine as se
 
@@ -211,9 +212,10 @@ def _six_by_six(value: object, where: str) -> tuple[tuple[Expr, ...], ...]:
         raise ModelError(f"{where}: expected a 6-vector (diagonal) or a 6×6 matrix, got {value!r}")
     shape = getattr(value, "shape", None)
     if shape is not None and not isinstance(value, se.Basic):
+        array: Any = value  # NumPy, SymPy or SymEngine matrices
         try:
-            rows = [[value[i, j] for j in range(shape[1])] for i in range(shape[0])] \
-                if len(shape) == 2 else [value[i] for i in range(shape[0])]
+            rows = [[array[i, j] for j in range(shape[1])] for i in range(shape[0])] \
+                if len(shape) == 2 else [array[i] for i in range(shape[0])]
         except Exception as exc:  # noqa: BLE001 - reported with the element's name
             raise ModelError(f"{where}: expected a 6-vector or a 6×6 matrix ({exc})") from None
         value = rows

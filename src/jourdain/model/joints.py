@@ -24,10 +24,16 @@ import numpy as np
 import symengine as se
 
 from ..errors import ModelError
-from .expressions import Expr, as_expr, as_matrix3, as_vector, axis_vector, values_at
-
-Vec3 = tuple[Expr, Expr, Expr]
-Mat3 = tuple[Vec3, Vec3, Vec3]
+from .expressions import (
+    Expr,
+    Mat3,
+    Vec3,
+    as_expr,
+    as_matrix3,
+    as_vector,
+    axis_vector,
+    values_at,
+)
 
 IDENTITY: Mat3 = (
     (se.Integer(1), se.Integer(0), se.Integer(0)),
@@ -310,8 +316,8 @@ def Free(name: str, coordinates: Sequence[object], sequence: str = "xyz", *,
     """Free joint (6 DOF): translations along x, y, z of the joint frame, then three rotations."""
     cs = _coords(name, coordinates, 6)
     pos, ori = _frame(name, position, orientation)
-    steps = (Trans("x", cs[0]), Trans("y", cs[1]), Trans("z", cs[2]),
-             *_rotations(name, sequence, cs[3:]))
+    steps: tuple[Rot | Trans, ...] = (Trans("x", cs[0]), Trans("y", cs[1]), Trans("z", cs[2]),
+                                      *_rotations(name, sequence, cs[3:]))
     return Joint(name, "free", cs, steps, pos, ori)
 
 

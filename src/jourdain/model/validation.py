@@ -27,7 +27,7 @@ from .forces import (
     elongation,
     elongation_d,
 )
-from .joints import orientation_problem
+from .joints import Rot, orientation_problem
 from .quantities import Quantity
 
 
@@ -127,17 +127,17 @@ def validate(sys: Description) -> None:
                     f'coordinate "{cn}" is driven by two joints: "{driven_by[cn]}" and "{j.name}"'
                 )
             driven_by[cn] = j.name
-        exprs = [*j.position, *(x for row in j.orientation for x in row)]
+        kin_exprs = [*j.position, *(x for row in j.orientation for x in row)]
         for s in j.steps:
-            exprs.extend([s.angle] if hasattr(s, "angle") else list(s.vector))
-        names = free_names(exprs)
-        bad = names - allowed_kin
+            kin_exprs.extend([s.angle] if isinstance(s, Rot) else list(s.vector))
+        kin_names = free_names(kin_exprs)
+        bad = kin_names - allowed_kin
         if bad:
             raise ModelError(
                 f'joint "{j.name}" (body "{b.name}"): undeclared symbol(s) {sorted(bad)}; joints may '
                 "depend on coordinates, parameters and t only"
             )
-        used_coords |= names & set(y_names)
+        used_coords |= kin_names & set(y_names)
         _check_axes(sys, b)
         # mass data
         mass_names = free_names([b.mass, *b.com, *(x for row in b.inertia for x in row)])
@@ -265,10 +265,10 @@ def _check_quantities(sys: Description, seen: dict[str, str], body_names: set[st
     for f in sys.forces:
         if isinstance(f, GeneralizedForce) and not f.on_coordinate:
             for s in f.coordinate.free_symbols:
-                q = getattr(s, "quantity", None)
-                if q is not None and q.uses_rates:
+                used = getattr(s, "quantity", None)
+                if used is not None and used.uses_rates:
                     raise ModelError(
-                        f'force "{f.name}": its coordinate uses {q.describe()}, which depends '
+                        f'force "{f.name}": its coordinate uses {used.describe()}, which depends '
                         "on the rates; a generalized coordinate may use positions, relative "
                         "positions and distances only")
     return names
@@ -283,7 +283,9 @@ def _check_axes(sys: Description, b: Body) -> None:
     defaults = dict(sys.parameters)
     for k, step in enumerate(j.steps):
         u = step.axis
-        names = free_names(u) if u is not None else set()
+        if u is None:
+            continue
+        names = free_names(u)
         if not names:
             continue
         axis = "the axis" if len({s.axis for s in j.steps}) == 1 else f"the axis of step {k}"

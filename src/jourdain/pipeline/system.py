@@ -42,13 +42,13 @@ class System(Model):
     def _stage(self, key: str, compute: Callable[[], _T]) -> _T:
         d = self.__dict__
         if key in d:
-            return d[key]  # type: ignore[no-any-return]  # the value compute() stored
+            return d[key]  # the value compute() stored
         with _LOCKS:
             lock = d.setdefault("_lock", threading.RLock())
         with lock:  # reentrant: equations_of_motion asks for newton_euler inside its own
             if key not in d:
                 d[key] = compute()
-            return d[key]  # type: ignore[no-any-return]
+            return d[key]
 
     def kinematics(self) -> Kinematics:
         """Kinematics of every body (METHOD §1); see :func:`jourdain.stages.kinematics.kinematics`."""
