@@ -34,6 +34,7 @@ from ..model.forces import (
     deflection_d,
     rate,
 )
+from ..model.validation import force_expressions  # moved out of model.system (issue 16)
 from ..stages.kinematics import Kinematics
 
 ZERO = se.Integer(0)
@@ -155,9 +156,7 @@ def _point(kin: Kinematics, body: str, p: tuple) -> tuple:
 
 def _has_quantities(fe: object) -> bool:
     """True when a force law uses kinematic quantities (treated as non-conservative)."""
-    from ..model.system import _force_expressions
-
-    return any(hasattr(s, "quantity") for e in _force_expressions(fe) for s in e.free_symbols)
+    return any(hasattr(s, "quantity") for e in force_expressions(fe) for s in e.free_symbols)
 
 
 def _constant(e: se.Basic, sys: object, varying: set[str]) -> bool:
