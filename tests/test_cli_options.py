@@ -190,7 +190,7 @@ def test_input_laws_are_never_python(capsys, no_work):
 
 
 def test_progress_on_request(capsys, monkeypatch):
-    monkeypatch.setattr(cli, "PROGRESS_SECONDS", 0.0)
+    monkeypatch.setattr(cli.outputs, "PROGRESS_SECONDS", 0.0)  # read by the printer
     code, _, err = _run(capsys, "simulate", PENDULUM, "--t-end", "5000", "--progress")
     assert code == 0
     lines = [ln for ln in err.splitlines() if ln.startswith("simulating double pendulum: t = ")]

@@ -22,7 +22,7 @@ def no_work(monkeypatch):
         raise AssertionError("the work started before the output was checked")
 
     monkeypatch.setattr(capabilities, "simulate", refuse)
-    monkeypatch.setattr(report, "_sections", refuse)
+    monkeypatch.setattr(report.document, "compute_sections", refuse)
 
 
 def _run(capsys, *args) -> tuple[int, str, str]:

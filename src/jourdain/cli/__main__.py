@@ -1,0 +1,7 @@
+"""``python -m jourdain.cli``: the ``jourdain`` command."""
+
+import sys
+
+from . import main
+
+sys.exit(main())

@@ -1,0 +1,127 @@
+"""``jourdain simulate``, ``jourdain run`` (the report) and ``jourdain fmu``: the motion, the
+report of everything, and the FMU export."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from ..errors import JourdainError
+from ..io import capabilities as integration
+from ..io.fmu import export_fmu
+from ..io.report import write_report
+from ..simulation.simulate import OUTPUT_SUFFIXES
+from ..workflow import require
+from .arguments import UsageError, load, overrides, sim_options, tree_only
+from .outputs import output_file, output_folder, progress_printer, samples
+
+EXIT_OK, EXIT_MODEL, EXIT_INTERRUPTED = 0, 1, 130
+
+
+def cmd_simulate(args: argparse.Namespace) -> int:
+    model = load(args.model)
+    tree_only(model, "simulate")
+    system = model.system
+    require(system, "simulate", "simulation")
+
+    # every option and the output file are checked before the work
+    params = overrides(system, args.set)
+    opts = sim_options(model, args)
+    out = output_file(args.out, args.force, OUTPUT_SUFFIXES) if args.out else None
+    progress = progress_printer(args.progress, f"simulating {system.name}")
+    failure: JourdainError | None = None
+    try:
+        # with --out the results are written as the run goes, and complete at its end
+        res = integration.simulate(model, params, **opts, progress=progress or False,
+                                   output=out)
+    except JourdainError as exc:
+        partial = getattr(exc, "results", None)  # the motion up to a failure
+        if partial is None:
+            raise
+        if len(partial.t) == 0:  # failed before the first sample
+            raise JourdainError(f"{exc}; nothing was computed"
+                                + (f" ({out} holds the header only)" if out else "")) from None
+        res, failure = partial, exc
+    finally:
+        if progress:
+            progress.done()
+    names = system.coordinate_names
+    span = f"t = {res.t[0]:g} … {res.t[-1]:g}"
+    if out:
+        print(f"wrote {out} ({samples(len(res.t))}, {span}"
+              + ("" if res.status == "finished" else f"; {res.status}") + ")")
+    else:
+        print(f"{system.name}: simulated {span} ({samples(len(res.t))})")
+    where = ("final {}: " if res.status == "finished" else f"{{}} at t = {res.t[-1]:g}: ").format
+    print(where("state") + ", ".join(f"{n}={v:.6g}" for n, v in
+                                     zip(names, res.y[-1], strict=True)))
+    print(where("rates") + ", ".join(f"{n}_d={v:.6g}" for n, v in
+                                     zip(names, res.yd[-1], strict=True)))
+    kept = (f"the motion up to t = {res.t[-1]:g} ({samples(len(res.t))}) is in {out}" if out
+            else "give --out FILE to keep the motion up to there")
+    if failure is not None:
+        raise JourdainError(f"{failure}; {kept}")
+    if res.interrupted:
+        print(f"jourdain simulate: interrupted (Ctrl-C) at t = {res.t[-1]:g}; {kept}",
+              file=sys.stderr)
+        return EXIT_INTERRUPTED
+    return EXIT_OK
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    model = load(args.model)
+    params = overrides(model.system, args.set)
+    opts = sim_options(model, args)
+    out = output_folder(args.out, args.force, model)
+    if getattr(model, "loops", None) is not None:  # a loop model: jourdain.loops' report
+        # jourdain.loops brings SciPy's linear algebra (0.2 s): imported for loop models only
+        from ..loops.report import run_report
+
+        for line in run_report(model, out, params, opts.get("t_end")):
+            print(line)
+        print(f"report: {out / 'index.html'}")
+        return EXIT_OK
+    progress = progress_printer(args.progress, f"simulating {model.system.name}")
+    try:
+        info = write_report(model, out, parameters=params, t_end=opts.get("t_end"),
+                            max_ops=args.max_ops, progress=progress or False,
+                            parallel=True)
+    finally:
+        if progress:
+            progress.done()
+    for line in info.summary_lines:
+        print(line)
+    print(f"report: {info.html}")
+    if info.status == "interrupted":
+        print(f"jourdain run: {info.message}; the report holds what was computed",
+              file=sys.stderr)
+        return EXIT_INTERRUPTED
+    if info.status == "failed":
+        print(f"jourdain run: error: {info.message}", file=sys.stderr)
+        return EXIT_MODEL
+    return EXIT_OK
+
+
+def cmd_fmu(args: argparse.Namespace) -> int:
+    """``jourdain fmu MODEL --out model.fmu``: an FMI 2.0 FMU (docs/fmu.md)."""
+    out = Path(args.out)
+    if out.suffix.lower() != ".fmu":
+        raise UsageError(f"--out: expected a file name ending in .fmu, got {args.out!r}")
+    if out.is_dir():
+        raise UsageError(f"--out: {args.out} is a folder; expected a .fmu file")
+    if out.exists() and not args.force:
+        raise UsageError(f"--out: {args.out} exists; --force replaces it")
+    model = load(args.model)
+    params = overrides(model.system, args.set)
+    names = [n.strip() for r in args.reaction for n in r.split(",") if n.strip()]
+    info = export_fmu(model, out, reactions="all" if names == ["all"] else names,
+                      parameters=params, model_identifier=args.identifier,
+                      binary=not args.sources_only)
+    f = model.system.f
+    print(f"{info.path}: FMI 2.0 model exchange and co-simulation, modelIdentifier "
+          f"{info.model_identifier}; {2 * f} states, {len(model.system.parameters)} parameters, "
+          f"{len(model.system.inputs)} inputs, {len(info.reactions)} reaction outputs; "
+          + (f"binary {info.binary}" if info.binary else "sources only"))
+    return EXIT_OK
+

@@ -1,0 +1,155 @@
+"""The report as a whole: its sections in order, the page, ``run.json``, and the workers of
+``jourdain run`` (:func:`write_report`)."""
+
+from __future__ import annotations
+
+import datetime as _dt
+import json
+import time
+from collections.abc import Mapping
+from concurrent.futures import Future, ProcessPoolExecutor
+from pathlib import Path
+from typing import Any
+
+import jourdain  # its __version__, read when a report is written (set after io is imported)
+
+from ...workflow import summary
+from .. import export
+from ..modelfile import ModelFile
+from .equations import (
+    Display,
+    cached_display,
+    display_in_worker,
+    equations_section,
+    set_pending,
+)
+from .figures import Figures
+from .html import CSS, esc
+from .linearization import linearization_section, nominal_placeholder
+from .sections import model_section, numbers_section
+from .simulation import simulation_section
+from .state import RUN_FORMAT, ReportInfo, Run
+from .workers import fork_worker
+
+#: the number of computed sections (the list of files is the sixth)
+SECTIONS = 5
+_EQUATIONS = "<!--jourdain-equations-->"
+
+
+def compute_sections(run: Run, sections: list[str], display: Future[Display] | None) -> None:
+    """The sections of the report, each appended to ``sections`` when it is complete, with
+    their data files (so that an interruption leaves the sections finished before it). The
+    symbolic display (section 2) is ``display``, a worker's, or computed here in turn."""
+    sections.append(model_section(run))
+    if display is None:
+        run.display = cached_display(run.model, run.max_ops)
+        html, files = equations_section(run.display, run.model, run.out)
+        run.info.files += files
+        sections.append(html)
+    else:  # the worker's: its files are written when it is done
+        run.info.files += [run.out / "equations.tex", run.out / "equations.json"]
+        sections.append(_EQUATIONS)
+    sections.append(numbers_section(run))
+    sections.append(linearization_section(run))
+    sections.append(simulation_section(run))
+
+
+def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | None = None,
+                 t_end: float | None = None, max_ops: int = export.MAX_DISPLAY_OPS,
+                 progress: Any = False, parallel: bool = False) -> ReportInfo:
+    """Compute everything for ``model`` and write ``out/report.html`` with the data files.
+
+    Files: ``report.html``, ``model.toml`` (a copy of the input; ``model.urdf`` for a URDF
+    robot), ``equations.tex``,
+    ``equations.json`` (the matrices with shared temporaries), ``values.json`` (the numbers at
+    the initial state, the format of ``jourdain eval --json``), ``linearization-<name>.json``
+    per nominal motion, ``simulation.csv`` (written as the simulation goes; ``progress`` is
+    passed to it), ``run.json`` (``"format": "jourdain-run/1"``: how the run ended, ``status``
+    complete, interrupted or failed, and ``message``; the files and notes).
+
+    ``parallel``: the symbolic display and the figures are computed in two processes forked
+    from this one while it computes the numbers (``jourdain run``; the page is the same).
+
+    Ctrl-C stops the work: the sections finished before it are written (a simulation stops
+    where it is and its motion up to there is shown), and report.html, run.json and the header
+    of simulation.csv say that the run was interrupted (``info.status``). A simulation that
+    fails keeps its motion up to the failure (``info.status`` "failed").
+    """
+    t_start = time.perf_counter()
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    system = model.system
+    info = ReportInfo(out / "report.html")
+    pools: list[ProcessPoolExecutor] = []
+    figure_pool = Figures.worker() if parallel else None  # imports Matplotlib meanwhile
+    if figure_pool is not None:
+        pools.append(figure_pool)
+    try:
+        summ = summary(model)  # the symbolic equations and reactions, shared by the fork
+        display: Future[Display] | None = None
+        if figure_pool is not None:
+            set_pending(model, max_ops)
+            display_pool = fork_worker()
+            if display_pool is not None:
+                pools.append(display_pool)
+                display = display_pool.submit(display_in_worker)
+        values = system.parameter_values
+        values.update(parameters or {})
+        run = Run(model, out, dict(parameters or {}), t_end, max_ops, progress, info, summ,
+                  values, Figures(figure_pool), None)
+        sections: list[str] = []
+        try:
+            compute_sections(run, sections, display)
+        except KeyboardInterrupt:
+            info.status = "interrupted"
+            info.message = (f"interrupted by the user (Ctrl-C) after section {len(sections)} "
+                            f"of {SECTIONS}; the sections after it are missing")
+        if display is not None:  # the worker's display, and its files
+            run.display = display.result()
+            html, _ = equations_section(run.display, model, out)
+            sections = [html if s == _EQUATIONS else s for s in sections]
+        page = _page(run, sections, t_start)
+    finally:
+        for pool in pools:
+            pool.shutdown(cancel_futures=True)
+    info.html.write_text(page, encoding="utf-8")
+    manifest = {"format": RUN_FORMAT, "model": system.name, "file": model.path,
+                "status": info.status, "message": info.message,
+                "files": [f.name for f in info.files], "notes": info.notes}
+    (out / "run.json").write_text(json.dumps(manifest, indent=1), encoding="utf-8")
+    ops = run.display.ops if run.display is not None else {}
+    count = (f" with {ops['M'] + ops['k'] + ops['q']} operations"
+             if all(k in ops for k in ("M", "k", "q")) else "")
+    info.summary_lines.insert(0, f"{system.name}: f = {system.f}, p = {len(system.bodies)} "
+                                 f"bodies, {summ['constraints']} constrained directions; "
+                                 f"M·ÿ + k = q{count}")
+    for n in info.notes:
+        info.summary_lines.append(f"  note: {n}")
+    if info.status != "complete":
+        info.summary_lines.append(f"  {info.status}: {info.message}")
+    return info
+
+
+def _page(run: Run, sections: list[str], t_start: float) -> str:
+    """The HTML page: the sections with their figures and nominal motions filled in, the list
+    of files (``report.html`` and ``run.json`` first) and the header."""
+    info, model = run.info, run.model
+    info.files.insert(0, info.html)
+    info.files.insert(1, run.out / "run.json")
+    files = "".join(f"<li><a href='{esc(f.name)}'>{esc(f.name)}</a></li>" for f in info.files)
+    sections.append(f"<h2>6. Files</h2><ul>{files}</ul>")
+    body = run.figures.fill("".join(sections))
+    if run.display is not None:
+        for i, nominal in enumerate(model.nominal):
+            body = body.replace(nominal_placeholder(i), run.display.nominal[nominal.name], 1)
+    elapsed = time.perf_counter() - t_start
+    name = model.system.name
+    head = (f"<h1>{esc(name)}</h1><p class='meta'>jourdain {jourdain.__version__} report of "
+            f"{esc(model.path)}, {_dt.datetime.now().strftime('%Y-%m-%d %H:%M')}, "
+            f"computed in {elapsed:.1f} s</p>")
+    if info.status != "complete":
+        head += f"<p class='bad'>{esc(info.status.capitalize())}: {esc(info.message)}.</p>"
+    return ("<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
+            f"<meta name='viewport' content='width=device-width, initial-scale=1'>"
+            f"<title>{esc(name)} — jourdain report</title><style>{CSS}</style></head>"
+            f"<body>{head}{body}</body></html>")
