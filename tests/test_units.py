@@ -204,6 +204,7 @@ inputs = { F = 1.0 }
 
 def test_report_figures_and_json_carry_the_units(tmp_path, monkeypatch):
     from jourdain.io import report
+    from jourdain.io.report import figures  # H8: the plots' SVG writer lives here
 
     labels = []
     svg = report._svg
