@@ -569,3 +569,34 @@ def test_primitive_visuals_and_a_urdf_models_geometry(spatial):
     kinds += [("world", w["kind"]) for w in v.scene["world_visuals"]]
     assert sorted(kinds) == sorted(k for k, g in geo.items() if g.kind != "mesh")
     assert any("tool.stl" in n_ and "not found" in n_ for n_ in v.notes), v.notes
+
+
+def test_a_mesh_file_is_parsed_once_and_stored_bit_for_bit(tmp_path, monkeypatch):
+    """read_mesh parses a file once: a second read in the process (the four legs of a
+    quadruped) and a read by a later process (the stored arrays in the cache folder) give the
+    parsed arrays bit for bit without parsing; a file changed on disk is parsed again."""
+    from jourdain.io.viewer import mesh_store, meshes
+
+    monkeypatch.setenv("JOURDAIN_CACHE", str(tmp_path / "cache"))
+    monkeypatch.setattr(mesh_store, "_memory", type(mesh_store._memory)())
+    path = tmp_path / "part.dae"
+    path.write_text(_DAE)
+    first = meshes.read_mesh(path)
+    assert len(list((tmp_path / "cache" / "meshes").glob("*.npz"))) == 1
+    assert not first.vertices.flags.writeable and not first.faces.flags.writeable
+
+    def no_parse(data, where):
+        raise AssertionError("parsed again")
+
+    monkeypatch.setattr(meshes, "_dae", no_parse)
+    again = meshes.read_mesh(path)  # this process: the same arrays
+    assert again.vertices is first.vertices and again.groups == first.groups
+    mesh_store._memory.clear()  # as a later process: from the stored file
+    stored = meshes.read_mesh(path)
+    assert stored.vertices is not first.vertices
+    assert stored.vertices.tobytes() == first.vertices.tobytes()
+    assert stored.faces.tobytes() == first.faces.tobytes()
+    assert stored.faces.dtype == first.faces.dtype and stored.groups == first.groups
+    path.write_text(_DAE.replace("<p>0 1 3</p>", "<p>0 1 9</p>"))  # changed: parsed again
+    with pytest.raises(AssertionError, match="parsed again"):
+        meshes.read_mesh(path)

@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from ...errors import ModelError
+from . import mesh_store
 
 #: files larger than this are not read
 MAX_MESH_BYTES = 64 * 2**20
@@ -116,7 +117,7 @@ def _numbers(el: ET.Element | None, where: str, kind: type = float) -> np.ndarra
     with warnings.catch_warnings():
         warnings.simplefilter("error", DeprecationWarning)  # text that is not all numbers
         try:
-            a = np.fromstring(el.text, dtype=float, sep=" ")  # type: ignore[arg-type]
+            a = np.fromstring(el.text or "", dtype=np.float64, sep=" ")
         except (DeprecationWarning, ValueError):
             raise ModelError(f"{where}: <{el.tag}> holds something that is not a number"
                              ) from None
@@ -235,12 +236,12 @@ def _dae(data: bytes, where: str) -> Mesh:
     except ValueError:
         raise ModelError(f"{where}: <unit meter=...> is not a number") from None
     # material id -> diffuse colour
-    colour_of_effect = {}
+    colour_of_effect: dict[str, tuple[float, float, float]] = {}
     for eff in root.iter("effect"):
-        c = _numbers(eff.find(".//diffuse/color"), where)
-        if c.size >= 3:
-            colour_of_effect[eff.get("id", "")] = tuple(float(x) for x in np.clip(c[:3], 0, 1))
-    colour = {}
+        c = np.clip(_numbers(eff.find(".//diffuse/color"), where)[:3], 0, 1)
+        if c.size == 3:
+            colour_of_effect[eff.get("id", "")] = (float(c[0]), float(c[1]), float(c[2]))
+    colour: dict[str, tuple[float, float, float] | None] = {}
     for mat in root.iter("material"):
         ie = mat.find("instance_effect")
         if ie is not None:
@@ -248,7 +249,7 @@ def _dae(data: bytes, where: str) -> Mesh:
     geometries = {g.get("id", ""): g for g in root.iter("geometry")}
     library_nodes = {n.get("id", ""): n for lib in root.iter("library_nodes")
                      for n in lib.findall("node")}
-    parts: list[tuple[np.ndarray, np.ndarray, tuple | None]] = []
+    parts: list[tuple[np.ndarray, np.ndarray, tuple[float, float, float] | None]] = []
     cache: dict[str, list] = {}
 
     def geometry(gid: str) -> list:
@@ -280,12 +281,14 @@ def _dae(data: bytes, where: str) -> Mesh:
     else:  # no scene: every geometry where it is
         for gid in geometries:
             parts.extend((p, f, None) for p, f, _ in geometry(gid))
-    verts, faces, groups = [], [], []
+    verts: list[np.ndarray] = []
+    faces: list[np.ndarray] = []
+    groups: list[tuple[int, int, tuple[float, float, float] | None]] = []
     nv = nf = 0
-    for pos, f, c in parts:
+    for pos, f, rgb in parts:
         verts.append(pos * meter)
         faces.append(f + nv)
-        groups.append((nf, len(f), c))
+        groups.append((nf, len(f), rgb))
         nv += len(pos)
         nf += len(f)
     if not nf:
@@ -294,7 +297,8 @@ def _dae(data: bytes, where: str) -> Mesh:
 
 
 def read_mesh(path: str | Path) -> Mesh:
-    """The :class:`Mesh` of an STL, OBJ or COLLADA file; ModelError naming the file otherwise."""
+    """The :class:`Mesh` of an STL, OBJ or COLLADA file; ModelError naming the file otherwise.
+    Each file is parsed once (:mod:`.mesh_store`): the arrays are shared and read-only."""
     where = f"mesh {str(path)!r}"
     if "://" in str(path):
         raise ModelError(f"{where}: an address, not a file (resolve package:// first)")
@@ -304,14 +308,23 @@ def read_mesh(path: str | Path) -> Mesh:
         raise ModelError(f"{where}: only STL, OBJ and COLLADA (.dae) meshes are read (not "
                          f"{suffix or 'this'})")
     try:
-        size = p.stat().st_size
-        if size > MAX_MESH_BYTES:
-            raise ModelError(f"{where}: {size} bytes, more than {MAX_MESH_BYTES}")
+        st = p.stat()
+        if st.st_size > MAX_MESH_BYTES:
+            raise ModelError(f"{where}: {st.st_size} bytes, more than {MAX_MESH_BYTES}")
+        key = mesh_store.file_key(p, st)
+        hit = mesh_store.remembered(key)
+        if hit is not None:
+            return Mesh(*hit)
         data = p.read_bytes()
     except OSError as exc:
         raise ModelError(f"{where}: cannot be read ({exc.strerror or exc})") from None
-    reader = {".stl": _stl, ".obj": _obj, ".dae": _dae}[suffix]
-    m = reader(data, where)
-    if not np.all(np.isfinite(m.vertices)):
-        raise ModelError(f"{where}: coordinates that are not finite numbers")
-    return m
+    content = mesh_store.digest(data, suffix)
+    arrays = mesh_store.load(content)
+    if arrays is None:
+        reader = {".stl": _stl, ".obj": _obj, ".dae": _dae}[suffix]
+        m = reader(data, where)
+        if not np.all(np.isfinite(m.vertices)):
+            raise ModelError(f"{where}: coordinates that are not finite numbers")
+        arrays = (m.vertices, m.faces, m.groups)
+        mesh_store.store(content, arrays)
+    return Mesh(*mesh_store.remember(key, arrays))
