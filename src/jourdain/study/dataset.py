@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import JourdainError
+from ..simulation.labelled import results_dataset
 from .compute import VERDICTS, WRENCH_COMPONENTS, Context, output_layout
 from .spec import StudyError
 
@@ -36,6 +36,17 @@ def xarray() -> Any:
     return xr
 
 
+def _version() -> str:
+    """The installed jourdain's version (from its distribution: this module sits below the
+    package's ``__init__``, which holds the same number)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("jourdain")
+    except PackageNotFoundError:  # run from a source tree that is not installed
+        return "unknown"
+
+
 def _units(ctx: Context) -> dict[str, str]:
     from ..units import model_units, per_time
 
@@ -48,8 +59,6 @@ def _units(ctx: Context) -> dict[str, str]:
 
 def to_dataset(ctx: Context, blocks: Sequence[dict[str, Any]]) -> Any:
     """The dataset of a study from its blocks (in case order)."""
-    import jourdain
-
     xr = xarray()
     spec, system = ctx.spec, ctx.system
     layout = output_layout(ctx)
@@ -104,7 +113,7 @@ def to_dataset(ctx: Context, blocks: Sequence[dict[str, Any]]) -> Any:
              "model_hash": spec.model_hash, "compiled_keys": json.dumps(ctx.keys),
              "spec_hash": spec.spec_hash, "study_file": spec.source,
              "computed": json.dumps(sorted(spec.compute)),
-             "jourdain_version": jourdain.__version__, "n_cases": spec.n_cases,
+             "jourdain_version": _version(), "n_cases": spec.n_cases,
              "n_failed": int(np.count_nonzero(errors != ""))}
     if spec.design == "random":
         attrs["seed"] = int(spec.seed or 0)
@@ -192,51 +201,3 @@ def _engine() -> str:
         if importlib.util.find_spec(module) is not None:
             return engine
     raise StudyError("writing NetCDF needs h5netcdf (or netCDF4): pip install 'jourdain[study]'")
-
-
-def results_dataset(results: Any) -> Any:
-    """A simulation's :class:`jourdain.Results` as an ``xarray.Dataset``: ``y``, ``yd``,
-    ``ydd`` over (time, coordinate), ``u`` over (time, input), the energies where the model
-    gives them; units as attributes; ``model_hash``: the content key of the compiled equations
-    of motion (a SHA-256 of their generated C source)."""
-    xr = xarray()
-    from ..units import per_time
-
-    units = dict(results.units)
-    coords = list(results.coordinate_names)
-    data: dict[str, Any] = {}
-    for name, arr, order in (("y", results.y, 0), ("yd", results.yd, 1),
-                             ("ydd", results.ydd, 2)):
-        if arr is None:
-            continue
-        cu = [per_time(units.get(c, ""), order) if units.get(c) else "" for c in coords]
-        va = {"long_name": {"y": "coordinates", "yd": "rates", "ydd": "accelerations"}[name]}
-        if len(set(cu)) == 1 and cu[0]:
-            va["units"] = cu[0]
-        else:
-            va["coordinate_units"] = json.dumps(cu)
-        data[name] = xr.Variable(("time", "coordinate"), np.asarray(arr, dtype=float), va)
-    if results.u is not None and len(results.input_names):
-        data["u"] = xr.Variable(("time", "input"), np.asarray(results.u, dtype=float),
-                                {"long_name": "inputs"})
-    attrs: dict[str, Any] = {"title": f"jourdain simulation {results.name}",
-                             "model": results.name, "method": str(results.method),
-                             "rtol": float(results.rtol), "status": str(results.status),
-                             "parameters": json.dumps(dict(results.parameters or {}))}
-    if results.system is not None:
-        from ..numeric import mkq_function
-        from ..units import energy_unit
-
-        attrs["model_hash"] = mkq_function(results.system).key
-        try:
-            for n in ("kinetic_energy", "potential_energy", "total_energy"):
-                data[n] = xr.Variable(("time",), np.asarray(getattr(results, n), dtype=float),
-                                      {"units": energy_unit(units),
-                                       "long_name": n.replace("_", " ")})
-        except (JourdainError, ArithmeticError, ValueError):  # a model without energies
-            pass
-    c = {"time": xr.Variable(("time",), np.asarray(results.t, dtype=float), {"units": "s"}),
-         "coordinate": coords}
-    if results.u is not None and len(results.input_names):
-        c["input"] = list(results.input_names)
-    return xr.Dataset(data, coords=c, attrs=attrs)
