@@ -537,8 +537,9 @@ class Results:
 
     def to_xarray(self) -> Any:
         """These results as an ``xarray.Dataset`` (time, coordinate; units and the model's
-        hash as attributes; ``jourdain[study]``): :func:`jourdain.study.results_dataset`."""
-        from ..study.dataset import results_dataset
+        hash as attributes; ``jourdain[study]``):
+        :func:`jourdain.simulation.labelled.results_dataset`."""
+        from .labelled import results_dataset  # xarray, optional (labelled arrays on this floor)
 
         return results_dataset(self)
 
