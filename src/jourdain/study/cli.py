@@ -51,7 +51,7 @@ def _workers(text: str) -> int:
 
 def cmd_study(args: argparse.Namespace) -> int:
     from . import load_study, run_study
-    from .plots import study_report
+    from .report import study_page
 
     spec = load_study(args.spec, model=args.model)
     t0 = time.perf_counter()
@@ -65,5 +65,5 @@ def cmd_study(args: argparse.Namespace) -> int:
     if args.out:
         print(f"results: {args.out}")
     if args.plots:
-        print(f"report: {study_report(ds, args.plots)}")
+        print(f"report: {study_page(ds, args.plots)}")
     return 0

@@ -1,5 +1,6 @@
 """Plots of a study's dataset: stability map, Campbell diagram, histograms of Monte-Carlo
-outputs (Matplotlib figures; :func:`study_plots` writes them as SVG and PNG)."""
+outputs (Matplotlib figures; :func:`study_plots` writes them as SVG and PNG; the pages and the
+report's section that show them: :mod:`jourdain.study.report`)."""
 
 from __future__ import annotations
 
@@ -10,7 +11,7 @@ import numpy as np
 
 from .spec import StudyError
 
-__all__ = ["campbell_diagram", "histograms", "stability_map", "study_plots", "study_report"]
+__all__ = ["campbell_diagram", "histograms", "stability_map", "study_plots"]
 
 
 def _label(ds: Any, name: str) -> str:
@@ -117,10 +118,10 @@ def histograms(ds: Any) -> list[tuple[str, Any]]:
     return out
 
 
-def study_plots(ds: Any, folder: str | Path) -> list[Path]:
+def study_plots(ds: Any, folder: str | Path, prefix: str = "") -> list[Path]:
     """Write the plots that suit the study (stability map for grids of 2+ axes, Campbell
     diagram for grids with eigenvalues, histograms for list and random designs) to ``folder``
-    as ``<name>.svg`` and ``<name>.png``; returns the paths."""
+    as ``<prefix><name>.svg`` and ``.png``; returns the paths."""
     import matplotlib
 
     matplotlib.use("Agg", force=False)
@@ -139,63 +140,8 @@ def study_plots(ds: Any, folder: str | Path) -> list[Path]:
     paths = []
     for name, fig in figs:
         for ext in ("svg", "png"):
-            p = folder / f"{name}.{ext}"
+            p = folder / f"{prefix}{name}.{ext}"
             fig.savefig(p, dpi=110 if ext == "png" else None, bbox_inches="tight")
             paths.append(p)
         plt.close(fig)
     return paths
-
-
-def study_report(ds: Any, folder: str | Path) -> Path:
-    """Write the study's plots (:func:`study_plots`) and ``index.html`` beside them: one
-    self-contained page with the study's attributes, the plots (inline SVG), a summary of every
-    scalar output and the failed cases. Returns the page's path."""
-    import html
-
-    folder = Path(folder)
-    paths = study_plots(ds, folder)
-    esc = html.escape
-    rows = "".join(f"<tr><th>{esc(str(k))}</th><td>{esc(str(v))[:300]}</td></tr>"
-                   for k, v in ds.attrs.items() if k != "study_file")
-    figs = "".join(f"<figure>{p.read_text()}<figcaption>{esc(p.stem)}</figcaption></figure>"
-                   for p in paths if p.suffix == ".svg")
-    lead = ds["error"].dims
-    stats = []
-    for name in ds.data_vars:
-        v = ds[name]
-        if v.dims != lead or v.dtype.kind != "f":
-            continue
-        vals = v.values[np.isfinite(v.values)]
-        if vals.size:
-            unit = esc(v.attrs.get("units", ""))
-            stats.append(f"<tr><th>{esc(name)}</th><td>{unit}</td><td>{vals.min():.6g}</td>"
-                         f"<td>{vals.mean():.6g}</td><td>{vals.max():.6g}</td>"
-                         f"<td>{vals.size}</td></tr>")
-    if "verdict" in ds:
-        from .compute import VERDICTS
-
-        counts = ", ".join(f"{esc(w)}: {int((ds.verdict.values == i).sum())}"
-                           for i, w in enumerate(VERDICTS))
-        stats.append(f"<tr><th>verdict</th><td colspan=5>{counts}</td></tr>")
-    err = ds["error"].values.reshape(-1)
-    bad = np.flatnonzero(err != "")
-    failed = "".join(f"<li>case {int(i)}: {esc(str(err[i]))}</li>" for i in bad[:50])
-    if bad.size > 50:
-        failed += f"<li>… {bad.size - 50} more</li>"
-    page = f"""<!DOCTYPE html>
-<html><head><meta charset="utf-8"><title>{esc(str(ds.attrs.get("title", "study")))}</title>
-<style>body{{font-family:sans-serif;max-width:60em;margin:auto}}th{{text-align:left}}
-td,th{{padding:2px 8px}}figure{{display:inline-block;margin:1em}}</style></head><body>
-<h1>{esc(str(ds.attrs.get("title", "study")))}</h1>
-<table>{rows}</table>
-<h2>Outputs</h2>
-<table><tr><th>output</th><th>unit</th><th>min</th><th>mean</th><th>max</th><th>cases</th></tr>
-{"".join(stats)}</table>
-{figs}
-<h2>Failed cases ({bad.size})</h2><ul>{failed}</ul>
-<h2>Study file</h2><pre>{esc(str(ds.attrs.get("study_file", "")))}</pre>
-</body></html>
-"""
-    out = folder / "index.html"
-    out.write_text(page, encoding="utf-8")
-    return out
