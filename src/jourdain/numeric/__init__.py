@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import ctypes
 import math
+import shutil
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import lru_cache
@@ -433,6 +434,8 @@ def clear_cache(disk: bool = False) -> None:
             for p in d.iterdir():
                 if p.suffix in (".so", ".c") or p.name.endswith((".so.tmp", ".c.tmp")):
                     p.unlink(missing_ok=True)
+                elif p.is_dir() and (p.name.startswith(".build-") or p.name == "meshes"):
+                    shutil.rmtree(p, ignore_errors=True)  # builds cut off; parsed meshes
 
 
 def state_vectors(system: System, y: Any, yd: Any, t: float,

@@ -26,7 +26,7 @@ import subprocess
 import sys
 import tempfile
 import warnings
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 from ..errors import JourdainError
@@ -134,13 +134,47 @@ def cached_library(key: str) -> ctypes.CDLL | None:
     return lib
 
 
+def compile_shared(sources: Mapping[str, str | bytes], units: Sequence[str], out: Path,
+                   flags: Sequence[str]) -> None:
+    """Compile the translation ``units`` (names in ``sources``, which may also hold the headers
+    they include) into the shared library ``out``: each unit by its own compiler process, in
+    parallel, then linked. The sources are written into a private folder beside ``out`` (the
+    include path), removed afterwards; ``out`` is written under a private name and renamed into
+    place, so a concurrent reader never sees half a library. ``flags`` are for compiling
+    (``-shared`` is for the link alone and dropped there). CompilerError names the unit."""
+    cc = compiler()
+    compile_flags = [f for f in flags if f != "-shared"]
+    work = Path(tempfile.mkdtemp(prefix=".build-", dir=out.parent))
+    try:
+        for name, text in sources.items():
+            (work / name).write_bytes(text if isinstance(text, bytes) else text.encode())
+        objects = [work / f"{Path(u).stem}.o" for u in units]
+        procs = [subprocess.Popen([cc, *compile_flags, f"-I{work}", "-c", "-o", str(o),
+                                   str(work / u)],
+                                  stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                 for u, o in zip(units, objects, strict=True)]
+        errors = [p.communicate()[1] for p in procs]
+        for p, e, u in zip(procs, errors, units, strict=True):
+            if p.returncode != 0:
+                raise CompilerError(f"compiling {u} with {cc} failed:\n{e[-4000:]}")
+        tmp = work / f"{out.name}.tmp"
+        link = subprocess.run([cc, "-shared", "-o", str(tmp), *map(str, objects), "-lm"],
+                              capture_output=True, text=True)
+        if link.returncode != 0:
+            raise CompilerError(f"linking {out.name} with {cc} failed:\n{link.stderr[-4000:]}")
+        os.chmod(tmp, 0o700)  # this user's alone, whatever the umask
+        os.replace(tmp, out)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+
+
 def build(key: str, source: str | Sequence[str], extra_flags: Sequence[str] = ()) -> ctypes.CDLL:
     """Compile ``source`` to ``<cache>/<key>.so`` (unless there) and load it.
 
     ``source`` may be several translation units: they are compiled in parallel (one compiler
-    process each) and linked into one library; ``<key>.c`` keeps them one after the other.
-    ``extra_flags`` follow :data:`CFLAGS` (``-O3`` overrides ``-O2``); the caller puts them in
-    ``key`` (:func:`content_key`).
+    process each, :func:`compile_shared`) and linked into one library; ``<key>.c`` keeps them
+    one after the other. ``extra_flags`` follow :data:`CFLAGS` (``-O3`` overrides ``-O2``); the
+    caller puts them in ``key`` (:func:`content_key`).
     """
     lib = cached_library(key)
     if lib is not None:
@@ -149,48 +183,18 @@ def build(key: str, source: str | Sequence[str], extra_flags: Sequence[str] = ()
     d = library_dir()
     so = d / f"{key}.so"
     src = d / f"{key}.c"
-    # write and compile under private names, then rename: a concurrent build of the same key
-    # (another process) never sees a half-written source or library
-    fd, tmp = tempfile.mkstemp(suffix=".so", dir=d)
-    os.close(fd)
-    tmp_units: list[str] = []
-    objects: list[str] = []
+    # the source is kept for reading, also when the compiler fails; written under a private
+    # name and renamed into place like the library
+    fd, tmp_src = tempfile.mkstemp(suffix=".c.tmp", dir=d)
+    with os.fdopen(fd, "w") as fh:
+        fh.write("\n".join(units))
+    os.replace(tmp_src, src)
+    names = [f"jd_unit{k}.c" for k in range(len(units))]
     try:
-        for text in units:
-            fd, tmp_c = tempfile.mkstemp(suffix=".c", dir=d)
-            with os.fdopen(fd, "w") as fh:
-                fh.write(text)
-            tmp_units.append(tmp_c)
-        if len(units) == 1:
-            procs = [subprocess.Popen([compiler(), *CFLAGS, *extra_flags, "-o", tmp,
-                                       tmp_units[0], "-lm"],
-                                      stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)]
-        else:
-            objects = [u[:-2] + ".o" for u in tmp_units]
-            flags = [f for f in (*CFLAGS, *extra_flags) if f != "-shared"]
-            procs = [subprocess.Popen([compiler(), *flags, "-c", "-o", o, u],
-                                      stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-                     for u, o in zip(tmp_units, objects, strict=True)]
-        errors = [p.communicate()[1] for p in procs]
-        failed = [e for p, e in zip(procs, errors, strict=True) if p.returncode != 0]
-        if not failed and objects:
-            link = subprocess.run([compiler(), "-shared", "-o", tmp, *objects, "-lm"],
-                                  capture_output=True, text=True)
-            if link.returncode != 0:
-                failed.append(link.stderr)
-        # kept for reading, also when the compiler fails; renamed into place like the library
-        fd, tmp_src = tempfile.mkstemp(suffix=".c.tmp", dir=d)
-        with os.fdopen(fd, "w") as fh:
-            fh.write("\n".join(units))
-        os.replace(tmp_src, src)
-        if failed:
-            raise CompilerError(f"compiling {src} failed:\n{failed[0][-4000:]}")
-        os.chmod(tmp, 0o700)  # this user's alone, whatever the umask
-        os.replace(tmp, so)
-    finally:
-        for leftover in (tmp, *tmp_units, *objects):
-            if os.path.exists(leftover):
-                os.unlink(leftover)
+        compile_shared(dict(zip(names, units, strict=True)), names, so,
+                       (*CFLAGS, *extra_flags))
+    except CompilerError as exc:
+        raise CompilerError(f"compiling {src} failed:\n{str(exc)[-4000:]}") from None
     lib = ctypes.CDLL(str(so))
     _loaded[key] = lib
     return lib

@@ -28,7 +28,6 @@ import math
 import os
 import platform
 import re
-import subprocess
 import sys
 import tempfile
 import zipfile
@@ -42,7 +41,14 @@ from ...numeric import parameter_vector
 from ...numeric.ccode import argument_names, function_source
 from ...numeric.integrator_c import tables as rk_tables
 from ...numeric.recursive import recursive_units
-from ...numeric.toolchain import CompilerError, compiler, content_key, library_dir, not_private
+from ...numeric.toolchain import (
+    CompilerError,
+    compile_shared,
+    compiler,
+    content_key,
+    library_dir,
+    not_private,
+)
 from .description import Layout, build_description, layout, model_description
 
 if TYPE_CHECKING:
@@ -238,50 +244,24 @@ def _model_header(lay: Layout, guid: str, tolerance: float, n_bodies: int, table
             + tables + "#endif\n")
 
 
-def _compile(srcdir: Path, out: Path) -> None:
-    """Compile the FMU's sources into the shared library ``out`` (one compiler per unit)."""
-    cc = compiler()
-    objs = [srcdir / (s[:-2] + ".o") for s in SOURCES]
-    procs = [subprocess.Popen([cc, *CFLAGS, f"-I{srcdir}", "-c", "-o", str(o), str(srcdir / s)],
-                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-             for s, o in zip(SOURCES, objs, strict=True)]
-    errors = [p.communicate()[1] for p in procs]
-    for p, e, s in zip(procs, errors, SOURCES, strict=True):
-        if p.returncode != 0:
-            raise CompilerError(f"compiling the FMU's {s} with {cc} failed:\n{e[-4000:]}")
-    link = subprocess.run([cc, "-shared", "-o", str(out), *map(str, objs), "-lm"],
-                          capture_output=True, text=True)
-    if link.returncode != 0:
-        raise CompilerError(f"linking the FMU's binary with {cc} failed:\n{link.stderr[-4000:]}")
-    for o in objs:
-        o.unlink()
-
-
 def _binary(sources: Mapping[str, bytes], name: str) -> bytes:
     """The compiled binary of the FMU's sources: from jourdain's cache of compiled code
     (:func:`jourdain.numeric.cache_dir`, keyed by the sources, the compiler and its flags) when
-    it was built before, else compiled in a temporary folder and kept there."""
+    it was built before, else compiled there by :func:`jourdain.numeric.toolchain.compile_shared`
+    (one compiler per unit, in parallel) and kept."""
     cc = compiler()
     h = hashlib.sha256()
     for k, v in sorted(sources.items()):
         h.update(k.encode() + b"\0" + v + b"\0")
     key = "fmu-" + content_key("fmu", cc, *CFLAGS, h.hexdigest())
     cache = library_dir() / f"{key}{Path(name).suffix}"
-    if cache.is_file() and not_private(cache) is None:
-        return cache.read_bytes()
-    with tempfile.TemporaryDirectory(prefix="jourdain-fmu-") as tmp:
-        src = Path(tmp)
-        for k, data in sources.items():
-            (src / k.split("/", 1)[1]).write_bytes(data)
-        lib = src / name
-        _compile(src, lib)
-        data = lib.read_bytes()
-    fd, tmp_name = tempfile.mkstemp(suffix=".tmp", dir=cache.parent)
-    with os.fdopen(fd, "wb") as fh:
-        fh.write(data)
-    os.chmod(tmp_name, 0o700)
-    os.replace(tmp_name, cache)  # never half-written: a concurrent export sees all or nothing
-    return data
+    if not (cache.is_file() and not_private(cache) is None):
+        try:
+            compile_shared({k.split("/", 1)[1]: v for k, v in sources.items()}, SOURCES, cache,
+                           CFLAGS)
+        except CompilerError as exc:
+            raise CompilerError(f"the FMU's binary: {exc}") from None
+    return cache.read_bytes()
 
 
 def _model_of(model: Any) -> tuple[System, Any]:
