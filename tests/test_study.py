@@ -12,7 +12,8 @@ import pytest
 pytest.importorskip("xarray")
 pytest.importorskip("h5netcdf")
 
-from jourdain.analysis import stability, state_space  # noqa: E402
+from jourdain.analysis import stability  # noqa: E402
+from jourdain.analysis.state_space import state_space  # noqa: E402  (the module is jourdain.analysis.state_space)
 from jourdain.io.capabilities import nominal_mapping  # noqa: E402
 from jourdain.study import (  # noqa: E402
     VERDICTS,
