@@ -56,7 +56,8 @@ def compute_sections(run: Run, sections: list[str], display: Future[Display] | N
 
 def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | None = None,
                  t_end: float | None = None, max_ops: int = export.MAX_DISPLAY_OPS,
-                 progress: Any = False, parallel: bool = False) -> ReportInfo:
+                 progress: Any = False, parallel: bool = False,
+                 study: Any = None) -> ReportInfo:  # study: a parameter study's section (H3)
     """Compute everything for ``model`` and write ``out/report.html`` with the data files.
 
     Files: ``report.html``, ``model.toml`` (a copy of the input; ``model.urdf`` for a URDF
@@ -69,6 +70,11 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
 
     ``parallel``: the symbolic display and the figures are computed in two processes forked
     from this one while it computes the numbers (``jourdain run``; the page is the same).
+
+    ``study``: a parameter study (a study file or :class:`jourdain.study.StudySpec`) run on
+    this model; its section (stability map, Campbell diagram, histograms, the outputs' table)
+    follows the simulation, its files (``study.nc``, ``study-*.svg``/``.png``) join the report's
+    (:func:`jourdain.study.report.study_section`; a parameter study's section, H3).
 
     Ctrl-C stops the work: the sections finished before it are written (a simulation stops
     where it is and its motion up to there is shown), and report.html, run.json and the header
@@ -100,6 +106,10 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
         sections: list[str] = []
         try:
             compute_sections(run, sections, display)
+            if study is not None:  # a parameter study's section (H3); xarray is optional
+                from ...study.report import study_section
+
+                sections.append(study_section(study, out, info, model=model.path))
         except KeyboardInterrupt:
             info.status = "interrupted"
             info.message = (f"interrupted by the user (Ctrl-C) after section {len(sections)} "
