@@ -138,6 +138,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", help=set_help)
     p.add_argument("--max-ops", type=operations, default=600, metavar="N",
                    help="summarize matrices needing more than N operations")
+    p.add_argument("--study", metavar="STUDY",  # a parameter study's section (H3)
+                   help="also run this study file on the model (docs/studies.md) and show its "
+                        "stability map, Campbell diagram or histograms in the report")
 
     p = subcommand(subs, "fmu", "export an FMI 2.0 FMU (model exchange and co-simulation, C sources "
              "and a binary for this machine; docs/fmu.md)",
