@@ -82,6 +82,11 @@ def cmd_run(args: argparse.Namespace) -> int:
             print(line)
         print(f"report: {out / 'index.html'}")
         return EXIT_OK
+    study = None
+    if getattr(args, "study", None):  # a parameter study's section (H3): checked before the run
+        from ..study import load_study
+
+        study = load_study(args.study, model=model.path)
     progress = progress_printer(args.progress, f"simulating {model.system.name}")
     try:
         info = write_report(model, out, parameters=params, t_end=opts.get("t_end"),
