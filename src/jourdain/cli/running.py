@@ -91,7 +91,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     try:
         info = write_report(model, out, parameters=params, t_end=opts.get("t_end"),
                             max_ops=args.max_ops, progress=progress or False,
-                            parallel=True)
+                            parallel=True, study=study)
     finally:
         if progress:
             progress.done()
