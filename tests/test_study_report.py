@@ -101,3 +101,33 @@ def test_a_study_that_cannot_run_is_a_note(tmp_path: Path) -> None:
     assert "could not be run" in page and "missing.toml" in page
     assert len(info.notes) == 1 and "missing.toml" in info.notes[0]
     assert info.files == []
+
+
+def test_jourdain_run_with_a_study(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+    """``jourdain run MODEL --study STUDY``: the model's report holds the study's section, its
+    figures are files of the report (listed in its Files section and in run.json)."""
+    import json
+
+    from jourdain.cli import main
+
+    spec_file = tmp_path / "map.toml"
+    spec_file.write_text(MAP.replace(f'model = "{MODEL}"\n', ""))  # the model: the report's
+    out = tmp_path / "report"
+    assert main(["run", str(MODEL), "--out", str(out), "--study", str(spec_file)]) == 0
+    page = (out / "report.html").read_text()
+    assert "Parameter study: whirl map" in page
+    assert page.index("Parameter study") > page.index("<h2>5.")  # after the simulation
+    files = json.loads((out / "run.json").read_text())["files"]
+    for name in ("study.nc", "study-stability_map.svg", "study-campbell.png"):
+        assert (out / name).exists() and name in files
+        assert f"href='{name}'" in page
+    ds = open_study(out / "study.nc")
+    assert ds.attrs["model_file"] == str(MODEL)
+    mr = ds.max_real_part.values
+    assert _row(page, "max_real_part")[1:4] == [f"{mr.min():.6g}", f"{mr.mean():.6g}",
+                                                f"{mr.max():.6g}"]
+    # a study file with a mistake stops the command before the report, naming the file
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[study]\ndesign = "sobol"\n[compute.linearize]\n')
+    assert main(["run", str(MODEL), "--out", str(tmp_path / "r2"), "--study", str(bad)]) != 0
+    assert "bad.toml" in capsys.readouterr().err and not (tmp_path / "r2" / "report.html").exists()
