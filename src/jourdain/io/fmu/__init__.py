@@ -21,53 +21,40 @@ the DefaultExperiment's). The FMI 2.0 headers come from FMPy (the ``fmu`` extra:
 
 from __future__ import annotations
 
-import difflib
 import hashlib
-import importlib.util
-import math
 import os
-import platform
 import re
-import sys
 import tempfile
 import zipfile
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from ...errors import EvaluationError, JourdainError, ModelError
+from ...model.system import System
 from ...numeric import parameter_vector
 from ...numeric.ccode import argument_names, function_source
 from ...numeric.integrator_c import tables as rk_tables
 from ...numeric.recursive import recursive_units
-from ...numeric.toolchain import (
-    CompilerError,
-    compile_shared,
-    compiler,
-    content_key,
-    library_dir,
-    not_private,
+from ...numeric.toolchain import compiler
+from .binary import FMI_HEADERS, SOURCES, _binary, fmi_header_dir, platform_folder
+from .description import build_description, layout, model_description
+from .sources import (
+    _C_KEYWORDS,
+    _finite,
+    _model_header,
+    _reaction_names,
+    _state,
+    _tables,
+    model_identifier_of,
 )
-from .description import Layout, build_description, layout, model_description
-
-if TYPE_CHECKING:
-    from ...model.system import System
 
 __all__ = ["FmuExport", "FMI_HEADERS", "export_fmu", "fmi_header_dir", "platform_folder"]
 
-#: the FMI 2.0 headers copied into ``sources/`` (BSD-licensed, Modelica Association)
-FMI_HEADERS = ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h")
-#: the compiled sources, in the order of buildDescription.xml
-SOURCES = ("jd_local.c", "jd_engine.c", "fmi2.c")
-#: flags of the FMU's binary: only the fmi2 functions are exported (FMI2_Export)
-CFLAGS = ("-O2", "-fPIC", "-std=c99", "-fno-math-errno", "-fvisibility=hidden")
+
 DEFAULT_TOLERANCE = 1e-8
 _HERE = Path(__file__).resolve().parent
-_C_KEYWORDS = frozenset(
-    "auto break case char const continue default do double else enum extern float for goto if "
-    "inline int long register restrict return short signed sizeof static struct switch typedef "
-    "union unsigned void volatile while".split())
 
 
 @dataclass(frozen=True)
@@ -92,181 +79,7 @@ class FmuExport:
     binary: str | None
 
 
-def fmi_header_dir() -> Path:
-    """The folder of the FMI 2.0 headers that FMPy ships (``fmpy/c-code``)."""
-    from ...analysis.python_control import MissingDependency
-
-    spec = importlib.util.find_spec("fmpy")
-    if spec is None or not spec.submodule_search_locations:
-        raise MissingDependency(
-            "exporting an FMU needs the FMI 2.0 headers that FMPy ships, an optional dependency "
-            'of jourdain: pip install "jourdain[fmu]" (or pip install fmpy)')
-    for loc in spec.submodule_search_locations:
-        d = Path(loc) / "c-code"
-        if all((d / h).is_file() for h in FMI_HEADERS):
-            return d
-    raise MissingDependency(f"the installed FMPy has no FMI 2.0 headers ({', '.join(FMI_HEADERS)}"
-                            ' in fmpy/c-code): pip install --upgrade "jourdain[fmu]"')
-
-
-def platform_folder() -> tuple[str, str]:
-    """FMI 2.0's ``binaries/`` folder and the library suffix of this machine."""
-    machine = platform.machine().lower()
-    bits64 = sys.maxsize > 2**32
-    if sys.platform.startswith("linux") and bits64 and machine in ("x86_64", "amd64"):
-        return "linux64", ".so"
-    if sys.platform == "darwin" and bits64:
-        return "darwin64", ".dylib"
-    raise CompilerError(f"no FMI 2.0 binary folder for this platform ({sys.platform}, {machine}):"
-                        " FMUs are compiled here for Linux x86_64 and macOS; export with "
-                        "binary=False (jourdain fmu --sources-only) for an FMU of sources only")
-
-
-def model_identifier_of(name: str) -> str:
-    """A C identifier from a model's name (``"double pendulum"`` -> ``double_pendulum``)."""
-    ident = re.sub(r"[^A-Za-z0-9_]+", "_", name).strip("_") or "model"
-    if ident[0].isdigit() or ident in _C_KEYWORDS or ident.startswith("fmi2"):
-        ident = "jd_" + ident
-    return ident[:64]
-
-
-def _state(system: System, values: Any, what: str, suffix: str) -> list[float]:
-    """Initial coordinates or rates by name (a mapping) or in order (a sequence)."""
-    f, names = system.f, system.coordinate_names
-    if values is None:
-        return [0.0] * f
-    if isinstance(values, Mapping):
-        out = [0.0] * f
-        for k, v in values.items():
-            key = str(k)
-            if suffix and key.endswith(suffix) and key[:-len(suffix)] in names:
-                key = key[:-len(suffix)]
-            if key not in names:
-                raise EvaluationError(f"{what}: {k!r} is not a coordinate; coordinates are "
-                                      f"{', '.join(names)}")
-            out[names.index(key)] = _finite(v, f"{what} {k}")
-        return out
-    seq = list(values)
-    if len(seq) != f:
-        raise EvaluationError(f"{what}: expected {f} values ({', '.join(names)}), got {len(seq)}")
-    return [_finite(v, f"{what}[{i}]") for i, v in enumerate(seq)]
-
-
-def _finite(v: Any, what: str) -> float:
-    try:
-        x = float(v)
-    except (TypeError, ValueError):
-        raise EvaluationError(f"{what}: expected a number, got {v!r}") from None
-    if not math.isfinite(x):
-        raise EvaluationError(f"{what} = {v!r} is not finite")
-    return x
-
-
-def _reaction_names(system: System, reactions: Sequence[str] | str | None
-                    ) -> tuple[list[Any], list[str]]:
-    """The joints with their constrained directions, and the chosen components by name."""
-    if reactions is None or (not isinstance(reactions, str) and not list(reactions)):
-        return [], []
-    from ...stages.reactions import check_reactions, joint_directions
-
-    try:
-        joints = list(joint_directions(system))
-        check_reactions(system)
-    except JourdainError as exc:
-        raise ModelError(f"the reaction forces of {system.name!r} cannot be exported: {exc}"
-                         ) from None
-    names = [n for jr in joints for n in jr.names]
-    if isinstance(reactions, str):
-        if reactions != "all":
-            raise ModelError(f'reactions: expected "all" or a list of names such as '
-                             f'{names[:2]}, got {reactions!r}')
-        return joints, names
-    chosen: list[str] = []
-    for r in reactions:
-        if r not in names:
-            close = difflib.get_close_matches(str(r), names, n=1)
-            hint = f' (did you mean "{close[0]}"?)' if close else ""
-            raise ModelError(f'reactions: "{r}" is not a reaction component of '
-                             f"{system.name!r}{hint}; they are: {', '.join(names)}")
-        if r not in chosen:
-            chosen.append(r)
-    return joints, chosen
-
-
-def _tables(joints: list[Any], chosen: list[str], bodies: list[str]) -> tuple[str, list[Any]]:
-    """model.h's tables of the reaction outputs and the direction expressions of jd_dirs."""
-    if not chosen:
-        return "", []
-    used = [jr for jr in joints if any(n in chosen for n in jr.names)]
-    body, ndir, off, exprs = [], [], [0], []
-    for jr in used:
-        body.append(bodies.index(jr.child))
-        ndir.append(len(jr.wrenches))
-        for w in jr.wrenches:
-            exprs.extend(w)
-        off.append(off[-1] + 6 * len(jr.wrenches))
-    g_joint, g_dir = [], []
-    for n in chosen:
-        j = next(k for k, jr in enumerate(used) if n in jr.names)
-        g_joint.append(j)
-        g_dir.append(used[j].names.index(n))
-    text = (f"#define JD_NJ {len(used)}\n#define JD_NE {max(off[-1], 1)}\n"
-            + _array("int", "jd_rj_body", body) + _array("int", "jd_rj_ndir", ndir)
-            + _array("int", "jd_rj_off", off) + _array("int", "jd_g_joint", g_joint)
-            + _array("int", "jd_g_dir", g_dir)
-            + "void jd_dirs(const double *y, const double *yd, double t, const double *p,\n"
-              "             const double *u, double *out);\n")
-    return text, exprs
-
-
-def _array(ctype: str, name: str, values: Sequence[Any]) -> str:
-    body = ", ".join(repr(float(v)) if ctype == "double" else str(int(v)) for v in values)
-    return f"static const {ctype} {name}[{max(len(values), 1)}] = {{{body or '0'}}};\n"
-
-
-def _model_header(lay: Layout, guid: str, tolerance: float, n_bodies: int, tables: str) -> str:
-    vs = lay.variables
-    f = lay.f
-    x_start = [v.start for v in vs[1:1 + 2 * f]]
-    p_start = [v.start for v in vs[1 + 4 * f:1 + 4 * f + lay.n_p]]
-    u_start = [v.start for v in vs[1 + 4 * f + lay.n_p:1 + 4 * f + lay.n_p + lay.n_u]]
-    return ("/* generated by jourdain; do not edit: sizes, start values and tables of the FMU */\n"
-            "#ifndef JD_MODEL_H\n#define JD_MODEL_H\n"
-            f'#define JD_GUID "{guid}"\n'
-            f"#define JD_NY {f}\n#define JD_NP {lay.n_p}\n#define JD_NU {lay.n_u}\n"
-            f"#define JD_NG {len(lay.reactions)}\n#define JD_NB {n_bodies}\n"
-            f"#define JD_DEFAULT_TOLERANCE {tolerance!r}\n"
-            + _array("double", "jd_x_start", x_start)
-            + _array("double", "jd_p_start", p_start)
-            + _array("double", "jd_u_start", u_start)
-            + "int jd_dynamics(const double *y, const double *yd, double t, const double *p,\n"
-              "                const double *u, double *ydd, double *wrench);\n"
-            + tables + "#endif\n")
-
-
-def _binary(sources: Mapping[str, bytes], name: str) -> bytes:
-    """The compiled binary of the FMU's sources: from jourdain's cache of compiled code
-    (:func:`jourdain.numeric.cache_dir`, keyed by the sources, the compiler and its flags) when
-    it was built before, else compiled there by :func:`jourdain.numeric.toolchain.compile_shared`
-    (one compiler per unit, in parallel) and kept."""
-    cc = compiler()
-    h = hashlib.sha256()
-    for k, v in sorted(sources.items()):
-        h.update(k.encode() + b"\0" + v + b"\0")
-    key = "fmu-" + content_key("fmu", cc, *CFLAGS, h.hexdigest())
-    cache = library_dir() / f"{key}{Path(name).suffix}"
-    if not (cache.is_file() and not_private(cache) is None):
-        try:
-            compile_shared({k.split("/", 1)[1]: v for k, v in sources.items()}, SOURCES, cache,
-                           CFLAGS)
-        except CompilerError as exc:
-            raise CompilerError(f"the FMU's binary: {exc}") from None
-    return cache.read_bytes()
-
-
 def _model_of(model: Any) -> tuple[System, Any]:
-    from ...model.system import System
-
     if isinstance(model, System):
         return model, None
     system = getattr(model, "system", None)
