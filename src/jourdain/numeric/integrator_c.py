@@ -31,9 +31,8 @@ slower (3 345 evaluations: the same work, the time is the Python call per evalua
 n = 12 the C loop 7.8 ms, DOP853 15×, LSODA 6.6×, CVODE 11× slower. CVODE's own loop in C
 with a C right-hand side would need SUNDIALS built and linked by jourdain's toolchain, a
 dependency the compile-at-first-use design avoids; the own loop is some 900 lines of C, checked
-against the
-coefficients' order conditions (tests/test_integrator_tables.py) and against SciPy's integrators
-and closed-form motions (tests/test_simulate.py).
+against the coefficients' order conditions (tests/test_integrator_tables.py) and against SciPy's
+integrators and closed-form motions (tests/test_simulate.py).
 """
 
 from __future__ import annotations
