@@ -22,6 +22,7 @@ from __future__ import annotations
 import ast
 import importlib
 import pkgutil
+import warnings
 from functools import cache
 from pathlib import Path
 
@@ -32,17 +33,18 @@ import jourdain
 ROOT = Path(jourdain.__file__).parent
 MAX_LINES = 400
 
-# What the model layer may import from the package: itself, the errors and the units.
-MODEL_MAY_IMPORT = ("jourdain.model", "jourdain.errors", "jourdain.units")
+# What the model layer may import from the package: itself and the errors (jourdain.errors).
+MODEL_MAY_IMPORT = ("jourdain.model", "jourdain.errors")
 
 # The floors, lowest first (docs/architecture.md has the same table). A module belongs to the
 # floor of the longest prefix listed; a module may import from its own floor or any floor below.
 FLOORS: tuple[tuple[str, ...], ...] = (
-    # 0 foundations: the errors, units, the symbolic matrix, expression graph and identity maps
-    ("jourdain.errors", "jourdain.units", "jourdain.identity", "jourdain.symbolic",
+    # 0 foundations: the errors, the symbolic matrix, the expression graph (CSE,
+    #   differentiation) and identity maps
+    ("jourdain.errors", "jourdain.identity", "jourdain.symbolic", "jourdain.graph",
      "jourdain.cse", "jourdain.differentiate"),
-    # 1 the model: the description a user writes (pure, immutable data)
-    ("jourdain.model",),
+    # 1 the model: the description a user writes (pure, immutable data), and its units
+    ("jourdain.model", "jourdain.units"),
     # 2 the stages of the method: kinematics → Newton–Euler → projection → reactions →
     #   linearization, and what they share (kinematic measures)
     ("jourdain.measures", "jourdain.stages"),
@@ -66,8 +68,36 @@ FLOORS: tuple[tuple[str, ...], ...] = (
 # Known offenders while issue 16 is being worked on (parallel sessions own these files): each
 # entry is removed when its module is fixed. ("lines", module): longer than MAX_LINES without a
 # "Length:" reason; ("floor", importer, imported): an import up the floors; ("cycle", module):
-# a module on an import circle.
-PENDING: set[tuple[str, ...]] = set()
+# a module on an import circle; ("shadow", module): a submodule its package's attribute hides.
+PENDING: set[tuple[str, ...]] = {
+    # stages/ (H6): the numeric evaluation of reactions and linearizations still lives in the
+    # stages (deferred imports of numeric and wrenches), which closes numeric → stages.reactions
+    # → wrenches → numeric
+    ("cycle", "jourdain.numeric"), ("cycle", "jourdain.stages.reactions"),
+    ("cycle", "jourdain.wrenches"),
+    ("floor", "jourdain.stages.linearization", "jourdain.numeric"),
+    ("floor", "jourdain.stages.reactions", "jourdain.numeric"),
+    ("floor", "jourdain.stages.reactions", "jourdain.wrenches"),
+    # analysis/ (H6): modes ↔ cyclic, state_space ↔ python_control import each other
+    ("cycle", "jourdain.analysis.cyclic"), ("cycle", "jourdain.analysis.modes"),
+    ("cycle", "jourdain.analysis.python_control"), ("cycle", "jourdain.analysis.state_space"),
+    # the command line, the report, the FMU (H8, H7): `import jourdain` (the public API, the
+    # top floor) instead of the modules they use
+    ("floor", "jourdain.cli.parser", "jourdain"),
+    ("floor", "jourdain.io.report.document", "jourdain"),
+    ("floor", "jourdain.io.fmu", "jourdain"),
+    # re-exports that hide a submodule (H2: loops; H7: io.viewer)
+    ("shadow", "jourdain.loops.constraints"), ("shadow", "jourdain.io.viewer.page"),
+    ("shadow", "jourdain.io.viewer.scene"),
+    # modules over 400 lines being split (owners: H1 simulate; H2 loops; H6 stages, results,
+    # differentiate; H7 numeric, io)
+    ("lines", "jourdain.differentiate"), ("lines", "jourdain.io.expressions"),
+    ("lines", "jourdain.loops.closed_loop"),
+    ("lines", "jourdain.loops.simulate"), ("lines", "jourdain.numeric"),
+    ("lines", "jourdain.numeric.recursive"), ("lines", "jourdain.simulation.results"),
+    ("lines", "jourdain.simulation.simulate"), ("lines", "jourdain.stages.kinematics"),
+    ("lines", "jourdain.stages.linearization"), ("lines", "jourdain.stages.reactions"),
+}
 
 
 def _module_name(path: Path) -> str:
@@ -246,10 +276,12 @@ def test_floors_point_down() -> None:
 def test_submodules_are_reachable_as_modules() -> None:
     bad = []
     for info in pkgutil.walk_packages(jourdain.__path__, "jourdain."):
+        if info.name.endswith(".__main__"):  # running it is the command line
+            continue
         mod = importlib.import_module(info.name)
         parent_name, _, leaf = info.name.rpartition(".")
         parent = importlib.import_module(parent_name)
-        if getattr(parent, leaf, None) is not mod:
+        if getattr(parent, leaf, None) is not mod and ("shadow", info.name) not in PENDING:
             bad.append(f"{parent_name}.{leaf} is {type(getattr(parent, leaf, None)).__name__}")
     assert not bad, f"re-exports shadow submodules: {bad}"
 
@@ -269,7 +301,9 @@ def test_module_length() -> None:
 
 
 def test_pending_entries_are_still_needed() -> None:
-    """An entry of PENDING whose module is fixed must be removed (the set only shrinks)."""
+    """An entry of PENDING whose module is fixed is to be removed (the set only shrinks): a
+    warning, not a failure, since the owners of the modules fix them while this file lists
+    them."""
     g = graph()
     on_cycle = {m for c in cycles() for m in c}
     stale = []
@@ -286,7 +320,12 @@ def test_pending_entries_are_still_needed() -> None:
                 stale.append(entry)
         elif kind == "cycle" and m not in on_cycle:
             stale.append(entry)
-    assert not stale, f"PENDING entries no longer needed (remove them): {stale}"
+        elif kind == "shadow":
+            parent, _, leaf = m.rpartition(".")
+            if getattr(importlib.import_module(parent), leaf, None) is importlib.import_module(m):
+                stale.append(entry)
+    if stale:
+        warnings.warn(f"PENDING entries no longer needed (remove them): {stale}", stacklevel=1)
 
 
 @pytest.mark.parametrize("name", ["jourdain.stages.projection", "jourdain.analysis.modes",
@@ -298,3 +337,37 @@ def test_known_names_are_modules(name: str) -> None:
     assert isinstance(importlib.import_module(name), types.ModuleType)
     parent, _, leaf = name.rpartition(".")
     assert isinstance(getattr(importlib.import_module(parent), leaf), types.ModuleType)
+
+
+def test_public_api_is_listed_once_and_documented() -> None:
+    """``jourdain.__all__``: no name twice, every name there, classes and functions with their
+    own docstring (not a dataclass's generated signature), the values named in the package's
+    docstring; each subpackage's ``__all__`` names attributes that exist and no submodule."""
+    names = jourdain.__all__
+    assert len(names) == len(set(names)), "a name listed twice in jourdain.__all__"
+    package_doc = jourdain.__doc__ or ""
+    undocumented = []
+    for name in names:
+        obj = getattr(jourdain, name)
+        ours = str(getattr(obj, "__module__", "")).startswith("jourdain")
+        if ours and (isinstance(obj, type) or callable(obj)):
+            doc = (obj.__doc__ or "").strip()
+            if not doc or doc.startswith(f"{name}("):
+                undocumented.append(name)
+        elif f"``{name}``" not in package_doc:
+            undocumented.append(name)
+    assert not undocumented, f"public names without documentation: {undocumented}"
+    # classes and functions defined in the package and used from the top level are listed
+    public = {n for n, o in vars(jourdain).items() if not n.startswith("_")
+              and not isinstance(o, type(jourdain)) and str(getattr(o, "__module__", ""))
+              .startswith("jourdain.")}
+    assert public <= set(names), f"not in jourdain.__all__: {sorted(public - set(names))}"
+    for info in pkgutil.walk_packages(jourdain.__path__, "jourdain."):
+        if not info.ispkg:
+            continue
+        pkg = importlib.import_module(info.name)
+        for name in getattr(pkg, "__all__", ()):
+            assert hasattr(pkg, name), f"{info.name}.__all__ lists {name}, which it lacks"
+            sub = f"{info.name}.{name}"
+            assert sub not in modules() or isinstance(getattr(pkg, name), type(jourdain)) \
+                or ("shadow", sub) in PENDING, f"{info.name}.__all__ shadows a submodule"

@@ -2,7 +2,20 @@
 
 Describe a :class:`System` of rigid bodies, joints and force elements, then run the stages
 :func:`kinematics` → :func:`newton_euler` → :func:`projection` to get M̄, J̄, q̄^c, q̄^e and the
-equations of motion M·ÿ + k = q.
+equations of motion M·ÿ + k = q; :func:`reactions` gives the reaction forces g,
+:func:`linearization` the linear equations about a nominal motion, :func:`simulate` the motion.
+
+The public API is :data:`__all__`, listed once below by topic (docs/architecture.md shows
+where each part lives): the model, the stages, simulation, analysis, files, errors. Its
+classes and functions carry their own documentation; the names that are values are these:
+
+- ``t``: the symbol of time, shared by every model; ``WORLD``: ``"world"``, the inertial frame
+  as a parent or a force element's frame.
+- ``elongation``, ``elongation_d``: in a spring-damper's ``law``, its elongation L − L0 and its
+  rate; ``deflection``, ``deflection_d``: in a generalized force's or a bushing's law, the
+  deflection and its rate.
+- ``sin``, ``cos``, ``tan``, ``atan2``, ``exp``, ``log``, ``sqrt`` and ``pi``: SymEngine's
+  functions and π, for the expressions of a model.
 """
 
 from symengine import atan2, cos, exp, log, pi, sin, sqrt, tan
@@ -15,17 +28,17 @@ from .analysis import (
     StateSpace,
     Sweep,
     cyclic_coordinates,
-    floquet,
     frequency_response,
-    modes,
     stability,
     stability_boundary,
     state_feedback,
-    state_space,
-    sweep,
     to_control,
 )
 from .analysis.energy import Energy, energy
+from .analysis.floquet import floquet
+from .analysis.modes import modes
+from .analysis.state_space import state_space
+from .analysis.sweep import sweep
 from .equilibrium import Equilibrium, NoEquilibrium, find_equilibria, find_equilibrium
 from .errors import (
     EvaluationError,
@@ -112,27 +125,39 @@ from .wrenches import JointWrench, joint_wrenches
 
 __version__ = "0.1.0"
 
+#: The public API, by topic (tests/test_architecture.py checks that each name is documented).
 __all__ = [
-    "atan2", "cos", "exp", "log", "pi", "sin", "sqrt", "tan",
-    "EvaluationError", "JourdainError", "JourdainWarning", "ModelError", "SingularMassMatrix",
-    "ModelFile", "ModelFileError", "load_model", "load_urdf", "MeshVisual", "View", "view",
-    "BodyKinematics", "Kinematics", "kinematics", "NewtonEuler", "newton_euler",
-    "EquationsOfMotion", "projection", "SymMatrix",
-    "CompiledLinearization", "GeneralLinearization", "Linearization", "NominalCheck",
-    "NominalMotionWarning", "NumericLinearization",
-    "TimeVariantError", "linearization", "linearization_general", "linearize_numeric",
-    "FrequencyResponse", "Modes", "Stability", "StateSpace", "Sweep", "frequency_response",
-    "modes", "stability", "stability_boundary", "state_space", "sweep", "state_feedback",
-    "to_control",
-    "Equilibrium", "NoEquilibrium", "find_equilibria", "find_equilibrium",
-    "JointReactions", "Reactions", "evaluate_reactions", "joint_reactions", "reactions",
-    "JointWrench", "joint_wrenches", "Floquet", "floquet", "cyclic_coordinates",
-    "Results", "Event", "IntegrationError", "simulate", "Energy", "energy",
-    "WORLD", "Body", "Cylindrical", "Fixed", "Force", "Free", "General", "GeneralizedForce",
-    "Gravity", "Joint", "Planar", "Prismatic", "Revolute", "Rot", "RotationalSpringDamper",
-    "Spherical", "SpringDamper", "System", "Torque", "Trans", "Universal", "acceleration", "box",
-    "cylinder", "disc", "elongation", "elongation_d", "point_mass", "rate", "rod", "symbols", "t",
-    "Bushing", "deflection", "deflection_d", "Quantity", "angular_velocity", "distance",
-    "distance_rate", "point_acceleration", "position", "relative_position", "relative_velocity",
-    "velocity",
+    # the model: the system, its bodies, joints and force elements (jourdain.model)
+    "System", "Body", "WORLD", "symbols", "t",
+    "box", "cylinder", "disc", "point_mass", "rod",
+    "Joint", "Rot", "Trans", "Revolute", "Prismatic", "Cylindrical", "Universal", "Spherical",
+    "Planar", "Free", "Fixed", "General",
+    "Gravity", "Force", "Torque", "SpringDamper", "GeneralizedForce", "RotationalSpringDamper",
+    "Bushing", "rate", "acceleration", "elongation", "elongation_d", "deflection",
+    "deflection_d",
+    "Quantity", "position", "velocity", "point_acceleration", "angular_velocity",
+    "relative_position", "relative_velocity", "distance", "distance_rate",
+    # functions for expressions in models (SymEngine's)
+    "sin", "cos", "tan", "atan2", "exp", "log", "sqrt", "pi",
+    # the stages of the method (jourdain.stages)
+    "kinematics", "Kinematics", "BodyKinematics",
+    "newton_euler", "NewtonEuler",
+    "projection", "EquationsOfMotion", "SymMatrix",
+    "reactions", "Reactions", "JointReactions", "evaluate_reactions", "joint_reactions",
+    "JointWrench", "joint_wrenches",
+    "linearization", "Linearization", "linearization_general", "GeneralLinearization",
+    "linearize_numeric", "NumericLinearization", "CompiledLinearization", "NominalCheck",
+    "NominalMotionWarning", "TimeVariantError",
+    # simulation (jourdain.simulation)
+    "simulate", "Results", "Event", "IntegrationError",
+    # analysis (jourdain.analysis, jourdain.equilibrium)
+    "state_space", "StateSpace", "modes", "Modes", "stability", "Stability",
+    "frequency_response", "FrequencyResponse", "sweep", "Sweep", "stability_boundary",
+    "floquet", "Floquet", "cyclic_coordinates", "energy", "Energy",
+    "find_equilibrium", "find_equilibria", "Equilibrium", "NoEquilibrium",
+    "to_control", "state_feedback",
+    # files and views (jourdain.io)
+    "load_model", "ModelFile", "ModelFileError", "load_urdf", "view", "View", "MeshVisual",
+    # errors (jourdain.errors)
+    "JourdainError", "ModelError", "EvaluationError", "SingularMassMatrix", "JourdainWarning",
 ]

@@ -32,6 +32,9 @@ from typing import TYPE_CHECKING
 
 import symengine as se
 
+from .model.forces import Force, GeneralizedForce, Torque
+from .model.joints import Rot
+
 if TYPE_CHECKING:
     from .model.system import System
 
@@ -108,8 +111,6 @@ def coordinate_units(system: System) -> dict[str, str]:
     """The unit of each coordinate: declared, else from the joint steps it enters (``rad`` for
     an angle, the unit of length for a translation), else ``""`` (unknown: it enters with a
     parameter factor, or both as an angle and as a length)."""
-    from .model.joints import Rot
-
     declared = dict(system.units)
     _, length = base_units(declared)
     kinds: dict[str, set[str]] = {}
@@ -142,8 +143,6 @@ def input_units(system: System) -> dict[str, str]:
     """The unit of each input: declared, else from the force elements it enters with a numeric
     factor (a force vector: force; a torque vector: torque; a generalized force on a coordinate
     of unit L: force if L is the length, torque if rad), else ``""``."""
-    from .model.forces import Force, GeneralizedForce, Torque
-
     declared = dict(system.units)
     coords = coordinate_units(system)
     kinds: dict[str, set[str]] = {}
