@@ -4,7 +4,7 @@ Every model of examples/ (``*.toml`` and ``*.urdf``) is run as a user runs it,
 ``jourdain run examples/<model> --out <dir>``, at every build; the pictures of the gallery are
 the report's own: the snapshot strip, the animation and the first time plot of a tree model's
 ``report.html`` (inline SVG, cut out by the section heading above each), and the PNG plots of
-a closed-loop model's report. The report itself is copied into the site beside its page. A model
+a closed-loop model's report. The report itself is copied into the site (gallery/reports/<stem>/). A model
 whose run fails, or whose report has no picture, fails the build with the command's output.
 
 The text of a page is the model's paragraph in examples/README.md (else the file's
@@ -119,7 +119,7 @@ def write_page(model: Path, out: Path, about: str) -> tuple[str, str, str]:
     if (out / "report.html").is_file():
         report = "report.html"
         for name, svg in tree_figures(out / "report.html"):
-            rel = f"{stem}/{name}.svg"
+            rel = f"figures/{stem}/{name}.svg"
             with mkdocs_gen_files.open(f"gallery/{rel}", "w") as f:
                 f.write(svg)
             pictures.append((name, rel))
@@ -127,19 +127,20 @@ def write_page(model: Path, out: Path, about: str) -> tuple[str, str, str]:
         report = "index.html"
         for name in LOOP_FIGURES:
             if (out / name).is_file():
-                pictures.append((Path(name).stem.replace("_", " "), f"{stem}/{name}"))
+                pictures.append((Path(name).stem.replace("_", " "), f"reports/{stem}/{name}"))
     if not pictures:
         raise RuntimeError(f"gallery: the report of examples/{model.name} in {out} has no "
                            f"picture the gallery knows (headings {TREE_FIGURES} or files "
                            f"{LOOP_FIGURES}): has the report's layout changed?")
-    # the report beside the page, with the files its page loads (pictures; not the data)
+    # the report in gallery/reports/<stem>/, with the files its page loads (pictures; not the
+    # data files); not beside the page, whose own index.html is gallery/<stem>/index.html
     for path in sorted(out.iterdir()):
         if path.suffix in (".html", ".png", ".svg"):
-            with mkdocs_gen_files.open(f"gallery/{stem}/{path.name}", "wb") as f:
+            with mkdocs_gen_files.open(f"gallery/reports/{stem}/{path.name}", "wb") as f:
                 f.write(path.read_bytes())
     for caption, rel in pictures:
-        lines += [f"![{caption}]({stem}/{Path(rel).name})", ""]
-    lines += [f"[The full report]({stem}/{report}) · "
+        lines += [f"![{caption}]({rel})", ""]
+    lines += [f"[The full report](reports/{stem}/{report}) · "
               f"[the model file](../examples/{model.name})", "",
               f'??? note "examples/{model.name}"', "",
               "    ```" + ("toml" if model.suffix == ".toml" else "xml")]
@@ -148,7 +149,7 @@ def write_page(model: Path, out: Path, about: str) -> tuple[str, str, str]:
     lines += ["    ```", ""]
     with mkdocs_gen_files.open(f"gallery/{stem}.md", "w") as f:
         f.write("\n".join(lines))
-    return title, f"{stem}.md", f"{stem}/{Path(pictures[0][1]).name}"
+    return title, f"{stem}.md", pictures[0][1]
 
 
 def main() -> None:
