@@ -25,8 +25,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..differentiate import Graph, free_symbol_names, jet_float
 from ..errors import JourdainError
+from ..graph import Graph, free_symbol_names, jet_float
 from ..stages.kinematics import kinematics  # the model has no stage methods (issue 16)
 from ..stages.newton_euler import newton_euler
 from ..stages.projection import projection
@@ -50,12 +50,12 @@ def cyclic_coordinates(source: System | EquationsOfMotion) -> tuple[str, ...]:
     (:func:`_screen_compiled`: shifted by three angles at two random states, no entry may
     change); where that cannot decide (no compiler, no real value), by the exact derivatives ``∂k/∂y_c``,
     ``∂q/∂y_c`` and ``∂M/∂y_c = (∂J̄/∂y_c)ᵀM̄J̄ + J̄ᵀM̄(∂J̄/∂y_c)`` (forward mode,
-    :func:`jourdain.differentiate.jet_float`) at two random states and times, at the
+    :func:`jourdain.graph.jet_float`) at two random states and times, at the
     default parameter values and at a random set near them, must vanish to
     :data:`CYCLIC_RTOL` of the largest value or derivative there. The result is a property of
     the model, for all parameter values.
     """
-    from ..differentiate import evaluate_float
+    from ..graph import evaluate_float
     from ..stages.linearization import _perturbed
     from ..stages.projection import EquationsOfMotion
 

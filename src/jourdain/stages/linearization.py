@@ -13,7 +13,7 @@ All are the value and the gradient of the residual ``r = M·ÿ + k − q`` at th
 ``Q = ∂r/∂y``, ``P = ∂r/∂ẏ``, ``B = −∂r/∂u`` and ``h = −r``, with ``ÿ`` replaced by ``ÿ_s``
 (which gives the position term ``∂(M·ÿ_s)/∂y`` of the note in METHOD.md §5). k, q and the
 entries of M are differentiated in one forward-mode pass over their shared expression graph with
-the nominal motion substituted on the way (:func:`jourdain.differentiate.jet`), the gradients of
+the nominal motion substituted on the way (:func:`jourdain.graph.jet`), the gradients of
 M only where ÿ_s ≠ 0. M is never inverted.
 
 Three forms: :func:`linearization` (symbolic in the parameters, about a given nominal motion),
@@ -41,8 +41,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import symengine as se
 
-from ..differentiate import Graph, evaluate_float, free_symbol_names, jet, jet_float
 from ..errors import EvaluationError, JourdainError, JourdainWarning, ModelError, warn
+from ..graph import Graph, evaluate_float, free_symbol_names, jet, jet_float
 from ..model.expressions import as_expr
 from ..symbolic import SymMatrix
 from .kinematics import kinematics  # the model has no stage methods (issue 16)
@@ -787,7 +787,7 @@ def linearize_numeric(source: System | EquationsOfMotion, nominal: Mapping[Any, 
                       parameters: Mapping[str, float] | None = None,
                       inputs: Mapping[Any, Any] | None = None) -> NumericLinearization:
     """M̃, P, Q, h, B as numbers for given parameter values, by forward-mode differentiation in
-    floating point over the graphs of k, q and J̄ (:func:`jourdain.differentiate.jet_float`),
+    floating point over the graphs of k, q and J̄ (:func:`jourdain.graph.jet_float`),
     with ``M̃ = J̄ᵀ·M̄·J̄`` in numbers.
 
     Same equations, nominal motions, nominal inputs and :class:`NominalMotionWarning` as

@@ -1,0 +1,207 @@
+"""Numbers of shared expression graphs: evaluation and first derivatives in floating point.
+
+:func:`evaluate_float` gives the numbers of some expressions for numbers of their symbols, and
+:func:`jet_float` their values and Jacobian (forward mode with dense NumPy gradients), each
+visiting every distinct node of the :class:`~jourdain.graph.Graph` once. For one evaluation this
+is faster than compiling; for many, compile (:func:`jourdain.numeric.lambdify`).
+
+Floor: graph tools (imports only this package and :mod:`jourdain.errors`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import symengine as se
+
+from ..errors import JourdainError
+from .forward import needed_gradients, partials
+from .identity import Expr, no_gc
+from .nodes import Graph
+
+# --- numbers -------------------------------------------------------------------------------------
+_FLOAT_FUNCS: dict[str, Callable[..., float]] = {
+    "sin": math.sin, "cos": math.cos, "tan": math.tan, "asin": math.asin, "acos": math.acos,
+    "atan": math.atan, "sinh": math.sinh, "cosh": math.cosh, "tanh": math.tanh, "log": math.log,
+    "Abs": abs, "atan2": math.atan2, "sign": lambda x: float((x > 0) - (x < 0)),
+}
+
+
+def evaluate_float(exprs: Sequence[Expr], values: Mapping[str, float]) -> list[float]:
+    """Numbers of some expressions for numbers of their symbols, visiting each shared node once.
+
+    For a single evaluation this is faster than compiling (no code generation); for many
+    evaluations compile with :func:`jourdain.numeric.lambdify`. ``values`` maps symbol names to
+    numbers; a symbol without a value raises :class:`JourdainError`.
+    """
+    g = Graph(exprs)
+    with no_gc():
+        num = _float_values(g, values)
+    return [num[k] for k in g.roots]
+
+
+def _float_values(g: Graph, values: Mapping[str, float]) -> dict[int, float]:
+    num: dict[int, float] = {}
+    for ka, a in g.atoms.items():
+        if a.is_Symbol:
+            name = str(a)
+            if name not in values:
+                raise JourdainError(f'no value for the symbol "{name}"')
+            num[ka] = float(values[name])
+        else:
+            num[ka] = float(a)
+    funcs = _FLOAT_FUNCS
+    fsum, prod = math.fsum, math.prod
+    kind, children = g.kind, g.children
+    for k in g.order:
+        args = [num[c] for c in children[k]]
+        name = kind[k]
+        if name == "Add":
+            v = fsum(args)
+        elif name == "Mul":
+            v = prod(args)
+        elif name == "Pow":
+            b, e = args
+            try:
+                v = math.exp(e) if g.atoms.get(children[k][0]) == se.E else b**e
+            except (ZeroDivisionError, OverflowError):
+                raise JourdainError(f"{b}**{e}: division by zero or overflow") from None
+            if isinstance(v, complex):
+                raise JourdainError(f"{b}**{e} has no real value")
+        elif name in funcs:
+            try:
+                v = funcs[name](*args)
+            except (ValueError, ZeroDivisionError, OverflowError):
+                raise JourdainError(f"{name}{tuple(args)} has no real value") from None
+        else:
+            v = float(g.node[k].func(*(se.RealDouble(x) for x in args)))
+        num[k] = v
+    return num
+
+
+def free_symbol_names(exprs: Sequence[Expr]) -> set[str]:
+    """Names of the symbols in some expressions, visiting each shared node once (SymEngine's
+    ``free_symbols`` walks a shared graph as a tree)."""
+    return Graph(exprs).symbol_names()
+
+
+# --- numeric forward mode --------------------------------------------------------------------
+_DFLOAT = {
+    "sin": lambda v, val: math.cos(v[0]),
+    "cos": lambda v, val: -math.sin(v[0]),
+    "tan": lambda v, val: 1.0 + val * val,
+    "log": lambda v, val: 1.0 / v[0],
+    "atan": lambda v, val: 1.0 / (1.0 + v[0] ** 2),
+    "asin": lambda v, val: 1.0 / math.sqrt(1.0 - v[0] ** 2),
+    "acos": lambda v, val: -1.0 / math.sqrt(1.0 - v[0] ** 2),
+    "sinh": lambda v, val: math.cosh(v[0]),
+    "cosh": lambda v, val: math.sinh(v[0]),
+    "tanh": lambda v, val: 1.0 - val * val,
+    "Abs": lambda v, val: float((v[0] > 0) - (v[0] < 0)),
+    "sign": lambda v, val: 0.0,
+}
+
+
+@dataclass(frozen=True)
+class FloatJet:
+    """Result of :func:`jet_float`: ``values`` (n,), ``jacobian`` (n, number of variables), and
+    ``symbols``: the names of all symbols met in the expressions."""
+
+    values: np.ndarray
+    jacobian: np.ndarray
+    symbols: frozenset[str]
+
+
+def jet_float(exprs: Sequence[Expr] | Graph, variables: Sequence[se.Symbol],
+              values: Mapping[str, float], differentiate: Sequence[bool] | None = None
+              ) -> FloatJet:
+    """Numbers and first derivatives of ``exprs`` with respect to ``variables`` at a numeric
+    point: forward mode in floating point with dense NumPy gradients, each shared node once.
+
+    ``exprs`` may be a prebuilt :class:`Graph` (to evaluate the same expressions at many
+    points). ``values`` maps every symbol name of the expressions (variables included) to a
+    number. Only the expressions marked in ``differentiate`` are differentiated (all when
+    None); the rows of the others in the Jacobian are zero.
+    """
+    g = exprs if isinstance(exprs, Graph) else Graph(exprs)
+    mask = ([True] * len(g.roots) if differentiate is None
+            else [bool(d) for d in differentiate])
+    with no_gc():
+        return _jet_float(g, variables, values, mask)
+
+
+def _jet_float(g: Graph, variables: Sequence[se.Symbol], values: Mapping[str, float],
+               mask: list[bool]) -> FloatJet:
+    nv = len(variables)
+    unit = np.eye(nv)
+    var_index = {str(v): i for i, v in enumerate(variables)}
+    value = _float_values(g, values)
+    grad: dict[int, np.ndarray | None] = {}
+    for ka, a in g.atoms.items():
+        i = var_index.get(str(a)) if a.is_Symbol else None
+        grad[ka] = None if i is None else unit[i]
+    atom_keys = set(g.atoms)
+
+    # nodes that need a gradient (a product with two vanishing factors needs none)
+    need = needed_gradients(g, value, mask, atom_keys, lambda v: v == 0.0)
+
+    # gradients (None: does not depend on the variables)
+    prod = math.prod
+    for k in g.order:
+        if k not in need:
+            continue
+        kids = g.children[k]
+        grads = [grad.get(c) for c in kids]
+        if all(x is None for x in grads):
+            grad[k] = None
+            continue
+        vals = [value[c] for c in kids]
+        node = g.node[k]
+        name = g.kind[k]
+        acc = None
+        if name == "Add":
+            for x in grads:
+                if x is not None:
+                    acc = x if acc is None else acc + x
+        elif name == "Mul":
+            n = len(vals)
+            for i, x in enumerate(grads):
+                if x is None:
+                    continue
+                c = prod(vals[j] for j in range(n) if j != i) if n > 2 else vals[1 - i]
+                if c != 0.0:
+                    acc = c * x if acc is None else acc + c * x
+        elif name == "Pow":
+            b, e = vals
+            gb, ge = grads
+            if gb is not None:
+                acc = (e * b ** (e - 1.0)) * gb
+            if ge is not None:
+                term = (value[k] * math.log(b)) * ge
+                acc = term if acc is None else acc + term
+        else:
+            if name in _DFLOAT:
+                coeffs = [_DFLOAT[name](vals, value[k])]
+            elif name == "atan2":
+                yy, xx = vals
+                r2 = xx * xx + yy * yy
+                coeffs = [xx / r2, -yy / r2]
+            else:
+                coeffs = [float(p) for p in partials(node, name,
+                                                        [se.RealDouble(x) for x in vals],
+                                                        se.RealDouble(value[k]))]
+            for c, x in zip(coeffs, grads, strict=True):
+                if x is not None and c != 0.0:
+                    acc = c * x if acc is None else acc + c * x
+        grad[k] = acc
+
+    out_v = np.array([value[k] for k in g.roots], dtype=float)
+    out_j = np.zeros((len(g.roots), nv))
+    for i, k in enumerate(g.roots):
+        gi = grad.get(k) if mask[i] else None
+        if gi is not None:
+            out_j[i] = gi
+    return FloatJet(out_v, out_j, frozenset(g.symbol_names()))
