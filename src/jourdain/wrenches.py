@@ -27,8 +27,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .differentiate import evaluate_float
 from .errors import EvaluationError
+from .graph import evaluate_float
 from .numeric import lambdify, state_vectors
 from .numeric.diagnose import state_values
 from .stages.kinematics import kinematics
