@@ -2,7 +2,7 @@
 
 Compiled code only says that a number is not finite. When it is, the parts of the model are
 evaluated one by one at the same state, from their own short expressions (no compilation, each
-shared node once: :func:`jourdain.differentiate.evaluate_float`): every joint's relative
+shared node once: :func:`jourdain.graph.evaluate_float`): every joint's relative
 kinematics, every body's mass data, and the loads of every force element alone. A part whose
 numbers are not finite, or whose expressions have no real value there (a spring of zero length
 divides by its length), is named in the error.
@@ -16,8 +16,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..differentiate import evaluate_float
 from ..errors import JourdainError
+from ..graph import evaluate_float
 from ..stages.kinematics import joint_motions, kinematics
 from ..stages.newton_euler import applied_forces
 
@@ -28,7 +28,7 @@ if TYPE_CHECKING:
 def state_values(system: System, y: np.ndarray, yd: np.ndarray, t: float, p: np.ndarray,
                  u: np.ndarray) -> dict[str, float]:
     """The numbers of one state by symbol name (parameters, y, ẏ, inputs and t), as
-    :func:`jourdain.differentiate.evaluate_float` takes them."""
+    :func:`jourdain.graph.evaluate_float` takes them."""
     vals = {str(s): float(v) for s, v in zip(system.parameter_symbols, p, strict=True)}
     vals.update({str(s): float(v) for s, v in zip(system.y, y, strict=True)})
     vals.update({str(s): float(v) for s, v in zip(system.yd, yd, strict=True)})
