@@ -26,8 +26,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import symengine as se
 
-from ..cse import count_nodes
 from ..errors import EvaluationError, JourdainError, ModelError, SingularMassMatrix
+from ..graph import count_nodes
 from ..model.bodies import check_values
 from ..stages.kinematics import kinematics  # the model has no stage methods (issue 16)
 from ..stages.newton_euler import newton_euler
