@@ -249,14 +249,14 @@ def to_sympy(expr: Expr, memo: dict | None = None) -> Any:
 def to_sympy_many(exprs: Sequence[Expr]) -> list[Any]:
     """Convert SymEngine expressions to SymPy; nodes shared between them are converted once.
 
-    One :class:`jourdain.cse.Graph` over all of them: node ids are only meaningful within one
+    One merged :class:`jourdain.graph.Graph` over all of them: node ids are only meaningful within one
     graph, which keeps every node it has seen alive.
     """
     import sympy
 
-    from .cse import Graph
+    from .graph import Graph
 
-    g = Graph(list(exprs))
+    g = Graph(list(exprs)).merged()
     memo: dict[int, Any] = {}
     for i in g.order:
         node: Any = g.node[i]  # SymEngine objects (no type information)
@@ -272,10 +272,10 @@ def to_sympy_many(exprs: Sequence[Expr]) -> list[Any]:
 
 def count_ops(exprs: Sequence[Expr], cse: bool = True) -> int:
     """Operation count of a list of expressions (n-ary + and * count n-1, functions and powers
-    one), after common-subexpression elimination (:mod:`jourdain.cse`) when ``cse``, else
+    one), after common-subexpression elimination (:func:`jourdain.graph.cse`) when ``cse``, else
     counting each distinct node of the shared graph once."""
-    from .cse import cse as graph_cse
-    from .cse import graph_ops
+    from .graph import cse as graph_cse
+    from .graph import graph_ops
 
     exprs = list(exprs)
     return graph_cse(exprs).count_ops() if cse else graph_ops(exprs)
