@@ -3,7 +3,7 @@
 Solved by Levenberg–Marquardt (any equilibrium) or by regularized Newton steps that go downhill
 in the potential (stable ones), both with the exact Jacobian ``∂(k − q)/∂y`` at ``ẏ = 0`` (the
 stiffness part of the linearization), obtained together with the residual in one pass over the
-expression graph (:func:`jourdain.differentiate.jet_float`, in floating point). A system usually has
+expression graph (:func:`jourdain.graph.jet_float`, in floating point). A system usually has
 several equilibria (a pendulum hangs or stands); the starting guess says which one is meant,
 :func:`find_equilibria` collects the distinct ones reached from several guesses.
 """
@@ -16,8 +16,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .differentiate import Graph, jet_float
 from .errors import EvaluationError, JourdainError
+from .graph import Graph, jet_float
 from .numeric import parameter_vector
 from .stages.kinematics import kinematics
 from .stages.newton_euler import newton_euler
