@@ -140,7 +140,9 @@ def _check_parameters(ctx: Context, P: np.ndarray, errors: list[str]) -> np.ndar
 
     ok = np.ones(len(P), dtype=bool)
     names = ctx.parameter_names
-    used = _body_names(ctx.system) & {v.name for v in ctx.spec.varied if v.kind == "parameter"}
+    if ctx.body_parameters is None:  # once per context: a walk over every body's expressions
+        ctx.body_parameters = frozenset(_body_names(ctx.system))
+    used = ctx.body_parameters & {v.name for v in ctx.spec.varied if v.kind == "parameter"}
     if not used:
         return ok
     cols = [names.index(n) for n in names if n in used]

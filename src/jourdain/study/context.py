@@ -43,6 +43,8 @@ class Context:
     bounds: Any = None
     #: the runs of ``simulate``, advanced together (None: one run per case)
     ensemble: Any = None
+    #: the parameters the bodies' mass data and joints use (found on first use)
+    body_parameters: frozenset[str] | None = None
     #: problems of the model's numbers found so far, by the values of the parameters the
     #: bodies and joints use ("" where the values passed the checks)
     checked: dict[tuple[float, ...], str] = field(default_factory=dict)
