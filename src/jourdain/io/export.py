@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 
 import symengine as se
 
-from ..cse import cse as graph_cse
+from ..graph import cse as graph_cse
 from ..symbolic import (  # noqa: F401 - the display settings, re-exported
     MAX_DISPLAY_OPS,
     SIMPLIFY_OPS,
