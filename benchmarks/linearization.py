@@ -12,7 +12,7 @@ jourdain), n = 1, 2, 4, 6. Reported per case, each sympy stage in a subprocess w
   ``KanesMethod.linearize(A_and_B=True, op_point=...)`` (A, B: sympy inverts M symbolically);
   operation counts of both results after CSE, counted by the same function
   (``jourdain.symbolic.count_ops`` on SymEngine versions), and as trees (without CSE:
-  ``jourdain.cse.tree_ops``);
+  ``jourdain.graph.tree_ops``);
 * the numeric A, B at the default parameters from both, and their largest relative difference.
 
 Derivation of the equations of motion is timed separately (it is the same work in both tools'
@@ -39,7 +39,7 @@ import symengine as se
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import jourdain as jd  # noqa: E402
-from jourdain.cse import tree_ops  # noqa: E402
+from jourdain.graph import tree_ops  # noqa: E402
 from jourdain.models import n_link_pendulum_on_cart, spatial_chain  # noqa: E402
 from jourdain.stages.linearization import linearization_general  # noqa: E402
 from jourdain.symbolic import count_ops  # noqa: E402
