@@ -22,6 +22,7 @@ from __future__ import annotations
 import ast
 import importlib
 import pkgutil
+import re
 import warnings
 from functools import cache
 from pathlib import Path
@@ -371,3 +372,16 @@ def test_public_api_is_listed_once_and_documented() -> None:
             sub = f"{info.name}.{name}"
             assert sub not in modules() or isinstance(getattr(pkg, name), type(jourdain)) \
                 or ("shadow", sub) in PENDING, f"{info.name}.__all__ shadows a submodule"
+
+
+def test_floor_table_in_the_documentation_matches() -> None:
+    """docs/architecture.md shows the floors of :data:`FLOORS`, row by row, and has a line in
+    its tree for every folder of the package."""
+    doc = (ROOT.parents[1] / "docs" / "architecture.md").read_text(encoding="utf-8")
+    rows = [line for line in doc.splitlines() if line.startswith("| ") and line[2].isdigit()]
+    table = tuple(tuple(re.findall(r"`(jourdain[\w.]*)`", row.split("|")[2])) for row in rows)
+    assert table == FLOORS
+    tree = doc[doc.index("## The tree"):]
+    folders = sorted({p.parent.relative_to(ROOT).as_posix() for p in modules().values()} - {"."})
+    missing = [f for f in folders if not re.search(rf"{re.escape(f.split('/')[-1])}/\s", tree)]
+    assert not missing, f"folders without a line in the tree of docs/architecture.md: {missing}"
