@@ -1,4 +1,8 @@
-"""The immutable, validated model: coordinates, parameters, inputs, bodies and force elements."""
+"""The immutable, validated model: coordinates, parameters, inputs, bodies and force elements.
+
+Pure data: the stages of the method take a System (:mod:`jourdain.stages`), and
+:class:`jourdain.System` (:mod:`jourdain.pipeline`) adds them as cached methods; nothing here
+imports them (docs/architecture.md)."""
 
 from __future__ import annotations
 

@@ -32,9 +32,20 @@ _LOCKS = threading.Lock()  # guards the creation of the per-system locks
 
 
 class System(Model):
-    """A multibody system (:class:`jourdain.model.System`: coordinates, bodies, force elements,
-    parameters, inputs) with the method's stages as methods, each computed once and kept.
+    """A multibody system with the method's stages as methods, each computed once and kept.
 
+    Built as :class:`jourdain.model.System` (the same parameters: ``coordinates``, ``bodies``,
+    ``forces``, ``parameters``, ``inputs``, ``units``, ``name``; the same checks):
+
+    >>> import jourdain as jd
+    >>> from jourdain.models import double_pendulum
+    >>> system = double_pendulum()          # a jourdain.System
+    >>> eom = system.equations_of_motion()  # M·ÿ + k = q, derived once
+    >>> eom is system.equations_of_motion()
+    True
+
+    Methods: :meth:`kinematics`, :meth:`newton_euler`, :meth:`equations_of_motion`,
+    :meth:`reactions` (symbolic, kept), :meth:`linearize`, :meth:`evaluate`, :meth:`simulate`.
     Equal to another ``jourdain.System`` with the same description; the kept stages take no
     part in equality, hashing or pickling.
     """
