@@ -10,6 +10,9 @@ whose run fails, or whose report has no picture, fails the build with the comman
 The text of a page is the model's paragraph in examples/README.md (else the file's
 ``[model] description``), the command, and the model file.
 
+mkdocs-gen-files runs this file with ``runpy.run_path`` (``__name__ == "<run_path>"``); imported
+(tests/test_docs_site.py) it only defines its functions.
+
 Environment: ``JOURDAIN_DOCS_WORKERS`` (default: the number of CPUs, at most 4) runs that
 many reports at a time; the compiled libraries go to ``$JOURDAIN_CACHE`` as for any run.
 """
@@ -25,8 +28,7 @@ import tempfile
 import tomllib
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
-
-import mkdocs_gen_files
+from typing import Any
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = ROOT / "examples"
@@ -109,18 +111,20 @@ def model_title(model: Path) -> tuple[str, str]:
     return (m.group(1) if m else model.stem), ""
 
 
-def write_page(model: Path, out: Path, about: str) -> tuple[str, str, str]:
-    """gallery/<stem>.md and its pictures; returns (title, page, thumbnail) for the index."""
+def write_page(gen: Any, model: Path, out: Path, about: str) -> tuple[str, str, str]:
+    """gallery/<stem>.md and its pictures, written with ``gen`` (mkdocs_gen_files); returns
+    (title, page, thumbnail) for the index: the animation where the report has one."""
     stem = model.stem
     title, description = model_title(model)
-    lines = [f"# {title}", "", site_links(about or description), "",
+    text = site_links(about or description)
+    lines = [f"# {title}", "", text[:1].upper() + text[1:], "",
              "```sh", f"jourdain run examples/{model.name} --out report/", "```", ""]
     pictures: list[tuple[str, str]] = []        # (caption, file relative to gallery/)
     if (out / "report.html").is_file():
         report = "report.html"
         for name, svg in tree_figures(out / "report.html"):
             rel = f"figures/{stem}/{name}.svg"
-            with mkdocs_gen_files.open(f"gallery/{rel}", "w") as f:
+            with gen.open(f"gallery/{rel}", "w") as f:
                 f.write(svg)
             pictures.append((name, rel))
     else:
@@ -136,7 +140,7 @@ def write_page(model: Path, out: Path, about: str) -> tuple[str, str, str]:
     # data files); not beside the page, whose own index.html is gallery/<stem>/index.html
     for path in sorted(out.iterdir()):
         if path.suffix in (".html", ".png", ".svg"):
-            with mkdocs_gen_files.open(f"gallery/reports/{stem}/{path.name}", "wb") as f:
+            with gen.open(f"gallery/reports/{stem}/{path.name}", "wb") as f:
                 f.write(path.read_bytes())
     for caption, rel in pictures:
         lines += [f"![{caption}]({rel})", ""]
@@ -147,19 +151,22 @@ def write_page(model: Path, out: Path, about: str) -> tuple[str, str, str]:
     lines += ["    " + line if line else "" for line in
               model.read_text(encoding="utf-8").splitlines()]
     lines += ["    ```", ""]
-    with mkdocs_gen_files.open(f"gallery/{stem}.md", "w") as f:
+    with gen.open(f"gallery/{stem}.md", "w") as f:
         f.write("\n".join(lines))
-    return title, f"{stem}.md", pictures[0][1]
+    thumbnail = next((rel for name, rel in pictures if name == "animation"), pictures[0][1])
+    return title, f"{stem}.md", thumbnail
 
 
 def main() -> None:
+    import mkdocs_gen_files as gen  # the documentation build's own dependency
+
     paragraphs = readme_paragraphs()
     workers = int(os.environ.get("JOURDAIN_DOCS_WORKERS", min(4, os.cpu_count() or 1)))
     with tempfile.TemporaryDirectory(prefix="jourdain-gallery-") as tmp:
         jobs = [(model, Path(tmp) / model.stem) for model in models()]
         with ThreadPoolExecutor(max_workers=max(1, workers)) as pool:
             outs = list(pool.map(lambda job: run_report(*job), jobs))
-        entries = [write_page(model, out, paragraphs.get(model.name, ""))
+        entries = [write_page(gen, model, out, paragraphs.get(model.name, ""))
                    for (model, _), out in zip(jobs, outs, strict=True)]
     index = ["# Gallery", "",
              "Every model of the repository's `examples/` folder, run at each build of this site",
@@ -168,11 +175,12 @@ def main() -> None:
     for title, page, thumb in entries:
         index += [f"-   [**{title}**]({page})", "", f"    [![{title}]({thumb})]({page})", ""]
     index += ["</div>", ""]
-    with mkdocs_gen_files.open("gallery/index.md", "w") as f:
+    with gen.open("gallery/index.md", "w") as f:
         f.write("\n".join(index))
-    with mkdocs_gen_files.open("gallery/SUMMARY.md", "w") as f:
+    with gen.open("gallery/SUMMARY.md", "w") as f:
         f.write("* [Gallery](index.md)\n")
         f.writelines(f"* [{title}]({page})\n" for title, page, _ in entries)
 
 
-main()
+if __name__ in ("__main__", "<run_path>"):
+    main()
