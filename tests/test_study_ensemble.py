@@ -77,7 +77,7 @@ def test_ensemble_refuses_what_it_cannot_run_in_c() -> None:
         ens.run(np.zeros((2, 3)), np.zeros((2, 2)), np.zeros((2, 2)))
 
 
-def test_study_with_ensembles_equals_one_run_per_case() -> None:
+def test_study_with_ensembles_equals_one_run_per_case(tmp_path: Path) -> None:
     body = f"""[study]
 model = "{CAR}"
 design = "random"
@@ -112,6 +112,16 @@ method = "RK45"
     c = run_study(together, workers=2, pool="threads", quiet=True)
     for name in ("series_z_b", "final"):
         assert np.array_equal(a[name].values, c[name].values), name
+    # the command line: 2 threads asked for, the NetCDF file the same
+    from jourdain.cli import main
+    from jourdain.study import open_study
+
+    spec_file = tmp_path / "mc.toml"
+    spec_file.write_text(body)
+    assert main(["study", "--spec", str(spec_file), "--out", str(tmp_path / "mc.nc"),
+                 "--workers", "2", "--pool", "threads", "--quiet"]) == 0
+    d = open_study(tmp_path / "mc.nc")
+    assert np.array_equal(a.series_z_b.values, d.series_z_b.values)
 
 
 BLOWUP = """

@@ -26,6 +26,10 @@ def add_study_parser(subs: Any, parser_class: type) -> Any:
                         "FILE.parts/ as they come and a run with the same --out resumes")
     p.add_argument("--workers", type=_workers, metavar="N",
                    help="processes on this machine (default: one per core; 1: no processes)")
+    p.add_argument("--pool", choices=("auto", "processes", "threads"), default="auto",
+                   help="how the local workers run: processes, threads (for work that "
+                        "releases the GIL: simulations advanced as ensembles), or auto (the "
+                        "default: threads for a study that only simulates, else processes)")
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help="run on this dask.distributed scheduler (tcp://host:8786)")
     p.add_argument("--plots", metavar="DIR",
@@ -56,7 +60,7 @@ def cmd_study(args: argparse.Namespace) -> int:
     spec = load_study(args.spec, model=args.model)
     t0 = time.perf_counter()
     ds = run_study(spec, args.out, workers=args.workers, scheduler=args.scheduler,
-                   quiet=args.quiet, force=args.force)
+                   quiet=args.quiet, force=args.force, pool=args.pool)
     wall = time.perf_counter() - t0
     failed = int(ds.attrs["n_failed"])
     where = f" on {args.scheduler}" if args.scheduler else ""
