@@ -317,6 +317,17 @@ def test_ctrl_c_during_the_c_loop_stops_between_chunks():
     assert signal.getsignal(signal.SIGINT) is before  # the handler is restored
 
 
+class _Counting:
+    """The integrator library with its jd_integrate calls counted."""
+
+    def __init__(self, lib, calls: list) -> None:
+        self._lib, self._calls = lib, calls
+
+    def jd_integrate(self, *args):
+        self._calls.append(1)
+        return self._lib.jd_integrate(*args)
+
+
 @pytest.mark.parametrize("method", ["DOP853", "RK45"])
 def test_steps_do_not_depend_on_how_the_run_is_split(method, monkeypatch):
     """The C loop runs in calls of a few thousand steps (for Ctrl-C and progress); a run split
@@ -326,11 +337,15 @@ def test_steps_do_not_depend_on_how_the_run_is_split(method, monkeypatch):
     with a collapsed step)."""
     import importlib
 
-    sim = importlib.import_module("jourdain.simulation.simulate")  # the package re-exports a function
+    runs = importlib.import_module("jourdain.simulation.runs")  # where the C loop is called
     s = spatial_chain(3)
     rng = np.random.default_rng(3)
     y0, yd0 = rng.uniform(-1, 1, s.f), rng.uniform(-1, 1, s.f)
     big = s.simulate((0, 1.0), y0, yd0, method=method, rtol=1e-10, atol=1e-10)
-    monkeypatch.setattr(sim, "steps_per_call", lambda f: 7)
+    monkeypatch.setattr(runs, "steps_per_call", lambda f: 7)
+    calls = []
+    real = runs.integrator_library()
+    monkeypatch.setattr(runs, "integrator_library", lambda: _Counting(real, calls))
     small = s.simulate((0, 1.0), y0, yd0, method=method, rtol=1e-10, atol=1e-10)
+    assert len(calls) > big.n_accepted // 7  # the run did go in calls of 7 steps
     assert np.array_equal(big.t, small.t) and np.array_equal(big.y, small.y)

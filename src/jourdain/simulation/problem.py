@@ -129,8 +129,6 @@ class _Setup:
             raise EvaluationError(
                 f"input(s) {missing} not given: pass inputs={{{', '.join(repr(m) + ': 0.0' for m in missing)}}}"
                 " or a function of time, an expression in t or a table (times, values)")
-        state_names = set(system.coordinate_names) | {f"{n}_d" for n in system.coordinate_names}
-        allowed = state_names | {"t"} | {k for k, _ in system.parameters}
         n_tab = 0
         for i, name in enumerate(names):
             v = inputs[name]
@@ -161,7 +159,7 @@ class _Setup:
                     e = as_expr(v, f'input "{name}"')
                 except JourdainError as exc:
                     raise EvaluationError(str(exc)) from None
-                bad = {str(s) for s in e.free_symbols} - allowed
+                bad = {str(s) for s in e.free_symbols} - _allowed_symbols(system)
                 if bad:
                     raise EvaluationError(
                         f'input "{name}": expression {e} uses {sorted(bad)}; input expressions '
@@ -173,7 +171,6 @@ class _Setup:
         self.tab_v = np.concatenate(tab_v) if tab_v else np.zeros(1)
         self.uexpr = (lambdify(system, {"u": SymMatrix.column(exprs)})
                       if np.any(self.u_kind == 2) else None)
-        allowed_ev = allowed | set(names)
         ev_exprs = []
         for ev in events:
             if not isinstance(ev, Event):
@@ -182,7 +179,7 @@ class _Setup:
                 e = as_expr(ev.expr, f"event {ev.label}")
             except JourdainError as exc:
                 raise EvaluationError(str(exc)) from None
-            bad = {str(s) for s in e.free_symbols} - allowed_ev
+            bad = {str(s) for s in e.free_symbols} - _allowed_symbols(system) - set(names)
             if bad:
                 raise EvaluationError(f"event {ev.label}: unknown symbol(s) {sorted(bad)}")
             if ev.direction not in (-1, 0, 1):
@@ -245,6 +242,13 @@ class _Setup:
             mask = self.u_kind[:nu] == 2
             U[:, mask] = ue[:, mask]
         return U
+
+
+def _allowed_symbols(system: System) -> set[str]:
+    """The names an input expression may use: t, coordinates, rates and parameters (formed
+    only where an expression is given: a run with numbers as inputs never needs them)."""
+    names = system.coordinate_names
+    return {"t", *names, *(f"{n}_d" for n in names), *(k for k, _ in system.parameters)}
 
 
 def _takes_state(fn: Callable[..., Any]) -> bool:

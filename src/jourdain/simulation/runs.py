@@ -81,29 +81,35 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
     f = system.f
     n = 2 * f + 1
     nev = len(setup.events)
-    st = np.array([t0, 0.0, 0.0, 0.0])  # t, step size, last trial rejected, last error
-    x = x0.copy()
-    k0 = np.zeros(n)
-    g_old = np.zeros(max(nev, 1))
-    cnt = np.zeros(5, dtype=np.int_)
-    i_eval = np.zeros(1, dtype=np.int_)
-    n_out = np.zeros(1, dtype=np.int_)
-    n_ev = np.zeros(1, dtype=np.int_)
-    fail = np.zeros(n + 1)
     ev_cap = 100000 if nev else 1  # crossings recorded (the message says if more were dropped)
+    # the loop's state and counters in one buffer of doubles and one of C longs, their
+    # addresses computed from two (a run's set-up is counted in microseconds)
+    dbl = np.zeros(4 + 3 * n + 1 + max(nev, 1))
+    # st (t, h, last trial rejected, last error), x, k0 (the derivative at x), fail, g_old
+    st, x, fail = dbl[0:4], dbl[4:4 + n], dbl[4 + 2 * n:5 + 3 * n]
+    st[0] = t0
+    x[:] = x0
+    ints = np.zeros(8 + ev_cap, dtype=np.int_)
+    # cnt (5), i_eval, n_out, n_ev, ev_i (ev_cap)
+    cnt, n_out, n_ev, ev_i = ints[0:5], ints[6:7], ints[7:8], ints[8:]
+    a_dbl, a_int, di = _ptr(dbl) or 0, _ptr(ints) or 0, ints.itemsize
+    p_st, p_x, p_k0, p_fail, p_g = (a_dbl + 8 * o for o in (0, 4, 4 + n, 4 + 2 * n, 5 + 3 * n))
+    p_cnt, p_ieval, p_nout, p_nev, p_evi = (a_int + di * o for o in (0, 5, 6, 7, 8))
     ev_t = np.empty(ev_cap)
     ev_x = np.empty((ev_cap, n))
-    ev_i = np.empty(ev_cap, dtype=np.int_)
+    p_evt, p_evx = _ptr(ev_t), _ptr(ev_x)
     if te is not None:
         cap = te.size
-        out_t = np.empty(cap)
-        out_x = np.empty((cap, n))
-        out_dx = np.empty((cap, n))
+        out = np.empty(cap * (1 + 2 * n))
+        out_t, out_x = out[:cap], out[cap:cap * (1 + n)].reshape(cap, n)
+        out_dx = out[cap * (1 + n):].reshape(cap, n)
+        a_out = _ptr(out) or 0
+        p_te, n_te = _ptr(te), te.size
     chunks_t: list[np.ndarray] = []
     chunks_x: list[np.ndarray] = []
     chunks_dx: list[np.ndarray] = []
     if te is None:
-        cap = 1024
+        cap, p_te, n_te = 1024, None, 0
     writer = (_Writer(output, system)
               if output and str(output).lower().endswith(OUTPUT_SUFFIXES) else None)
     status = "finished"
@@ -122,32 +128,45 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
     max_steps = steps_per_call(f)
     t_last_report = time.perf_counter()
     # Ctrl-C sets a flag that is looked at between calls of the C loop, so it never lands in
-    # the middle of bookkeeping; a second Ctrl-C raises at once
+    # the middle of bookkeeping; a second Ctrl-C raises at once. Without Python input functions
+    # the handler is installed after the first call, and only when the run goes on: no Python
+    # runs during that call, so Python's own handler does the same (KeyboardInterrupt as the
+    # call returns, its chunk kept below), and a run done in one call (most runs of ordinary
+    # length) saves the two signal() calls. An input function is Python called from the loop,
+    # where Python's handler would raise: then the handler comes first.
     interrupted = [False]
     old_handler = None
-    if threading.current_thread() is threading.main_thread():
-        def on_sigint(signum: int, frame: Any) -> None:
-            if interrupted[0]:
-                raise KeyboardInterrupt
-            interrupted[0] = True
+    handler_due = threading.current_thread() is threading.main_thread()
 
+    def on_sigint(signum: int, frame: Any) -> None:
+        if interrupted[0]:
+            raise KeyboardInterrupt
+        interrupted[0] = True
+
+    def install() -> None:
+        nonlocal handler_due, old_handler
+        handler_due = False
         try:
             old_handler = signal.signal(signal.SIGINT, on_sigint)
         except ValueError:  # not the main interpreter
             old_handler = None
+
+    problem = ctypes.byref(setup.problem)
     try:
+        if handler_due and setup.callables:
+            install()
         while True:
             if te is None:
-                out_t = np.empty(cap)
-                out_x = np.empty((cap, n))
-                out_dx = np.empty((cap, n))
+                out = np.empty(cap * (1 + 2 * n))
+                out_t, out_x = out[:cap], out[cap:cap * (1 + n)].reshape(cap, n)
+                out_dx = out[cap * (1 + n):].reshape(cap, n)
+                a_out = _ptr(out) or 0
                 n_out[0] = 0
             id_chunk += 1
             code = lib.jd_integrate(
-                ctypes.byref(setup.problem), t1, _ptr(st), _ptr(x), _ptr(k0), _ptr(g_old),
-                _ptr(cnt), _ptr(te), 0 if te is None else te.size, _ptr(i_eval), _ptr(out_t),
-                _ptr(out_x), _ptr(out_dx), cap, _ptr(n_out), _ptr(ev_t), _ptr(ev_x), _ptr(ev_i),
-                ev_cap, _ptr(n_ev), max_steps, _ptr(fail))
+                problem, t1, p_st, p_x, p_k0, p_g, p_cnt, p_te, n_te, p_ieval, a_out,
+                a_out + 8 * cap, a_out + 8 * cap * (1 + n), cap, p_nout, p_evt, p_evx, p_evi,
+                ev_cap, p_nev, max_steps, p_fail)
             if te is None:
                 _keep_chunk()
                 if writer:
@@ -171,6 +190,8 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
                 break
             if code == _DONE:
                 break
+            if handler_due:
+                install()
             if interrupted[0]:
                 raise KeyboardInterrupt
             now = time.perf_counter()

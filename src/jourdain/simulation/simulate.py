@@ -44,7 +44,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import EvaluationError
-from ..numeric import CompiledFunction, mkq_function, parameter_vector
+from ..numeric import CompiledFunction, _vector, mkq_function, parameter_vector
 from .options import (  # noqa: F401 - the import paths of the options stay those of this module
     ATOL_MAX,
     C_METHODS,
@@ -146,12 +146,10 @@ def simulate(system: System, t_span: tuple[float, float], y0: Any, yd0: Any,
     EvaluationError
         bad arguments (wrong sizes, NaN initial values, unknown names).
     """
-    from ..numeric import _vector
-
     f = system.f
     t0, t1 = check_t_span(t_span)
-    yv = _vector(y0, f, "y0", system.coordinate_names)
-    ydv = _vector(yd0, f, "yd0", [f"{n}_d" for n in system.coordinate_names])
+    yv = _initial(y0, f, "y0", system, "")
+    ydv = _initial(yd0, f, "yd0", system, "_d")
     method = check_method(method)
     rtol = check_rtol(rtol)
     a = check_atol(atol, 2 * f)
@@ -188,6 +186,16 @@ def simulate(system: System, t_span: tuple[float, float], y0: Any, yd0: Any,
                                                              KeyboardInterrupt):
         raise run["exception"]
     return res
+
+
+def _initial(x: Any, f: int, what: str, system: System, suffix: str) -> np.ndarray:
+    """An initial vector of ``f`` finite numbers; the names of the coordinates are formed only
+    for the message of a bad one."""
+    if isinstance(x, np.ndarray) and x.dtype == np.float64 and x.size == f:
+        v = x.reshape(-1)
+        if np.isfinite(v).all():
+            return v
+    return _vector(x, f, what, [f"{n}{suffix}" for n in system.coordinate_names])
 
 
 def _results(setup: _Setup, run: dict, method: str, rtol: float, atol: np.ndarray,
