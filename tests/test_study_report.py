@@ -114,6 +114,7 @@ def test_jourdain_run_with_a_study(tmp_path: Path, capsys: pytest.CaptureFixture
     spec_file.write_text(MAP.replace(f'model = "{MODEL}"\n', ""))  # the model: the report's
     out = tmp_path / "report"
     assert main(["run", str(MODEL), "--out", str(out), "--study", str(spec_file)]) == 0
+    printed = capsys.readouterr().out
     page = (out / "report.html").read_text()
     assert "Parameter study: whirl map" in page
     assert page.index("Parameter study") > page.index("<h2>5.")  # after the simulation
@@ -126,6 +127,8 @@ def test_jourdain_run_with_a_study(tmp_path: Path, capsys: pytest.CaptureFixture
     mr = ds.max_real_part.values
     assert _row(page, "max_real_part")[1:4] == [f"{mr.min():.6g}", f"{mr.mean():.6g}",
                                                 f"{mr.max():.6g}"]
+    unstable = int((ds.verdict.values == 2).sum())
+    assert f"study whirl map: 48 cases (grid), {unstable} unstable; results in study.nc" in printed
     # a study file with a mistake stops the command before the report, naming the file
     bad = tmp_path / "bad.toml"
     bad.write_text('[study]\ndesign = "sobol"\n[compute.linearize]\n')

@@ -124,6 +124,12 @@ def study_section(study: Any, out: str | Path, info: Any = None, *, model: Any =
         return f"<h2>Parameter study</h2><p class='bad'>{esc(msg)}</p>"
     if info is not None:
         info.files += [out / "study.nc", *paths]
+        failed = int(ds.attrs.get("n_failed", 0))
+        line = f"  study {spec.name}: {spec.n_cases} cases ({spec.design})"
+        if "verdict" in ds:
+            line += f", {int((ds.verdict.values == 2).sum())} unstable"
+        getattr(info, "summary_lines", []).append(
+            line + (f", {failed} failed" if failed else "") + "; results in study.nc")
     title = esc(str(spec.name))
     return (f"<h2 id='study'>Parameter study: {title}</h2>{_describe(spec, ds)}"
             f"<h3>Outputs</h3>{_summary_html(ds)}{_figures_html(paths)}"
