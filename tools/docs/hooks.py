@@ -3,6 +3,8 @@
 * Links from a page under docs/ to a file of the repository's examples/ folder
   (``../examples/view_robot_arm.py``, right on GitHub) point at the copy that
   tools/docs/gen_pages.py puts into the site (``examples/view_robot_arm.py``).
+* The navigation files of mkdocs-literate-nav (``SUMMARY.md`` of the generated reference and
+  gallery) are read for the navigation only, not built as pages of their own.
 * The site must load nothing from the network. The notebook template of mkdocs-jupyter adds
   MathJax and Mermaid from a CDN to every tutorial page; the tutorials use neither (no LaTeX
   output, no diagrams), so both blocks are removed. Any other script, style sheet, font or
@@ -37,6 +39,16 @@ _REMOTE_LOAD = re.compile(
     r"""|import\(\s*["'](?:https?:)?//""",
     re.I,
 )
+
+
+def on_nav(nav: Any, config: Any, files: Any) -> Any:
+    """Leave the literate-nav files (read by then) out of the build."""
+    from mkdocs.structure.files import InclusionLevel  # the build's own package
+
+    for file in files.documentation_pages():
+        if file.src_uri.endswith("/SUMMARY.md"):
+            file.inclusion = InclusionLevel.EXCLUDED
+    return nav
 
 
 def on_page_markdown(markdown: str, page: Any, config: Any, files: Any) -> str:
