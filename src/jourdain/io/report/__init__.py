@@ -17,11 +17,10 @@ command line is :mod:`jourdain.workflow`.
 
 from .document import write_report
 from .equations import MAX_DISPLAY_ROWS, REPORT_SIMPLIFY_SECONDS
-from .figures import svg as _svg
 from .linearization import floquet_html as _floquet_html
 from .simulation import wrench_section as _wrench_section
 from .state import RUN_FORMAT, ReportInfo, model_copy, report_files
 
 __all__ = ["write_report", "ReportInfo", "RUN_FORMAT", "model_copy", "report_files",
-           "MAX_DISPLAY_ROWS", "REPORT_SIMPLIFY_SECONDS", "_svg", "_floquet_html",
+           "MAX_DISPLAY_ROWS", "REPORT_SIMPLIFY_SECONDS", "_floquet_html",
            "_wrench_section"]

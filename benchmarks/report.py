@@ -1,0 +1,119 @@
+"""``jourdain run`` time per example (issue 13: at most 2 s each, every example).
+
+Each example of ``examples/`` (every ``.toml`` and ``.urdf``; none excluded) is reported by
+``jourdain run EXAMPLE --out DIR --force`` in a fresh Python process, timed from the start of
+the process to its exit (imports included), in two states of the compile cache:
+
+- **empty**: a new, empty ``JOURDAIN_CACHE`` for each repetition (C code generated and
+  compiled, the report's symbolic display computed);
+- **warm**: the same cache after a first run (what a user sees the second time; the compiled
+  libraries and the display are read from the cache).
+
+Reported per example: the best of ``--repeat`` runs in each state (the machine is shared: the
+best is the least disturbed), its exit status, and the ratio of the warm time to the 2 s
+target; then the worst example of each state. Before the timings, one untimed run writes the
+bytecode of every module imported (a fresh checkout's first run compiles them). The floor of
+every run, ``python -c "import jourdain.cli"``, is timed the same way and printed first.
+
+Usage::
+
+    python benchmarks/report.py                       # every example, 3 repetitions
+    python benchmarks/report.py --repeat 1 --only double_pendulum robot_arm
+    python benchmarks/report.py --json times.json
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+from typing import Any
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLES = ROOT / "examples"
+#: issue 13: seconds per example
+TARGET_SECONDS = 2.0
+
+
+def examples(only: list[str] | None) -> list[Path]:
+    """Every model file of ``examples/`` (``--only``: those whose stem is named)."""
+    found = sorted(p for p in EXAMPLES.iterdir() if p.suffix in (".toml", ".urdf"))
+    if only:
+        missing = set(only) - {p.stem for p in found}
+        if missing:
+            raise SystemExit(f"--only: no example {', '.join(sorted(missing))} in {EXAMPLES}")
+        found = [p for p in found if p.stem in only]
+    return found
+
+
+def timed(cmd: list[str], cache: Path) -> tuple[float, int, str]:
+    """Seconds from the start of ``cmd`` to its exit, its exit status and its last line of
+    error output (the process's own compile cache ``cache``)."""
+    env = {**os.environ, "JOURDAIN_CACHE": str(cache), "PYTHONPATH": str(ROOT / "src")}
+    t0 = time.perf_counter()
+    proc = subprocess.run(cmd, env=env, capture_output=True, text=True, check=False)
+    wall = time.perf_counter() - t0
+    err = (proc.stderr.strip().splitlines() or [""])[-1]
+    return wall, proc.returncode, err
+
+
+def run_cmd(model: Path, out: Path) -> list[str]:
+    return [sys.executable, "-m", "jourdain.cli", "run", str(model), "--out", str(out),
+            "--force"]
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--repeat", type=int, default=3, help="runs per example and state")
+    ap.add_argument("--only", nargs="*", help="example names (file stems)")
+    ap.add_argument("--json", help="write the times to this file")
+    args = ap.parse_args()
+    models = examples(args.only)
+    rows: list[dict[str, Any]] = []
+    with tempfile.TemporaryDirectory(prefix="jd-bench-report-") as tmp:
+        base = Path(tmp)
+        # bytecode of every module a run imports, written once, untimed
+        timed(run_cmd(models[0], base / "warmup"), base / "warmup-cache")
+        floor = min(timed([sys.executable, "-c", "import jourdain.cli"], base / "c")[0]
+                    for _ in range(args.repeat))
+        print(f"python {sys.version.split()[0]}, {os.cpu_count()} cores; best of "
+              f"{args.repeat}; target {TARGET_SECONDS:g} s per example")
+        print(f"floor: python -c 'import jourdain.cli': {floor:.2f} s\n")
+        print(f"{'example':<28} {'empty cache':>12} {'warm cache':>11} {'warm/target':>12}")
+        for k, model in enumerate(models):
+            out = base / f"out{k}"
+            empty, warm = [], []
+            status: list[tuple[int, str]] = []
+            for r in range(args.repeat):
+                cache = base / f"cache{k}-{r}"
+                wall, rc, err = timed(run_cmd(model, out), cache)  # empty cache
+                empty.append(wall)
+                status.append((rc, err))
+                wall, rc, err = timed(run_cmd(model, out), cache)  # the same cache, warm
+                warm.append(wall)
+                status.append((rc, err))
+            bad = [(rc, err) for rc, err in status if rc != 0]
+            row: dict[str, Any] = {"example": model.name, "empty_s": min(empty), "warm_s": min(warm),
+                   "exit": bad[0][0] if bad else 0, "error": bad[0][1] if bad else ""}
+            rows.append(row)
+            flag = "" if not bad else f"   exit {bad[0][0]}: {bad[0][1][:60]}"
+            print(f"{model.name:<28} {row['empty_s']:>10.2f} s {row['warm_s']:>9.2f} s "
+                  f"{row['warm_s'] / TARGET_SECONDS:>11.2f}×{flag}", flush=True)
+    worst_empty = max(rows, key=lambda r: r["empty_s"])
+    worst_warm = max(rows, key=lambda r: r["warm_s"])
+    print(f"\nworst, empty cache: {worst_empty['example']} {worst_empty['empty_s']:.2f} s "
+          f"({worst_empty['empty_s'] / TARGET_SECONDS:.2f}× the target)")
+    print(f"worst, warm cache:  {worst_warm['example']} {worst_warm['warm_s']:.2f} s "
+          f"({worst_warm['warm_s'] / TARGET_SECONDS:.2f}× the target)")
+    if args.json:
+        Path(args.json).write_text(json.dumps({"floor_s": floor, "examples": rows}, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
