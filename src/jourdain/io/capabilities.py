@@ -15,7 +15,12 @@ from typing import Any
 import numpy as np
 import symengine as se
 
+from ..analysis.cyclic import cyclic_coordinates
+from ..analysis.floquet import floquet
 from ..errors import EvaluationError
+from ..simulation.simulate import check_samples, check_t_end
+from ..stages.linearization import NominalMotionWarning
+from .export import format_array
 from .modelfile import ModelFile, NominalMotion
 
 T = se.Symbol("t")
@@ -59,8 +64,6 @@ def linearization_at(model: ModelFile, y: Any, yd: Any, t: float,
                      ) -> dict[str, np.ndarray]:
     """``M_tilde, P, Q, h`` about the state (y, ẏ) at time t (nominal ÿ_s = 0), and ``D, G, K,
     N``, the symmetric and skew parts of P and Q at that instant."""
-    from ..stages.linearization import NominalMotionWarning
-
     system = model.system
     with warnings.catch_warnings():
         # any state, not a claimed equilibrium: h = M·ÿ there is expected
@@ -94,8 +97,6 @@ def linear_analysis(model: ModelFile, about: str | None,
     The warnings of a nominal motion that is not a solution are not issued here: they are in
     ``nominal_check`` and the stability verdict, which the text and the report show.
     """
-    from ..stages.linearization import NominalMotionWarning
-
     system = model.system
     nominal = model.nominal_motion(about)
     params = dict(parameters or {}) or None
@@ -110,8 +111,6 @@ def linear_analysis(model: ModelFile, about: str | None,
     if period is None:
         period = nominal.period
     if period is not None:
-        from ..analysis.floquet import floquet
-
         res["floquet"] = floquet(lin, period_value(system, period, params), t0=t,
                                  parameters=params, cyclic=res["cyclic"])
     return res
@@ -133,8 +132,6 @@ def period_value(system: Any, period: Any, parameters: Mapping[str, float] | Non
 
 def _analyse(lin: Any, num: dict[str, np.ndarray], check: Any,
              params: Mapping[str, float] | None, t: float) -> dict[str, Any]:
-    from ..analysis.cyclic import cyclic_coordinates
-
     res: dict[str, Any] = {"linearization": lin, "numbers": num, "nominal_check": check,
                            "time_invariant": lin.is_time_invariant, "t": t,
                            "h_norm": float(np.abs(num["h"]).max(initial=0.0)),
@@ -226,14 +223,12 @@ def cyclic_text(cyclic: Any) -> str:
             "without their positions)")
 
 
-def _finite_list(a: np.ndarray) -> list[float | None]:
+def _finite_list(a: Any) -> list[float | None]:
     return [float(x) if np.isfinite(x) else None for x in np.asarray(a, float)]
 
 
 def linear_text(res: Mapping[str, Any]) -> str:
     """A plain-text account of :func:`linear_analysis`."""
-    from .export import format_array
-
     lin = res["linearization"]
     num = res["numbers"]
     nominal = res["nominal"]
@@ -293,8 +288,6 @@ def simulate(model: ModelFile, parameters: Mapping[str, float] | None = None,
     to :func:`jourdain.simulation.simulate.simulate`. The options are checked against the bounds of
     :mod:`jourdain.simulation.simulate` before anything is computed (:class:`EvaluationError`).
     """
-    from ..simulation.simulate import check_samples, check_t_end
-
     system = model.system
     sim = model.simulation
     t1 = check_t_end(t_end if t_end is not None else sim.t_end)

@@ -14,6 +14,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
 import symengine as se
 
 from ..graph import cse as graph_cse
@@ -324,8 +325,6 @@ ROUNDOFF_RTOL = 1e-10
 def chop(values: Any, scale: Any = None, rtol: float = ROUNDOFF_RTOL) -> Any:
     """``values`` (an array) with entries ``|x| ≤ rtol·max|scale|`` set to 0 (``scale``
     defaults to ``values``; NaN and inf are kept); ``-0.0`` becomes ``0.0``."""
-    import numpy as np
-
     a = np.array(values, dtype=float)
     ref = np.abs(np.asarray(a if scale is None else scale, dtype=float))
     ref = ref[np.isfinite(ref)]
@@ -338,14 +337,10 @@ def chop(values: Any, scale: Any = None, rtol: float = ROUNDOFF_RTOL) -> Any:
 def format_array(values: Any, scale: Any = None) -> str:
     """A matrix or vector for text output: round-off shown as 0 (:func:`chop`), 6 significant
     digits."""
-    import numpy as np
-
     return np.array2string(chop(values, scale), precision=6, suppress_small=True,
                            max_line_width=120, threshold=10_000)
 
 
 def nested(values: Iterable[Any]) -> Sequence[Any]:
     """NumPy arrays (or nested sequences) to lists of floats for JSON."""
-    import numpy as np
-
     return np.asarray(values, dtype=float).tolist()

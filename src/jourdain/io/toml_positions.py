@@ -42,6 +42,12 @@ _INLINE_KEY = re.compile(r"([A-Za-z0-9_-]++)[ \t]*+=")
 _ELEMENT = re.compile(_SCALAR)
 
 
+def _end(rx: re.Pattern[str], s: str, i: int) -> int:
+    """Where ``rx`` (a pattern that may match nothing) stops matching at ``i``."""
+    m = rx.match(s, i)
+    return i if m is None else m.end()
+
+
 class _Scanner:
     def __init__(self, text: str, max_depth: int | None = None) -> None:
         self.s = text
@@ -69,9 +75,9 @@ class _Scanner:
 
     def skip_ws(self, newlines: bool) -> None:
         if newlines:
-            self.i = _SPACE.match(self.s, self.i).end()
+            self.i = _end(_SPACE, self.s, self.i)
         else:
-            self.i = _INLINE_SPACE.match(self.s, self.i).end()
+            self.i = _end(_INLINE_SPACE, self.s, self.i)
             if self.i < self.n and self.s[self.i] == "#":
                 end = self.s.find("\n", self.i)
                 self.i = self.n if end < 0 else end
@@ -81,8 +87,11 @@ class _Scanner:
         q = self.s[self.i]
         opener = q * 3 if self.s.startswith(q * 3, self.i) else q
         m = _STRINGS[opener].match(self.s, self.i)
-        self.i = m.end()
-        return m.group()[len(opener):].rstrip(q)
+        if m is None:  # an unterminated multi-line string runs to the end of the file
+            text, self.i = self.s[self.i:], self.n
+        else:
+            text, self.i = m.group(), m.end()
+        return text[len(opener):].rstrip(q)
 
     def key(self) -> tuple[str, ...]:
         """A dotted key; stops before '=' or ']'."""
@@ -186,7 +195,7 @@ class _Scanner:
                 elif c in ('"', "'"):
                     self.string()
                 else:
-                    self.i = _BARE_VALUE.match(self.s, self.i).end()
+                    self.i = _end(_BARE_VALUE, self.s, self.i)
                 start = False
             if not stack:
                 return

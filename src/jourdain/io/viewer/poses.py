@@ -11,6 +11,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ...errors import EvaluationError, ModelError
+from ...numeric import lambdify
+from ...stages.kinematics import joint_motions
+from ...symbolic import SymMatrix
 
 if TYPE_CHECKING:
     from ...model.system import System
@@ -27,10 +30,6 @@ def pose_function(system: System) -> Any:
     expressions, one joint each: cheap to compile however deep the tree (composing the poses
     symbolically, as ``kinematics().bodies[i].S`` does, costs seconds of compilation for a chain
     of 60 bodies)."""
-    from ...numeric import lambdify
-    from ...stages.kinematics import joint_motions
-    from ...symbolic import SymMatrix
-
     mats = {}
     for i, jm in enumerate(joint_motions(system)):
         mats[f"A{i}"] = SymMatrix.from_rows([list(row) for row in jm.A])

@@ -12,6 +12,7 @@ import numpy as np
 
 from ...errors import EvaluationError, ModelError
 from ...model.expressions import values_at
+from ...model.forces import Gravity, SpringDamper
 
 if TYPE_CHECKING:
     from ...model.system import System
@@ -81,8 +82,6 @@ def _vec(exprs: Sequence[Any], values: Mapping[str, float], where: str) -> np.nd
 
 
 def _up(system: System, values: Mapping[str, float]) -> np.ndarray:
-    from ...model.forces import Gravity
-
     for f in system.forces:
         if isinstance(f, Gravity):
             g = np.array(values_at(f.vector, values), float)
@@ -187,8 +186,6 @@ def scene(results: Results, visuals: Any = None,
     world_visuals = _visual_specs("world", visuals.get("world", []), notes, budget)
 
     springs = []
-    from ...model.forces import SpringDamper
-
     for f in system.forces:
         if isinstance(f, SpringDamper):
             springs.append({"name": f.name, "body_a": f.body_a, "body_b": f.body_b,
