@@ -63,7 +63,9 @@ def ldl_source(f: int) -> str:
         for i in range(j + 1, f):  # forward substitution L z = b, column j
             out.append(f"    b{i} -= l{i}_{j} * b{j};")
     for i in range(f - 1, -1, -1):  # back substitution D Lᵀ ÿ = z
-        terms = "".join(f" - l{m}_{i} * x{m}" for m in range(i + 1, f))
+        # the terms of the unknowns found last come last: x_i waits one multiply-add for
+        # x_{i+1}, not the whole sum
+        terms = "".join(f" - l{m}_{i} * x{m}" for m in range(f - 1, i, -1))
         out.append(f"    const double x{i} = b{i} * r{i}{terms};")
         out.append(f"    ydd[{i}] = x{i};")
     out.append("    return " + " && ".join(f"isfinite(x{i})" for i in range(f)) + " ? 0 : 2;")
