@@ -217,6 +217,32 @@ def monte_carlo(n: int, repeat: int = 3) -> dict:
         t, _ = _best(lambda threads=threads: ctx.ensemble.run(P, Y, YD, threads=threads),
                      repeat)
         out[f"c_only_{threads}_s"] = t
+    # what a lock-step ensemble (one vectorized right-hand side for all cases per stage) could
+    # speed up at most: the model's M, k, q, here timed in one C loop over many states, times
+    # the number of evaluations the runs made; the rest of the C time is each case's own step
+    # loop (stage sums, error norm, step control, dense output), which lock-step keeps
+    from jourdain.numeric import mkq_function
+
+    nfev = int(ctx.ensemble.run(P, Y, YD).nfev.sum())
+    mkq = mkq_function(ctx.system)
+    rng = np.random.default_rng(0)
+    # 2 000 states per call (in cache, the output array reused), 50 calls: the C loop's cost
+    # per state, the call's own overhead (40 µs) spread over the states
+    m, calls, f, n_u = 2000, 50, ctx.system.f, len(ctx.system.inputs)
+    Ys, YDs = rng.normal(0, 0.02, (m, f)), rng.normal(0, 0.2, (m, f))
+    Ps = P[rng.integers(0, n, m)]
+    Us = rng.normal(0, 0.02, (m, n_u)) if n_u else None
+    buf = np.empty((m, mkq.size))
+
+    def mkq_calls() -> None:
+        for _ in range(calls):
+            mkq.batch(Ys, YDs, 1.0, Ps, Us, out=buf)
+
+    t_mkq, _ = _best(mkq_calls, 5 * repeat)
+    per_state = t_mkq / (calls * m)
+    out.update(nfev_total=nfev, mkq_ns=per_state * 1e9,
+               c_ns_per_evaluation=out["c_only_1_s"] / nfev * 1e9,
+               mkq_share_of_c=per_state * nfev / out["c_only_1_s"])
     out["ensemble_vs_per_case_1"] = out["per_case_1_s"] / out["ensemble_1_s"]
     out["ensemble_vs_per_case_2"] = out["per_case_2_processes_s"] / out["ensemble_2_threads_s"]
     out["per_case_1_to_2"] = out["per_case_1_s"] / out["per_case_2_processes_s"]
@@ -320,6 +346,10 @@ def _print_mc(c: dict) -> None:
           f"integration alone: {c['c_only_1_s']:.2f} s on 1 thread, {c['c_only_2_s']:.2f} s "
           f"on 2 ({100 * c['c_share_of_ensemble_1']:.0f} % of the 1-worker ensemble study); "
           f"max |z_b| {c['max_abs_z_b_mean_mm']:.2f} ± {c['max_abs_z_b_std_mm']:.2f} mm")
+    print(f"  lock-step bound: {c['nfev_total']} right-hand sides, {c['c_ns_per_evaluation']:.0f} ns "
+          f"of C integration each, of which the model's M, k, q {c['mkq_ns']:.0f} ns "
+          f"({100 * c['mkq_share_of_c']:.0f} %: what one vectorized right-hand side over the "
+          f"cases could speed up; each case's step loop remains)")
     if "dask_2_workers_s" in c:
         print(f"  ensembles on a Dask LocalCluster (warm): 1 worker {c['dask_1_workers_s']:.2f} s, "
               f"2 workers {c['dask_2_workers_s']:.2f} s: {c['dask_speedup']:.2f}x (identical: "
