@@ -77,7 +77,8 @@ def test_ensemble_refuses_what_it_cannot_run_in_c() -> None:
         ens.run(np.zeros((2, 3)), np.zeros((2, 2)), np.zeros((2, 2)))
 
 
-def test_study_with_ensembles_equals_one_run_per_case(tmp_path: Path) -> None:
+def test_study_with_ensembles_equals_one_run_per_case(tmp_path: Path,
+                                                      monkeypatch: pytest.MonkeyPatch) -> None:
     body = f"""[study]
 model = "{CAR}"
 design = "random"
@@ -112,6 +113,13 @@ method = "RK45"
     c = run_study(together, workers=2, pool="threads", quiet=True)
     for name in ("series_z_b", "final"):
         assert np.array_equal(a[name].values, c[name].values), name
+    # a block's runs in several ensemble calls (3 runs each: memory bounded) give the same
+    import jourdain.study.motion as motion
+
+    monkeypatch.setattr(motion, "ENSEMBLE_BYTES", 3 * 8 * 61 * 5)
+    e = run_study(together, workers=1, quiet=True)
+    for name in ("series_z_b", "final", "max_z_w"):
+        assert np.array_equal(a[name].values, e[name].values), name
     # the command line: 2 threads asked for, the NetCDF file the same
     from jourdain.cli import main
     from jourdain.study import open_study

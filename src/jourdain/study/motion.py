@@ -14,7 +14,11 @@ import numpy as np
 from .context import FAILURES, Context, record_errors
 from .spec import StudyError
 
-__all__ = ["evaluate_block", "simulate_block"]
+__all__ = ["ENSEMBLE_BYTES", "evaluate_block", "simulate_block"]
+
+#: the most memory the motions of one ensemble call take (a block's runs with many samples
+#: are integrated in several calls)
+ENSEMBLE_BYTES = 256 * 2**20
 
 
 def evaluate_block(ctx: Context, P: np.ndarray, Y: np.ndarray, YD: np.ndarray, ok: np.ndarray,
@@ -80,10 +84,17 @@ def simulate_block(ctx: Context, P: np.ndarray, Y: np.ndarray, YD: np.ndarray, o
     coords = ctx.system.coordinate_names
     alone = idx
     if ctx.ensemble is not None:
-        run = ctx.ensemble.run(P[idx], Y[idx], YD[idx])
-        for k in np.flatnonzero(run.ok):
-            _store(out, s, int(idx[k]), run.y[k], run.yd[k], coords)
-        alone = idx[~run.ok]
+        # the runs' motions at all samples are held at once: at most ENSEMBLE_BYTES of them
+        per_case = 8 * s["samples"] * (2 * ctx.system.f + 1)
+        step = max(1, ENSEMBLE_BYTES // per_case)
+        failed = []
+        for a in range(0, idx.size, step):
+            part = idx[a:a + step]
+            run = ctx.ensemble.run(P[part], Y[part], YD[part])
+            for k in np.flatnonzero(run.ok):
+                _store(out, s, int(part[k]), run.y[k], run.yd[k], coords)
+            failed.append(part[~run.ok])
+        alone = np.concatenate(failed)
     for i in alone:
         _simulate_case(ctx, int(i), P, Y, YD, out, errors)
 
