@@ -121,8 +121,10 @@ int jd_integrate(const jd_problem *P, double t_end, double *st, double *x, doubl
             continue;
         }
         /* error estimate */
-        for (long i = 0; i < n; ++i)
-            sc[i] = P->atol[i] + P->rtol * fmax(fabs(x[i]), fabs(x_new[i]));
+        for (long i = 0; i < n; ++i) {  /* both finite here: a comparison, not fmax's call */
+            double a = fabs(x[i]), b = fabs(x_new[i]);
+            sc[i] = P->atol[i] + P->rtol * (a > b ? a : b);
+        }
         double en;
         if (P->method == 1) {
             double e5 = 0.0, e3 = 0.0, *a3v = xe;

@@ -89,8 +89,11 @@ static int rhs(jd_ctx *c, double t, const double *x, double *dx) {
     long f = P->f;
     const double *y = x, *yd = x + f;
     c->nfev++;
-    for (long i = 0; i < c->n; ++i) {
-        if (!isfinite(x[i])) goto nan;
+    {   /* every component finite: x·0 is 0 for finite x, NaN for inf or NaN (no branch per
+           component, so the loop vectorizes) */
+        double z = 0.0;
+        for (long i = 0; i < c->n; ++i) z += x[i] * 0.0;
+        if (z != 0.0) goto nan;
     }
     {
         int r = inputs(c, t, y, yd);
