@@ -9,7 +9,7 @@ equal sub-expressions built separately are one node) and walks it:
   the merged view; the C code generator (:mod:`jourdain.numeric.ccode`) walks the same view;
 * :mod:`.forward`: first derivatives at a point, symbolically (:func:`jet`);
 * :mod:`.numbers`: numbers and first derivatives in floating point (:func:`evaluate_float`,
-  :func:`jet_float`);
+  :func:`jet_float`), and numbers at many states at once (:func:`evaluate_arrays`);
 * :mod:`.identity`: which SymEngine wrappers hold the same node.
 
 Floor: model → **graph tools** → stages → numeric. The package imports nothing of jourdain but
@@ -19,10 +19,10 @@ Floor: model → **graph tools** → stages → numeric. The package imports not
 from .elimination import CSE, count_nodes, cse, graph_ops, node_ops, tree_ops
 from .forward import Jet, as_basic, jet
 from .nodes import Graph, Merged, atom_key
-from .numbers import FloatJet, evaluate_float, free_symbol_names, jet_float
+from .numbers import FloatJet, evaluate_arrays, evaluate_float, free_symbol_names, jet_float
 
 __all__ = [
     "CSE", "FloatJet", "Graph", "Jet", "Merged", "as_basic", "atom_key", "count_nodes", "cse",
-    "evaluate_float", "free_symbol_names", "graph_ops", "jet", "jet_float", "node_ops",
+    "evaluate_arrays", "evaluate_float", "free_symbol_names", "graph_ops", "jet", "jet_float", "node_ops",
     "tree_ops",
 ]

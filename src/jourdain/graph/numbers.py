@@ -1,8 +1,9 @@
 """Numbers of shared expression graphs: evaluation and first derivatives in floating point.
 
 :func:`evaluate_float` gives the numbers of some expressions for numbers of their symbols, and
-:func:`jet_float` their values and Jacobian (forward mode with dense NumPy gradients), each
-visiting every distinct node of the :class:`~jourdain.graph.Graph` once. For one evaluation this
+:func:`jet_float` their values and Jacobian (forward mode with dense NumPy gradients), and
+:func:`evaluate_arrays` their values at many states at once (NumPy arrays), each visiting every
+distinct node of the :class:`~jourdain.graph.Graph` once. For one evaluation this
 is faster than compiling; for many, compile (:func:`jourdain.numeric.lambdify`).
 
 Floor: graph tools (imports only this package and :mod:`jourdain.errors`).
@@ -13,11 +14,12 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import symengine as se
 
-from ..errors import JourdainError
+from ..errors import EvaluationError, JourdainError
 from .forward import needed_gradients, partials
 from .identity import Expr, no_gc
 from .nodes import Graph
@@ -205,3 +207,56 @@ def _jet_float(g: Graph, variables: Sequence[se.Symbol], values: Mapping[str, fl
         if gi is not None:
             out_j[i] = gi
     return FloatJet(out_v, out_j, frozenset(g.symbol_names()))
+
+
+# --- arrays ------------------------------------------------------------------------------------
+_NUMPY: dict[str, Callable[..., Any]] = {
+    "sin": np.sin, "cos": np.cos, "tan": np.tan, "exp": np.exp, "log": np.log, "Abs": np.abs,
+    "asin": np.arcsin, "acos": np.arccos, "atan": np.arctan, "sinh": np.sinh, "cosh": np.cosh,
+    "tanh": np.tanh, "sign": np.sign, "atan2": np.arctan2,
+}
+
+
+def evaluate_arrays(exprs: Sequence[Expr], values: Mapping[Expr, Any]) -> list[Any]:
+    """Values of ``exprs`` for symbol values ``values`` (symbol -> number or NumPy array,
+    broadcast), each node of the merged graph evaluated once (sums and products left to right
+    in the order of the node's arguments). A symbol without a value raises
+    :class:`EvaluationError`. Meant for checks at many random states at once (a joint's
+    directions, reference comparisons); the matrices of whole systems are evaluated by the
+    compiled code of :mod:`jourdain.numeric`."""
+    given = {k: np.asarray(v, dtype=float) for k, v in values.items()}
+
+    def atom(a: Expr) -> Any:
+        if isinstance(a, se.Symbol):
+            if a in given:
+                return given[a]
+            raise EvaluationError(f"no value for symbol {a}")
+        return float(a)
+
+    exprs = list(exprs)
+    m = Graph(exprs).merged()
+    val: dict[int, Any] = {}
+    for i in m.order:
+        args = [atom(a) if ia is None else val[ia]
+                for a, ia in zip(m.args[i], m.arg_ids[i], strict=True)]
+        val[i] = _apply_array(m.node[i], args)
+    return [atom(e) if r is None else val[r] for e, r in zip(exprs, m.root_ids, strict=True)]
+
+
+def _apply_array(node: Expr, args: list[Any]) -> Any:
+    name = type(node).__name__
+    if name == "Add":
+        r = args[0]
+        for x in args[1:]:
+            r = r + x
+        return r
+    if name == "Mul":
+        r = args[0]
+        for x in args[1:]:
+            r = r * x
+        return r
+    if name == "Pow":
+        return np.power(args[0], args[1])
+    if name in _NUMPY:
+        return _NUMPY[name](*args)
+    return np.vectorize(lambda *xs: float(node.func(*(se.Float(x) for x in xs))))(*args)

@@ -1,0 +1,283 @@
+"""Reaction forces in numbers (``docs/method.md`` §4): N̂, k̂, q̂ from the compiled M̄, Q̄, q̄^c,
+q̄^e (:func:`projected_reactions`), the solution of ``N̂·g = k̂ − q̂`` bordered with the rows
+without inertia, with undetermined components reported as NaN and by name (:func:`solve_g`),
+and the evaluation at one state (:func:`evaluate_reactions`) or for selected joints
+(:func:`joint_reactions`).
+
+Floor: the compiled code comes from :mod:`jourdain.numeric` (a floor above the stages), imported
+inside the functions that need it; moving this module up to the numeric floor is the remaining
+step of issue 16 for it (tests/test_architecture.py lists it as pending).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from functools import lru_cache
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import symengine as se
+
+from ...errors import EvaluationError, JourdainError, ModelError
+from ...model.bodies import WORLD
+from ...symbolic import SymMatrix
+from ..kinematics import kinematics
+from ..newton_euler import newton_euler
+from ..projection import projection  # the model has no stage methods (issue 16)
+
+if TYPE_CHECKING:
+    from ...model.system import System
+from .checks import _check_assembled, _checked_joints
+from .joints import JointReactions, Wrench, constrained_directions, joint_directions
+from .rows import _body_rows, _singular_rows
+from .subtree import _subtree_parts
+
+
+@dataclass(frozen=True)
+class ReactionLayout:
+    """What the numeric reactions need besides the compiled matrices: the joints with their
+    constrained directions, the names of g, the rows of M̄ without inertia, and per body the
+    columns of Q̄ that touch it (its joint's and its children's joints' directions)."""
+
+    joints: tuple[JointReactions, ...]
+    g_names: tuple[str, ...]
+    singular_rows: tuple[int, ...]
+    touching: tuple[tuple[int, ...], ...]
+
+
+@lru_cache(maxsize=32)
+def _reactions_function(system: System) -> tuple[ReactionLayout, Any]:
+    """The compiled Newton–Euler matrices with Q̄ (:func:`jourdain.numeric.recursive`), after
+    the joint-by-joint check and the check of the assembled J̄ᵀ·Q̄ = 0; ModelError when the
+    model's reactions cannot be formed."""
+    from ...numeric import _eom_function
+
+    joints = joint_directions(system)
+    _checked_joints(system)
+    fn = _eom_function(system)
+    index = _body_rows(system)
+    touching: list[list[int]] = [list(jr.columns) for jr in joints]
+    for b, jr in zip(system.bodies, joints, strict=True):
+        if b.parent != WORLD:
+            touching[index[b.parent]].extend(jr.columns)
+    lay = ReactionLayout(joints, tuple(n for jr in joints for n in jr.names),
+                         _singular_rows(system)[0], tuple(tuple(sorted(t)) for t in touching))
+    _check_assembled(system, joints, fn)
+    return lay, fn
+
+
+def check_reactions(system: System) -> None:
+    """The checks made before reaction forces are given in numbers: constrained directions
+    that can be formed, the joint-by-joint and the assembled orthogonality ``J̄ᵀ·Q̄ = 0``;
+    :class:`ModelError` naming the joint otherwise (no symbolic N̂ is formed)."""
+    _reactions_function(system)
+
+
+def projected_reactions(lay: ReactionLayout, M_bar: np.ndarray, Q_bar: np.ndarray,
+                        q_c: np.ndarray, q_e: np.ndarray
+                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``N̂ = Q̄_rᵀM̄_r⁻¹Q̄_r``, ``k̂ = Q̄_rᵀM̄_r⁻¹q̄^c_r``, ``q̂ = Q̄_rᵀM̄_r⁻¹q̄^e_r`` in numbers over
+    the regular rows r of M̄ (METHOD.md §4), for one state or a batch (leading axes).
+
+    M̄ is block diagonal, so the products are formed body by body from the few columns of Q̄
+    that touch each body (O(p) small products, never a 6p×6p solve); with the Cholesky factor
+    C of each block, ``N̂ += (C⁻¹Q̄_b)ᵀ(C⁻¹Q̄_b)``, so N̂ is exactly symmetric.
+    """
+    lead = Q_bar.shape[:-2]
+    n6, q = Q_bar.shape[-2:]
+    p = n6 // 6
+    singular = set(lay.singular_rows)
+    N = np.zeros((*lead, q, q))
+    kh = np.zeros((*lead, q))
+    qh = np.zeros((*lead, q))
+    for i in range(p):
+        cols = list(lay.touching[i])
+        if not cols:
+            continue
+        for base in (3 * i, 3 * p + 3 * i):
+            rows = [base + a for a in range(3) if base + a not in singular]
+            if not rows:
+                continue
+            Mb = M_bar[..., rows, :][..., :, rows]
+            C = np.linalg.cholesky(Mb)
+            B = np.linalg.solve(C, Q_bar[..., rows, :][..., :, cols])
+            bc = np.linalg.solve(C, q_c[..., rows, None])[..., 0]
+            be = np.linalg.solve(C, q_e[..., rows, None])[..., 0]
+            ix = np.ix_(cols, cols)
+            N[..., ix[0], ix[1]] += np.swapaxes(B, -1, -2) @ B
+            kh[..., cols] += np.einsum("...rc,...r->...c", B, bc)
+            qh[..., cols] += np.einsum("...rc,...r->...c", B, be)
+    return 0.5 * (N + np.swapaxes(N, -1, -2)), kh, qh
+
+
+def solve_g(Q_bar: np.ndarray, N_hat: np.ndarray, k_hat: np.ndarray, q_hat: np.ndarray,
+            q_c: np.ndarray, q_e: np.ndarray, singular_rows: Sequence[int],
+            names: Sequence[str] = ()) -> tuple[np.ndarray, list[str]]:
+    """Solve ``N̂·g = k̂ − q̂`` (Cholesky; N̂ symmetric positive definite), or with rows of
+    bodies without inertia the bordered system of the module docstring.
+
+    Returns ``g`` (NaN where undetermined) and the names of the undetermined components.
+    """
+    q = N_hat.shape[0]
+    rhs = k_hat - q_hat
+    s = list(singular_rows)
+    if not s:
+        try:
+            C = np.linalg.cholesky(N_hat)
+            return np.linalg.solve(C.T, np.linalg.solve(C, rhs)), []
+        except np.linalg.LinAlgError:
+            pass  # not positive definite: redundant directions; the general path says which
+    Qs = Q_bar[s, :]
+    K = np.block([[N_hat, Qs.T], [Qs, np.zeros((len(s), len(s)))]])
+    b = np.concatenate([rhs, q_c[s] - q_e[s]])
+    U, sv, Vt = np.linalg.svd(K)
+    tol = max(K.shape) * np.finfo(float).eps * (sv[0] if sv.size else 0.0) * 1e3
+    rank = int((sv > tol).sum())
+    x = Vt[:rank].T @ ((U[:, :rank].T @ b) / sv[:rank])
+    resid = np.abs(K @ x - b).max()
+    if resid > 1e-8 * max(1.0, np.abs(b).max(), np.abs(K).max() * np.abs(x).max()):
+        raise EvaluationError(
+            "the reaction equations have no solution at this state: applied or gyroscopic loads "
+            "on rows without inertia that no joint can balance (rows "
+            f"{[s[i - q] for i in range(q, q + len(s)) if abs((K @ x - b)[i]) > 1e-8]})"
+        )
+    g = x[:q].copy()
+    null = Vt[rank:, :q]
+    und = np.nonzero(np.abs(null).max(axis=0) > 1e-8)[0] if null.size else np.array([], int)
+    g[und] = np.nan
+    return g, [names[i] for i in und] if names else [str(i) for i in und]
+
+
+def evaluate_reactions(system: System, y: Any, yd: Any, t: float = 0.0,
+                       parameters: Mapping[str, float] | None = None,
+                       inputs: Mapping[str, float] | Sequence[float] | None = None,
+                       eom: Mapping[str, np.ndarray] | None = None) -> dict[str, Any]:
+    """Reaction forces at one state ``y, ẏ, t`` (no ÿ needed).
+
+    Returns a dict with ``Q_bar`` (6p×q), ``N_hat`` (q×q), ``k_hat``, ``q_hat``, ``g`` (q,
+    NaN where undetermined), ``g_names`` (list of str) and ``g_undetermined`` (list of the names
+    of undetermined components; empty for a well-posed model). ``eom``: the output of
+    :func:`jourdain.numeric.evaluate` at the same state, if already at hand.
+    """
+    from ...numeric import evaluate as evaluate_eom
+
+    lay, _ = _reactions_function(system)
+    if eom is None or "Q_bar" not in eom:
+        eom = evaluate_eom(system, y, yd, t=t, parameters=parameters, inputs=inputs)
+    Q = np.asarray(eom["Q_bar"])
+    qc, qe = np.asarray(eom["q_c"]).reshape(-1), np.asarray(eom["q_e"]).reshape(-1)
+    N, kh, qh = projected_reactions(lay, np.asarray(eom["M_bar"]), Q, qc, qe)
+    g, und = solve_g(Q, N, kh, qh, qc, qe, lay.singular_rows, lay.g_names)
+    # NaN marks undetermined components only; anything else not finite is an error
+    bad = [k for k, v in (("N_hat", N), ("k_hat", kh), ("q_hat", qh)) if not np.isfinite(v).all()]
+    determined = [i for i, n in enumerate(lay.g_names) if n not in und]
+    if not np.isfinite(g[determined]).all():
+        bad.append("g")
+    if bad:
+        raise EvaluationError(f"{', '.join(bad)} of {system.name!r} contain NaN or inf at this "
+                              "state (the reaction equations are not solvable in floating point "
+                              "here)")
+    return {"Q_bar": Q, "N_hat": N, "k_hat": kh, "q_hat": qh, "g": g,
+            "g_names": list(lay.g_names), "g_undetermined": und}
+
+
+@lru_cache(maxsize=64)
+def _joint_function(system: System, joints: tuple[str, ...]) -> tuple[list, Any]:
+    """Compiled M, k, q and, per joint, ``Eᵀ·W0``, ``Eᵀ·W_y`` and ``EᵀE`` (E: its constrained
+    directions), so that ``EᵀE·g_j = Eᵀ·(W0 + W_y·ÿ)``."""
+    from ...numeric import lambdify
+
+    eom = projection(newton_euler(kinematics(system)))
+    ne = eom.newton_euler
+    by_joint = {b.joint.name: b for b in system.bodies}
+    params = system.parameter_values
+    mats: dict[str, SymMatrix] = {"M": eom.M, "k": eom.k, "q": eom.q}
+    info = []
+    for k, name in enumerate(joints):
+        body = by_joint[name]
+        dirs = constrained_directions(body.joint, system.coordinates, params)
+        info.append((name, [sfx for sfx, _ in dirs]))
+        if not dirs:
+            continue
+        W0, Wy = _subtree_parts(ne, body.name)
+
+        def dot(w: Wrench, v: Wrench) -> se.Basic:
+            return se.Add(*(x * y for x, y in zip(w, v, strict=True) if x != 0 and y != 0))
+
+        mats[f"G0_{k}"] = SymMatrix.column([dot(w, W0) for _, w in dirs])
+        mats[f"Gy_{k}"] = SymMatrix.from_rows([[dot(w, Wj) for Wj in Wy] for _, w in dirs])
+        mats[f"EE_{k}"] = SymMatrix.from_rows([[dot(w, v) for _, v in dirs] for _, w in dirs])
+    return info, lambdify(system, mats)
+
+
+def joint_reactions(system: System, joints: str | Sequence[str], y: Any, yd: Any,
+                    t: float = 0.0, parameters: Mapping[str, float] | None = None,
+                    inputs: Mapping[str, float] | Sequence[float] | None = None
+                    ) -> dict[str, float]:
+    """Reaction components of the named joints only, without forming ``N̂`` or all of ``g``.
+
+    ÿ comes from the equations of motion; the residual ``M̄·J̄·ÿ + q̄^c − q̄^e`` of the sub-tree
+    each joint carries, moved to the joint point and the child frame, is the wrench ``W`` the
+    joint transmits, and ``EᵀE·g_j = Eᵀ·W`` gives its components along the joint's constrained
+    directions ``E``. Compiled once per system and set of joints (``M, k, q`` and, per joint,
+    ``Eᵀ·W`` split into its part without ÿ and its coefficients of ÿ).
+
+    Returns ``{"<joint>.<direction>": value}``; directions that others of the same joint repeat
+    share their force and come back as NaN (undetermined).
+    """
+    from ...numeric import state_vectors
+
+    if isinstance(joints, str):
+        joints = [joints]
+    by_joint = {b.joint.name: b for b in system.bodies}
+    for name in joints:
+        if name not in by_joint:
+            raise ModelError(f'unknown joint "{name}"; joints are: {", ".join(by_joint)}')
+    args = state_vectors(system, y, yd, t, parameters, inputs)
+    info, fn = _joint_function(system, tuple(joints))
+    out_ = fn(*args)
+    try:
+        ydd = np.linalg.solve(np.atleast_2d(out_["M"]), (out_["q"] - out_["k"]).reshape(-1))
+    except np.linalg.LinAlgError:
+        from ...errors import SingularMassMatrix
+
+        raise SingularMassMatrix("the mass matrix M is singular at this state") from None
+    out: dict[str, float] = {}
+    for k, (name, suffixes) in enumerate(info):
+        if not suffixes:
+            continue
+        rhs = out_[f"G0_{k}"].reshape(-1) + out_[f"Gy_{k}"] @ ydd
+        EE = out_[f"EE_{k}"]
+        gj, *_ = np.linalg.lstsq(EE, rhs, rcond=None)
+        # directions that the others repeat (a rank-deficient Gram matrix) share their force
+        _, sv, Vt = np.linalg.svd(EE)
+        null = Vt[int((sv > 1e-10 * sv[0]).sum()):]
+        if null.size:
+            gj[np.abs(null).max(axis=0) > 1e-8] = np.nan
+        for sfx, v in zip(suffixes, gj, strict=True):
+            out[f"{name}.{sfx}"] = float(v)
+    return out
+
+
+def evaluate_keys(system: System, y: Any, yd: Any, t: float, parameters: Any, inputs: Any,
+                  eom: Mapping[str, np.ndarray]) -> dict[str, Any]:
+    """The reaction entries of :meth:`System.evaluate`: ``Q_bar, N_hat, k_hat, q_hat, g,
+    g_names, g_undetermined`` and ``joint_wrenches`` (``{joint: JointWrench}``: force and
+    torque vectors in the joint frame and the inertial frame, :mod:`jourdain.wrenches`).
+
+    A model whose reactions cannot be formed (a joint moved by another joint's coordinate, a
+    symbolic joint axis, constrained directions that do work), or a state where they have no
+    solution (a load on a body without inertia that nothing balances), still has equations of
+    motion: then the only entry is ``reactions_error``, the message that
+    :func:`evaluate_reactions` raises, so that no reaction numbers appear for it.
+    """
+    try:
+        _reactions_function(system)
+        out = evaluate_reactions(system, y, yd, t, parameters, inputs, eom=eom)
+    except JourdainError as exc:
+        return {"reactions_error": str(exc)}
+    from ...wrenches import joint_wrenches
+
+    out["joint_wrenches"] = joint_wrenches(system, out["g"], y, yd, t, parameters)
+    return out
