@@ -14,11 +14,13 @@ import numpy as np
 from .context import FAILURES, Context, record_errors
 from .spec import StudyError
 
-__all__ = ["ENSEMBLE_BYTES", "evaluate_block", "simulate_block"]
+__all__ = ["ENSEMBLE_BYTES", "ENSEMBLE_CASES", "evaluate_block", "simulate_block"]
 
 #: the most memory the motions of one ensemble call take (a block's runs with many samples
 #: are integrated in several calls)
 ENSEMBLE_BYTES = 256 * 2**20
+#: the most runs of one ensemble call (a Ctrl-C waits for the call to end)
+ENSEMBLE_CASES = 64
 
 
 def evaluate_block(ctx: Context, P: np.ndarray, Y: np.ndarray, YD: np.ndarray, ok: np.ndarray,
@@ -84,9 +86,10 @@ def simulate_block(ctx: Context, P: np.ndarray, Y: np.ndarray, YD: np.ndarray, o
     coords = ctx.system.coordinate_names
     alone = idx
     if ctx.ensemble is not None:
-        # the runs' motions at all samples are held at once: at most ENSEMBLE_BYTES of them
+        # the runs' motions at all samples are held at once: at most ENSEMBLE_BYTES of them,
+        # and ENSEMBLE_CASES runs per call (Ctrl-C is seen between calls)
         per_case = 8 * s["samples"] * (2 * ctx.system.f + 1)
-        step = max(1, ENSEMBLE_BYTES // per_case)
+        step = max(1, min(ENSEMBLE_CASES, ENSEMBLE_BYTES // per_case))
         failed = []
         for a in range(0, idx.size, step):
             part = idx[a:a + step]
