@@ -173,7 +173,8 @@ def main() -> None:
              "with `jourdain run examples/<model> --out report/`: the pictures are the report's.",
              "", '<div class="grid cards" markdown>', ""]
     for title, page, thumb in entries:
-        index += [f"-   [**{title}**]({page})", "", f"    [![{title}]({thumb})]({page})", ""]
+        index += [f"-   [**{title}**]({page})", "",
+                  f"    [![{title}]({thumb}){{ style=\"max-height: 12rem\" }}]({page})", ""]
     index += ["</div>", ""]
     with gen.open("gallery/index.md", "w") as f:
         f.write("\n".join(index))
