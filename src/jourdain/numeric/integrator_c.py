@@ -22,7 +22,7 @@ integrator would be preferable where it is as fast. The candidates that Python r
 SciPy's ``solve_ivp`` and SUNDIALS CVODE (through scikit-sundae); both call the right-hand side
 through Python, which costs more than the right-hand side itself (a ctypes call from Python is
 about 1 µs, the right-hand side of the 4-link pendulum on a cart 0.1–0.2 µs), and neither takes
-a C function pointer. ``benchmarks/simulation.py --integrators`` runs the same compiled
+a C function pointer. ``benchmarks/integrators.py`` runs the same compiled
 right-hand side under each, each at the loosest tolerance whose final state is as accurate as
 the C loop's at rtol = atol = 1e-8 (n-link pendulum on a cart, 10 s). Measured (2-core AMD EPYC,
 loaded machine, best of 5 rounds; scikit-sundae 1.2.0, SciPy 1.17.1): at n = 4 the C loop
