@@ -157,3 +157,11 @@ def test_hooks_reject_what_loads_from_the_network(caplog: pytest.LogCaptureFixtu
     with caplog.at_level(logging.WARNING):
         assert hooks.on_post_page(mathjax, _page("tutorials/a.py"), None) == ""
     assert not caplog.records
+
+
+def test_hooks_drop_sphinx_role_prefixes_on_reference_pages() -> None:
+    hooks = _load("hooks")
+    html = "Result of :func:<code>projection</code>; see :class:<code>System</code>."
+    assert hooks.on_post_page(html, _page("reference/jourdain/x.md"), None) == \
+        "Result of <code>projection</code>; see <code>System</code>."
+    assert hooks.on_post_page(html, _page("method.md"), None) == html

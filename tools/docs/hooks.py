@@ -5,6 +5,8 @@
   tools/docs/gen_pages.py puts into the site (``examples/view_robot_arm.py``).
 * The navigation files of mkdocs-literate-nav (``SUMMARY.md`` of the generated reference and
   gallery) are read for the navigation only, not built as pages of their own.
+* The docstrings use Sphinx roles (``:func:`projection` ``); Markdown renders the name as code
+  and leaves the role's prefix as text, which the reference pages drop.
 * The site must load nothing from the network. The notebook template of mkdocs-jupyter adds
   MathJax and Mermaid from a CDN to every tutorial page; the tutorials use neither (no LaTeX
   output, no diagrams), so both blocks are removed. Any other script, style sheet, font or
@@ -29,6 +31,9 @@ _EXAMPLE_LINK = re.compile(r"\]\((?P<up>(?:\.\./)+)examples/(?P<rest>[^)\s]+)\)"
 _MATHJAX = re.compile(r"<!-- Load mathjax -->.*?<!-- End of mathjax configuration -->", re.S)
 _MERMAID = re.compile(r"<script type=\"module\">(?:(?!</script>).)*?mermaid(?:(?!</script>).)*?"
                       r"</script>", re.S)
+
+# a Sphinx role's prefix left in front of the code it marked (":func:<code>x</code>")
+_ROLE = re.compile(r":(?:py:)?(?:func|class|mod|meth|attr|data|exc|obj|const):(?=<code>)")
 
 # what makes a browser fetch a resource (not a plain hyperlink, which is fine)
 _REMOTE_LOAD = re.compile(
@@ -70,6 +75,8 @@ def on_post_page(output: str, page: Any, config: Any) -> str:
     if page.file.src_uri.startswith("tutorials/"):
         output = _MATHJAX.sub("", output)
         output = _MERMAID.sub("", output)
+    if page.file.src_uri.startswith("reference/"):
+        output = _ROLE.sub("", output)
     for m in _REMOTE_LOAD.finditer(output):
         start = max(0, m.start() - 60)
         log.warning("%s: loads a resource from the network (the site must build and work "
