@@ -56,7 +56,7 @@ def cyclic_coordinates(source: System | EquationsOfMotion) -> tuple[str, ...]:
     the model, for all parameter values.
     """
     from ..graph import evaluate_float
-    from ..stages.linearization import _perturbed
+    from ..stages.linearization.nominal import _perturbed
     from ..stages.projection import EquationsOfMotion
 
     eom = source if isinstance(source, EquationsOfMotion) else projection(newton_euler(kinematics(source)))
@@ -134,7 +134,7 @@ def _screen_compiled(system: System, candidates: list[int]) -> set[int] | None:
     the expression graph in Python took 0.3–0.5 s for a 7-joint arm. None (the caller then
     differentiates) when there is no compiler or a state has no real value."""
     from ..numeric import mkq_function, parameter_vector
-    from ..stages.linearization import _perturbed
+    from ..stages.linearization.nominal import _perturbed
 
     try:
         fn = mkq_function(system)

@@ -150,7 +150,8 @@ def state_feedback(system: System, K: Any, nominal: Mapping[Any, Any] | Any,
     ModelError
         A nominal motion that names unknown coordinates or leaves some out.
     """
-    from ..stages.linearization import Linearization, _nominal
+    from ..stages.linearization import Linearization
+    from ..stages.linearization.nominal import _nominal
 
     f, names = system.f, system.input_names
     try:
