@@ -7,7 +7,7 @@
   (:mod:`jourdain.study.motion`);
 - ``linearize``, ``frequency_response``, ``critical``: M̃, P, Q, h of all cases in one C call,
   stacked solves and eigenvalues (:mod:`jourdain.study.linear`);
-- ``simulate``: the block's runs advanced together in one C call
+- ``simulate``: the block's runs advanced together, up to 64 per C call
   (:mod:`jourdain.study.ensemble`), bit for bit the per-case runs.
 
 A case that fails records its error (a string) and NaN outputs; it never stops the block.
@@ -86,6 +86,7 @@ def _empty(layout: Mapping[str, tuple[tuple[str, ...], tuple[int, ...], str]], n
     return {k: (np.full((n, *shape), -1, dtype=dt) if dt == "i1"
                 else np.full((n, *shape), np.nan)) for k, (_, shape, dt) in layout.items()}
 
+
 def compute_block(spec: StudySpec, start: int, stop: int,
                   keys: Mapping[str, str] | None = None) -> dict[str, Any]:
     """Compute cases ``start:stop`` of ``spec``; returns ``{"start", "stop", "outputs" (name ->
@@ -131,6 +132,7 @@ def compute_block(spec: StudySpec, start: int, stop: int,
     if "simulate" in comp:
         simulate_block(ctx, P, Y, YD, ok, out, errors)
     return {"start": start, "stop": stop, "outputs": out, "errors": errors}
+
 
 def _check_parameters(ctx: Context, P: np.ndarray, errors: list[str]) -> np.ndarray:
     """The model's checks of its numbers (mass data, joint axes) at every case's parameters;

@@ -72,7 +72,6 @@ def evaluate_block(ctx: Context, P: np.ndarray, Y: np.ndarray, YD: np.ndarray, o
                 out[name][idx[k]] = np.nan
 
 
-
 def simulate_block(ctx: Context, P: np.ndarray, Y: np.ndarray, YD: np.ndarray, ok: np.ndarray,
                    out: dict[str, np.ndarray], errors: list[str]) -> None:
     """The ``simulate`` outputs of the cases where ``ok``: all of them in one ensemble call
