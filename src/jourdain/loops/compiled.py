@@ -1,0 +1,154 @@
+"""The compiled right-hand side of a closed-loop system (issue 11): generated C for ``Φ``,
+``Φ_z``, ``Φ_t`` (``jd_con``) and the convective term ``c`` of ``Φ̈ = Φ_z z̈ + c`` (``jd_gam``),
+joined with the hand-written loop of ``loop_c.h`` (Newton on the dependent coordinates, the LU
+of ``Φ_d`` and its condition number, ``J_z`` and ``γ`` by linear solves, ``M = J_zᵀ M_tree
+J_z``, ``ÿ`` by Cholesky), which calls the tree's compiled ``M, k, q``
+(:func:`jourdain.numeric.mkq_function`) through a function pointer.
+
+:class:`LoopKernel` holds the C-side state (a ``jd_loop`` struct: the partition, the last
+configuration solved, the work array) for one :class:`~jourdain.loops.closed_loop.LoopEvaluator`.
+Its :attr:`LoopKernel.accel_address` and :attr:`LoopKernel.state_address` are the integrator's
+``jd_accel`` hook and the ``p`` it passes along (:mod:`jourdain.loops.simulate` drives
+jourdain's C integrator with them: one C call per step loop, no Python per right-hand side).
+"""
+
+from __future__ import annotations
+
+import ctypes
+from functools import lru_cache
+from importlib import resources
+from typing import Any
+
+import numpy as np
+
+from ..numeric import mkq_function
+from ..numeric.ccode import HEADER, argument_names, function_source
+from ..numeric.toolchain import build, content_key
+from .closed_loop import ClosedLoopSystem, LoopEvaluator, Partition, constraints
+
+_VERSION = "loop-c1"
+#: reasons in ``info[2]`` (``loop_c.h``)
+REASONS = {1: "Newton found no configuration on the manifold (Φ_d singular or divergence)",
+           2: "the condition number of Φ_d passed the limit",
+           3: "M in the independent coordinates is not positive definite"}
+
+
+class _Loop(ctypes.Structure):
+    _fields_ = [("tree", ctypes.c_void_p), ("p", ctypes.c_void_p), ("n", ctypes.c_long),
+                ("m", ctypes.c_long), ("f", ctypes.c_long), ("r", ctypes.c_long),
+                ("ind", ctypes.c_void_p), ("dep", ctypes.c_void_p), ("rows", ctypes.c_void_p),
+                ("z", ctypes.c_void_p), ("y_last", ctypes.c_void_p), ("work", ctypes.c_void_p),
+                ("piv", ctypes.c_void_p), ("info", ctypes.c_void_p),
+                ("newton_tol", ctypes.c_double), ("cond_limit", ctypes.c_double),
+                ("max_newton", ctypes.c_long)]
+
+
+def _ptr(a: np.ndarray) -> int:
+    return int(a.__array_interface__["data"][0])
+
+
+@lru_cache(maxsize=16)
+def loop_library(loop: ClosedLoopSystem) -> ctypes.CDLL:
+    """The compiled constraint functions and loop kernel of ``loop`` (cached by content)."""
+    tree = loop.tree
+    con = constraints(loop)
+    names = argument_names(tree.y, tree.yd, tree.t, tree.parameter_symbols, tree.inputs)
+    kernel = (resources.files(__package__) / "loop_c.h").read_text()
+    source = (HEADER + function_source("jd_con", [*con.Phi.entries(), *con.Phi_z.entries(),
+                                                  *con.Phi_t.entries()], names)
+              + function_source("jd_gam", con.c.entries(), names) + kernel)
+    lib = build(content_key(_VERSION, source), source, ("-O2",))
+    vp, lg = ctypes.c_void_p, ctypes.c_long
+    lib.jd_loop_samples.restype = lg
+    lib.jd_loop_samples.argtypes = [vp, lg, vp, vp, lg, vp, vp]
+    lib.jd_loop_work.restype = lg
+    lib.jd_loop_work.argtypes = [lg, lg, lg]
+    return lib
+
+
+class LoopKernel:
+    """The C-side state of one evaluator: call :meth:`set_partition` after the evaluator's
+    partition changes; :meth:`samples` evaluates states on the manifold."""
+
+    def __init__(self, ev: LoopEvaluator, cond_limit: float = np.inf) -> None:
+        self.ev = ev
+        self.lib = loop_library(ev.loop)
+        self.tree = mkq_function(ev.loop.tree)
+        n, m = ev.n, len(ev.labels)
+        self.n, self.m = n, m
+        self.z = ev.z_guess.astype(float).copy()
+        self.info = np.zeros(6)
+        self.struct = _Loop()
+        self.cond_limit = float(cond_limit)
+        self.set_partition(ev.part)
+
+    def set_partition(self, part: Partition) -> None:
+        n, m = self.n, self.m
+        self.part = part
+        self.ind = np.array(part.independent, dtype=np.int_)
+        self.dep = np.array(part.dependent, dtype=np.int_)
+        self.rows = np.array(part.rows, dtype=np.int_)
+        f, r = len(self.ind), len(self.dep)
+        self.y_last = np.zeros(max(f, 1))
+        self.work = np.zeros(int(self.lib.jd_loop_work(n, m, f)))
+        self.piv = np.zeros(max(r, 1), dtype=np.int_)
+        self.info[:] = 0.0
+        s = self.struct
+        s.tree, s.p = self.tree.address, _ptr(self.ev.p)
+        s.n, s.m, s.f, s.r = n, m, f, r
+        s.ind, s.dep, s.rows = _ptr(self.ind), _ptr(self.dep), _ptr(self.rows)
+        s.z, s.y_last, s.work = _ptr(self.z), _ptr(self.y_last), _ptr(self.work)
+        s.piv, s.info = _ptr(self.piv), _ptr(self.info)
+        s.newton_tol, s.cond_limit, s.max_newton = self.ev.newton_tol, self.cond_limit, \
+            self.ev.max_newton
+
+    def set_cond_limit(self, limit: float) -> None:
+        self.cond_limit = float(limit)
+        self.struct.cond_limit = self.cond_limit
+
+    @property
+    def accel_address(self) -> int:
+        return int(ctypes.cast(self.lib.jd_loop_accel, ctypes.c_void_p).value or 0)
+
+    @property
+    def state_address(self) -> int:
+        """The ``p`` the integrator passes to :attr:`accel_address`: the ``jd_loop``."""
+        return ctypes.addressof(self.struct)
+
+    @property
+    def cond(self) -> float:
+        """The 1-norm condition number of Φ_d at the last state solved."""
+        return float(self.info[0])
+
+    def reason(self) -> str:
+        return REASONS.get(int(self.info[2]), "")
+
+    def samples(self, t: np.ndarray, x: np.ndarray, u: np.ndarray | None = None
+                ) -> tuple[dict[str, np.ndarray], int]:
+        """States ``x`` (N × ≥2f: y, ẏ) at times ``t`` on the manifold: ``z, zd, zdd, Phi,
+        Phi_dot, lam, cond`` (N rows each) and the index of the first state that failed
+        (-1: none; the rows from there on are NaN)."""
+        n, m = self.n, self.m
+        t = np.ascontiguousarray(t, dtype=float)
+        x = np.ascontiguousarray(x, dtype=float)
+        N = t.size
+        w = 3 * n + 3 * m + 1
+        out = np.full((N, w), np.nan)
+        uu = self.ev.u if u is None else np.ascontiguousarray(u, dtype=float)
+        bad = int(self.lib.jd_loop_samples(self.state_address, N, _ptr(t), _ptr(x),
+                                           x.shape[1] if x.ndim == 2 else 0, _ptr(uu),
+                                           _ptr(out)))
+        if bad >= 0:
+            out[bad:] = np.nan
+        cols = {"z": (0, n), "zd": (n, 2 * n), "zdd": (2 * n, 3 * n),
+                "Phi": (3 * n, 3 * n + m), "Phi_dot": (3 * n + m, 3 * n + 2 * m),
+                "lam": (3 * n + 2 * m, 3 * n + 3 * m)}
+        res = {k: out[:, a:b] for k, (a, b) in cols.items()}
+        res["cond"] = out[:, w - 1]
+        return res, bad
+
+    def __getstate__(self) -> Any:  # ctypes structures do not pickle
+        raise TypeError("LoopKernel holds C pointers and cannot be pickled")
+
+
+__all__ = ["LoopKernel", "loop_library"]
