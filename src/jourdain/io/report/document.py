@@ -23,13 +23,13 @@ from .equations import (
     equations_section,
     set_pending,
 )
-from .figures import Figures
+from .figures import Figures, prepare_worker
 from .html import CSS, esc
 from .linearization import linearization_section, nominal_placeholder
 from .sections import model_section, numbers_section
 from .simulation import simulation_section
 from .state import RUN_FORMAT, ReportInfo, Run
-from .workers import fork_worker
+from .workers import fork_workers
 
 #: the number of computed sections (the list of files is the sixth)
 SECTIONS = 5
@@ -69,7 +69,8 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
     complete, interrupted or failed, and ``message``; the files and notes).
 
     ``parallel``: the symbolic display and the figures are computed in two processes forked
-    from this one while it computes the numbers (``jourdain run``; the page is the same).
+    from this one while it computes the numbers (``jourdain run``, where the machine has two
+    cores or more; the page is the same).
 
     ``study``: a parameter study (a study file or :class:`jourdain.study.StudySpec`) run on
     this model; its section (stability map, Campbell diagram, histograms, the outputs' table)
@@ -86,23 +87,19 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
     out.mkdir(parents=True, exist_ok=True)
     system = model.system
     info = ReportInfo(out / "report.html")
-    pools: list[ProcessPoolExecutor] = []
-    figure_pool = Figures.worker() if parallel else None  # imports Matplotlib meanwhile
-    if figure_pool is not None:
-        pools.append(figure_pool)
+    pool: ProcessPoolExecutor | None = None
     try:
         summ = summary(model)  # the symbolic equations and reactions, shared by the fork
         display: Future[Display] | None = None
-        if figure_pool is not None:
+        if parallel:  # two workers, Matplotlib imported in each while this process computes
             set_pending(model, max_ops)
-            display_pool = fork_worker()
-            if display_pool is not None:
-                pools.append(display_pool)
-                display = display_pool.submit(display_in_worker)
+            pool = fork_workers(prepare_worker)
+        if pool is not None:
+            display = pool.submit(display_in_worker)
         values = system.parameter_values
         values.update(parameters or {})
         run = Run(model, out, dict(parameters or {}), t_end, max_ops, progress, info, summ,
-                  values, Figures(figure_pool), None)
+                  values, Figures(pool), None)
         sections: list[str] = []
         try:
             compute_sections(run, sections, display)
@@ -120,7 +117,7 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
             sections = [html if s == _EQUATIONS else s for s in sections]
         page = _page(run, sections, t_start)
     finally:
-        for pool in pools:
+        if pool is not None:
             pool.shutdown(cancel_futures=True)
     info.html.write_text(page, encoding="utf-8")
     manifest = {"format": RUN_FORMAT, "model": system.name, "file": model.path,

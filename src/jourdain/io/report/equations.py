@@ -3,7 +3,7 @@
 
 This is the report's SymPy work (simplification for reading, LaTeX, MathML). It depends on
 the symbolic equations only, so it is computed once per model and display code and kept in
-the compile cache (``<cache>/report/<key>.json``, the key a SHA-256 of the matrices' entries,
+the compile cache (``<cache>/report/<key>.json``, the private one, the key a SHA-256 of the matrices' entries,
 the model's names and numbers, ``max_ops`` and the source of the display code); for
 ``jourdain run`` it is computed in a forked worker while the command computes the numbers.
 Simplification is bounded (:data:`REPORT_SIMPLIFY_SECONDS`); where the bound cuts it short the
@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from ...errors import JourdainError
-from ...numeric.toolchain import cache_dir
+from ...numeric.toolchain import library_dir
 from ...symbolic import to_sympy
 from ...workflow import eom_matrices, has_capability
 from .. import export
@@ -155,7 +155,9 @@ def display_key(model: ModelFile, max_ops: int) -> str:
 
 
 def _cache_file(key: str) -> Path:
-    return cache_dir() / "report" / f"{key}.json"
+    """Where the display of ``key`` is kept: in the compile cache once it is known to be
+    private (:func:`~jourdain.numeric.toolchain.library_dir`), as its HTML goes into pages."""
+    return library_dir() / "report" / f"{key}.json"
 
 
 def cached_display(model: ModelFile, max_ops: int) -> Display:
@@ -168,7 +170,7 @@ def cached_display(model: ModelFile, max_ops: int) -> Display:
         pass  # not cached yet (or unreadable): computed and cached
     display = compute_display(model, max_ops)
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
+        path.parent.mkdir(mode=0o700, exist_ok=True)
         tmp = path.with_name(f".{key}.{os.getpid()}.tmp")
         tmp.write_text(json.dumps(asdict(display)), encoding="utf-8")
         tmp.replace(path)  # whole or not at all, for a concurrent reader

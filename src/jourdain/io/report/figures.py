@@ -13,7 +13,6 @@ from typing import Any
 import numpy as np
 
 from .motion import Motion, frame_geometry, segments
-from .workers import fork_worker
 
 
 def new_figure(**kw: Any) -> Any:
@@ -47,13 +46,15 @@ def plot_axes(width: float, height: float) -> tuple[Any, Any]:
 
 
 def svg(fig: Any) -> str:
+    """The figure as an SVG element, the same bytes for the same figure: element ids from a
+    fixed salt (Matplotlib's default is random) and no date in the metadata."""
     import matplotlib
 
     buf = io.StringIO()
     # text as SVG text, not glyph outlines: the browser sets it, in a third of the time and
     # with smaller files
-    with matplotlib.rc_context({"svg.fonttype": "none"}):
-        fig.savefig(buf, format="svg")
+    with matplotlib.rc_context({"svg.fonttype": "none", "svg.hashsalt": "jourdain"}):
+        fig.savefig(buf, format="svg", metadata={"Date": None})
     text = buf.getvalue()
     return text[text.index("<svg"):]
 
@@ -137,7 +138,7 @@ def snapshot_strip(m: Motion, view: str | None, frames: int = 8) -> str:
 # drawing here or in a worker
 # ------------------------------------------------------------------------------------------
 
-def _prepare_worker() -> None:
+def prepare_worker() -> None:
     """A figure worker: Ctrl-C is the parent's to handle (it waits for the figures of the
     sections it finished), and Matplotlib is imported once, while the parent computes."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
@@ -169,8 +170,3 @@ class Figures:
             text = item if isinstance(item, str) else item.result()
             page = page.replace(f"<!--jourdain-figure-{k}-->", text, 1)
         return page
-
-    @staticmethod
-    def worker() -> ProcessPoolExecutor | None:
-        """A figure worker, Matplotlib imported in it (:func:`fork_worker`)."""
-        return fork_worker(_prepare_worker)

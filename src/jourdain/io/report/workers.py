@@ -1,10 +1,11 @@
 """Worker processes of ``jourdain run``: the report's symbolic display and its figures are
-computed in processes forked from the command's, while it computes the numbers (two cores
-or more: the report of a small model in about half the time)."""
+computed in two processes forked from the command's while it computes the numbers (where
+the machine has two cores or more)."""
 
 from __future__ import annotations
 
 import multiprocessing
+import os
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor
 
@@ -13,14 +14,25 @@ def _ready() -> bool:
     return True
 
 
-def fork_worker(initializer: Callable[[], None] | None = None) -> ProcessPoolExecutor | None:
-    """A pool of one worker process forked from this one now (it shares what this process
+def cores() -> int:
+    """The processor cores this process may run on."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
+def fork_workers(initializer: Callable[[], None] | None = None,
+                 workers: int = 2) -> ProcessPoolExecutor | None:
+    """A pool of ``workers`` processes forked from this one now (they share what this process
     has computed so far: the symbolic equations), or None where processes cannot be forked
-    (the work then stays in this process)."""
+    or a single core would run them by turns with this one (the work then stays here)."""
+    if cores() < 2:
+        return None
     try:
         context = multiprocessing.get_context("fork")
     except ValueError:  # no fork on this platform
         return None
-    pool = ProcessPoolExecutor(1, mp_context=context, initializer=initializer)
-    pool.submit(_ready)  # forks now, not at the first real job
+    pool = ProcessPoolExecutor(workers, mp_context=context, initializer=initializer)
+    pool.submit(_ready)  # forks them all now, not at the first real job
     return pool

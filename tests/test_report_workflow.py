@@ -1,0 +1,131 @@
+"""The report's structure (issue 16) and its speed-ups (issue 13): the command line and the
+report share jourdain.workflow and never import each other's private names; the report made
+with forked workers (``jourdain run``) is the report made in one process; the symbolic display
+comes from the compile cache only for the same equations."""
+
+import ast
+import json
+import re
+from pathlib import Path
+
+import jourdain.io.report.equations as equations
+from jourdain.io import load_model
+from jourdain.io.report import write_report
+
+ROOT = Path(__file__).resolve().parents[1]
+SRC = ROOT / "src" / "jourdain"
+PENDULUM = ROOT / "examples" / "double_pendulum.toml"
+
+
+def _imports(path: Path) -> list[tuple[str, list[str], bool]]:
+    """(module, names, at module level) of every import of a source file, relative imports
+    resolved to absolute module names."""
+    package = ".".join(path.relative_to(SRC.parent).with_suffix("").parts[:-1])
+    if path.name == "__init__.py":
+        package = ".".join(path.relative_to(SRC.parent).parts[:-1])
+    tree = ast.parse(path.read_text())
+    top = set(map(id, tree.body))
+    out = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            base = package.split(".")
+            mod = node.module or ""
+            if node.level:
+                base = base[:len(base) - node.level + 1]
+                mod = ".".join([*base, mod]) if mod else ".".join(base)
+            out.append((mod, [a.name for a in node.names], id(node) in top))
+        elif isinstance(node, ast.Import):
+            out += [(a.name, [], id(node) in top) for a in node.names]
+    return out
+
+
+def _files(*packages: str) -> list[Path]:
+    return [p for pkg in packages for p in sorted((SRC / pkg).rglob("*.py"))]
+
+
+def test_cli_and_report_share_the_workflow_not_each_other():
+    for path in _files("io/report", "workflow"):
+        for mod, _, _ in _imports(path):
+            assert not mod.startswith("jourdain.cli"), f"{path} imports {mod}"
+    for path in _files("workflow"):
+        for mod, _, _ in _imports(path):
+            assert not mod.startswith("jourdain.io.report"), f"{path} imports {mod}"
+    for path in _files("cli"):
+        for mod, names, _ in _imports(path):
+            if mod.startswith("jourdain.io.report"):
+                private = [n for n in names if n.startswith("_")]
+                assert not private, f"{path} imports private {private} of {mod}"
+
+
+def test_no_deferred_imports_but_heavy_optional_ones():
+    # function-level imports only for Matplotlib (imported by the figure workers),
+    # jourdain.loops (SciPy's linear algebra, for loop models only) and jourdain.study (a
+    # study's section of jourdain run --study; xarray is optional)
+    allowed = ("matplotlib", "jourdain.loops", "jourdain.study")
+    for path in _files("cli", "workflow", "io/report"):
+        for mod, _, top in _imports(path):
+            assert top or mod.startswith(allowed), f"{path}: deferred import of {mod}"
+
+
+def _normalized(page: str) -> str:
+    """The page without what depends on the clock: the header's time and the simulation's
+    wall time."""
+    page = re.sub(r"<p class='meta'>jourdain .*? computed in [0-9.]+ s</p>", "", page)
+    return re.sub(r"[0-9.]+ s wall time", "", page)
+
+
+def test_the_report_with_workers_is_the_report_without(tmp_path):
+    model = load_model(PENDULUM)
+    serial = write_report(model, tmp_path / "serial")
+    parallel = write_report(load_model(PENDULUM), tmp_path / "parallel", parallel=True)
+    assert serial.status == parallel.status == "complete"
+    assert [f.name for f in serial.files] == [f.name for f in parallel.files]
+    assert serial.summary_lines == parallel.summary_lines
+    one = (tmp_path / "serial" / "report.html").read_text()
+    two = (tmp_path / "parallel" / "report.html").read_text()
+    assert "jourdain-figure" not in two and "jourdain-nominal" not in two
+    assert "jourdain-equations" not in two
+    assert two.count("<svg") == one.count("<svg") >= 5
+    assert _normalized(one) == _normalized(two)
+    for name in ("equations.json", "equations.tex", "values.json",
+                 "linearization-hanging.json"):
+        assert (tmp_path / "serial" / name).read_bytes() == \
+            (tmp_path / "parallel" / name).read_bytes(), name
+
+
+def test_display_cache_is_keyed_by_what_it_shows(tmp_path, monkeypatch):
+    monkeypatch.setenv("JOURDAIN_CACHE", str(tmp_path / "cache"))
+    model = load_model(PENDULUM)
+    first = equations.cached_display(model, 600)
+    kept = list((tmp_path / "cache" / "report").glob("*.json"))
+    assert [p.stem for p in kept] == [equations.display_key(model, 600)]
+
+    def refuse(*args):
+        raise AssertionError("computed again although cached")
+
+    with monkeypatch.context() as m:
+        m.setattr(equations, "compute_display", refuse)
+        assert equations.cached_display(model, 600) == first
+    # another bound on displayed operations, another parameter value: other keys
+    assert equations.display_key(model, 10) != kept[0].stem
+    text = PENDULUM.read_text()
+    changed = text.replace('m1 = { value = 1.0,', 'm1 = { value = 1.25,', 1)
+    assert changed != text
+    other = tmp_path / "other.toml"
+    other.write_text(changed)
+    assert equations.display_key(load_model(other), 600) != kept[0].stem
+    # an unreadable entry is computed again (and replaced)
+    kept[0].write_text("{not json")
+    again = equations.cached_display(model, 600)
+    assert again == first
+    assert json.loads(kept[0].read_text())["ops"] == first.ops
+
+
+def test_display_counts_operations_of_the_equations():
+    model = load_model(PENDULUM)
+    display = equations.compute_display(model, 600)
+    mats = equations.eom_matrices(model.system)
+    assert display.ops == {k: m.count_ops(cse=True) for k, m in mats.items()}
+    assert set(display.nominal) == {n.name for n in model.nominal}
+    assert json.loads(display.json_text)["format"] == "jourdain-eom/1"
+
