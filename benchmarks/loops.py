@@ -8,20 +8,23 @@ speeds (configuration and velocity constraints) on the same four-bar (the model 
 Simulation of the four-bar over ``T`` seconds from the same consistent state, each route's
 error measured against a reference (jourdain at rtol 1e-13) at the end:
 
-* jourdain: coordinate partitioning (``jourdain.loops.simulate.simulate_loop``, DOP853);
+* jourdain: coordinate partitioning (``jourdain.loops.simulate.simulate_loop``, DOP853), the
+  compiled right-hand side in jourdain's C integrator (best of ``--repeat``), and the same
+  method stepped by SciPy from Python (``engine="scipy"``, "jd+scipy");
 * sympy + SciPy: Kane's ``mass_matrix_full`` and ``forcing_full`` lambdified (NumPy) and
   integrated by ``solve_ivp`` (DOP853) in q, u with the dependent speeds from the velocity
   constraints (the standard sympy route; Φ drifts with the integration error);
 * IDA (scikit-sundae, if installed): the index-1 redundant form in z, ż, λ with jourdain's
   compiled tree and constraints in the residual.
 
-    python benchmarks/loops.py [--T 5]
+    python benchmarks/loops.py [--T 5] [--repeat 5] [--no-ida]
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 import time
 from pathlib import Path
@@ -110,6 +113,8 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--T", type=float, default=5.0)
     ap.add_argument("--json", action="store_true")
+    ap.add_argument("--repeat", type=int, default=5, help="best of N for the C engine")
+    ap.add_argument("--no-ida", action="store_true", help="skip IDA (slow)")
     args = ap.parse_args()
     T = args.T
     out: dict = {}
@@ -123,21 +128,30 @@ def main() -> None:
     z0, zd0, zT = ref.z[0], ref.zd[0], ref.z[-1]
     rows = []
     fns = kane_full_four_bar()
+    simulate_loop(loop, (0, 0.1), z0, zd0, samples=2)  # compiled and loaded before timing
     for rtol in (1e-8, 1e-10):
-        t0 = time.perf_counter()
-        r = simulate_loop(loop, (0, T), z0, zd0, samples=2, rtol=rtol, atol=rtol * 1e-2)
-        wall = time.perf_counter() - t0
-        rows.append({"route": "jourdain", "rtol": rtol, "wall_s": wall, "nfev": r.nfev,
-                     "error": float(np.max(np.abs(r.z[-1] - zT))), "max_Phi": r.max_Phi})
+        for engine, route in (("c", "jourdain"), ("scipy", "jd+scipy")):
+            best = np.inf
+            for _ in range(args.repeat if engine == "c" else 1):
+                t0 = time.perf_counter()
+                r = simulate_loop(loop, (0, T), z0, zd0, samples=2, rtol=rtol,
+                                  atol=rtol * 1e-2, engine=engine)
+                best = min(best, time.perf_counter() - t0)
+            rows.append({"route": route, "rtol": rtol, "wall_s": best, "nfev": r.nfev,
+                         "error": float(np.max(np.abs(r.z[-1] - zT))), "max_Phi": r.max_Phi,
+                         "max_Phi_dot": r.max_Phi_dot})
         wall, zs, nfev = simulate_sympy(fns, z0, zd0, T, rtol)
         rows.append({"route": "sympy+scipy", "rtol": rtol, "wall_s": wall, "nfev": nfev,
                      "error": float(np.max(np.abs(zs - zT)))})
         try:
+            if args.no_ida:
+                raise ImportError
             wall, zi, phi = simulate_ida(loop, z0, zd0, T, rtol)
             rows.append({"route": "IDA index-1", "rtol": rtol, "wall_s": wall,
                          "error": float(np.max(np.abs(zi - zT))), "max_Phi_end": phi})
         except ImportError:
-            rows.append({"route": "IDA index-1", "rtol": rtol, "skipped": "no scikit-sundae"})
+            rows.append({"route": "IDA index-1", "rtol": rtol,
+                         "skipped": "--no-ida" if args.no_ida else "no scikit-sundae"})
     out["simulation"] = rows
     if args.json:
         print(json.dumps(out, indent=2))
@@ -154,8 +168,15 @@ def main() -> None:
             continue
         extra = (f", max |Φ| {r['max_Phi']:.1e}" if "max_Phi" in r else
                  f", |Φ(T)| {r['max_Phi_end']:.1e}" if "max_Phi_end" in r else "")
-        print(f"  {r['route']:<12} rtol {r['rtol']:.0e}: {r['wall_s']:.3f} s, error "
+        print(f"  {r['route']:<12} rtol {r['rtol']:.0e}: {r['wall_s']:.4f} s, error "
               f"{r['error']:.2e}{extra}")
+    for rtol in (1e-8, 1e-10):
+        by = {r["route"]: r for r in rows if r["rtol"] == rtol and "wall_s" in r}
+        c = by["jourdain"]["wall_s"]
+        print(f"  rtol {rtol:.0e}: sympy+scipy / jourdain = {by['sympy+scipy']['wall_s'] / c:.1f}x, "
+              f"jourdain's SciPy engine / C engine = {by['jd+scipy']['wall_s'] / c:.1f}x "
+              f"(errors {by['jourdain']['error']:.1e}, {by['sympy+scipy']['error']:.1e})")
+    print(f"  (load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores)")
 
 
 if __name__ == "__main__":
