@@ -313,7 +313,7 @@ class Results:
             return self._energies["W_Vt"]
         system = self.system
         fn = None if system is None else _potential_rate_function(system)
-        if fn is None or len(self.t) < 2:
+        if system is None or fn is None or len(self.t) < 2:
             W = np.zeros(len(self.t))
         else:
             p = np.array([self.parameters[k] for k, _ in system.parameters])

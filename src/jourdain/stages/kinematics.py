@@ -29,6 +29,7 @@ from typing import TYPE_CHECKING
 
 import symengine as se
 
+from ..errors import ModelError
 from ..identity import IdentityMap
 from ..model.forces import acceleration, rate
 from ..model.joints import IDENTITY, Joint, Mat3, Rot, Trans, Vec3, rotation_matrix
@@ -101,10 +102,17 @@ class FrameTag:
     def __init__(self, parent: FrameTag | None, A: Mat3, S: Mat3,
                  axis: tuple[Vec3, se.Basic] | None) -> None:
         self.parent, self.A, self.S, self.axis = parent, A, S, axis
-        self.depth = 0 if parent is None else parent.depth + 1
+        self.depth: int = 0 if parent is None else parent.depth + 1
 
 
 ROOT = FrameTag(None, IDENTITY, IDENTITY, None)
+
+
+def step_axis(step: Rot | Trans) -> Vec3:
+    """The axis of an elementary step; a translation given by a vector has none."""
+    if step.axis is None:
+        raise ModelError("a translation given by a vector has no axis")
+    return step.axis
 
 
 def relative_rotation(a: FrameTag, b: FrameTag) -> Mat3 | None:
@@ -285,8 +293,8 @@ def _translate(F: _Frame, d: Vec3, ctx: _Context) -> None:
         if j in F.JR:
             local = _cross(F.JR[j], d)
         dj = tuple(rt.dy.get(j, ZERO) for rt in rates)
-        if not _is_zero(dj):  # type: ignore[arg-type]
-            local = _add(local, dj)  # type: ignore[arg-type]
+        if not _is_zero(dj):
+            local = _add(local, dj)
         if _is_zero(local):
             newJT[j] = F.JT.get(j, Z3)
             continue
@@ -294,7 +302,8 @@ def _translate(F: _Frame, d: Vec3, ctx: _Context) -> None:
         # the local vectors (no sin² + cos² of components, see jourdain.stages.projection)
         old = F.JT.get(j)
         if old is None:
-            col, pieces = toI(local), ((F.tag, local),)
+            col = toI(local)
+            pieces: tuple | None = ((F.tag, local),)
         else:
             col = _add(old, toI(local))
             rec = ctx.pieces.get(old)
@@ -303,9 +312,9 @@ def _translate(F: _Frame, d: Vec3, ctx: _Context) -> None:
         if pieces is not None:
             ctx.pieces[col] = pieces
     F.JT = newJT
-    d_t: Vec3 = tuple(rt.dt for rt in rates)  # type: ignore[assignment]
-    d_1: Vec3 = tuple(rt.d1 for rt in rates)  # type: ignore[assignment]
-    d_2: Vec3 = tuple(rt.d2_local for rt in rates)  # type: ignore[assignment]
+    d_t: Vec3 = tuple(rt.dt for rt in rates)
+    d_1: Vec3 = tuple(rt.d1 for rt in rates)
+    d_2: Vec3 = tuple(rt.d2_local for rt in rates)
     F.v_bar = _add(F.v_bar, toI(_add(_cross(F.omega_bar, d), d_t)))
     acc = _add(_cross(F.alpha_bar, d), _cross(F.omega, _cross(F.omega, d)))
     if not _is_zero(d_1):

@@ -30,7 +30,19 @@ from ..model.forces import (
 )
 from ..model.joints import IDENTITY, Joint, Mat3, Rot, Vec3, rotation_matrix
 from ..symbolic import SymMatrix
-from .kinematics import Z3, BodyKinematics, Kinematics, _add, _cross, _dot, _mm, _mtv, _mv, _scale
+from .kinematics import (
+    Z3,
+    BodyKinematics,
+    Kinematics,
+    _add,
+    _cross,
+    _dot,
+    _mm,
+    _mtv,
+    _mv,
+    _scale,
+    step_axis,
+)
 
 if TYPE_CHECKING:
     from ..model.system import System
@@ -134,7 +146,7 @@ class _Accumulator:
         self.kin = kin
         self.sys = kin.system
         self.f: dict[str, list[list[se.Basic]]] = {b.name: [[], [], []] for b in self.sys.bodies}
-        self.l = {b.name: [[], [], []] for b in self.sys.bodies}
+        self.l: dict[str, list[list[se.Basic]]] = {b.name: [[], [], []] for b in self.sys.bodies}
         self.gravity: Vec3 = Z3
 
     def S(self, name: str) -> Mat3:
@@ -168,7 +180,7 @@ class _Accumulator:
         for b in self.sys.bodies:
             other = tuple(se.Add(*c) if c else ZERO for c in self.f[b.name])
             weight = _scale(self.gravity, b.mass) if b.mass != 0 else Z3
-            out.append(BodyForces(b.name, _add(other, weight), tuple(  # type: ignore[arg-type]
+            out.append(BodyForces(b.name, _add(other, weight), tuple(
                 se.Add(*c) if c else ZERO for c in self.l[b.name]), other, self.gravity))
         return tuple(out)
 
@@ -288,7 +300,7 @@ def _coordinate_pair(acc: _Accumulator, sys: System, fe: GeneralizedForce, coord
         for k, step in enumerate(j.steps):
             if step.parameter is not None and step.parameter == coordinate:
                 Rb, _, Ra = joint_step_frames(j)[k]
-                u = step.axis
+                u = step_axis(step)
                 v_child = _mtv(Ra, _scale(u, value))
                 v_parent = _scale(_mv(Rb, u), -value)
                 if isinstance(step, Rot):

@@ -105,7 +105,7 @@ def projection(ne: NewtonEuler) -> EquationsOfMotion:
         rkeys = sorted(R)
         for ii, j in enumerate(rkeys):
             cj = R[j]
-            if has_I:
+            if gyro_R is not None:  # the body has inertia
                 for kk in rkeys[ii:]:
                     M_terms[j][kk].append(_dot(cj, IR[kk]))
                 k_terms[j].append(_dot(cj, gyro_R))

@@ -59,7 +59,7 @@ class GeneralLinearization:
         mats = {"M_tilde": self.M_tilde, "P": self.P, "Q": self.Q, "h": self.h, "B": self.B}
         flat = [e for m in mats.values() for e in m.entries()]
         nums = iter(evaluate_float(flat, values))
-        out = {}
+        out: dict[str, np.ndarray] = {}
         for name, m in mats.items():
             n, c = m.shape
             out[name] = np.array([next(nums) for _ in range(n * c)]).reshape(n, c)

@@ -158,8 +158,8 @@ def linearize_numeric(source: System | EquationsOfMotion, nominal: Mapping[Any, 
     ne = eom.newton_euler
     J_bar = ne.J_bar.entries()
     n6 = ne.J_bar.shape[0]
-    M_bar = evaluate_float(ne.M_bar.entries(), pars)  # raises if M̄ depended on more
-    M_bar = np.array(M_bar).reshape(n6, n6)
+    # raises if M̄ depended on more
+    M_bar = np.array(evaluate_float(ne.M_bar.entries(), pars)).reshape(n6, n6)
     # q̄^c and q̄^e (values only) give the scale of the forces for the check of h
     exprs = [*eom.k.entries(), *eom.q.entries(), *J_bar, *ne.q_c.entries(), *ne.q_e.entries()]
     mask = [True] * (2 * f) + [any(ydd_nonzero)] * len(J_bar) + [False] * (2 * n6)

@@ -16,7 +16,7 @@ from ...errors import JourdainError, ModelError
 from ...model.bodies import WORLD
 from ...model.joints import Vec3
 from ...symbolic import SymMatrix
-from ..kinematics import _add, _cross, _mtv, _mv, _scale
+from ..kinematics import _add, _cross, _mat, _mtv, _mv, _scale
 from ..newton_euler import NewtonEuler, joint_transform
 
 if TYPE_CHECKING:
@@ -182,13 +182,14 @@ def reactions(ne: NewtonEuler) -> Reactions:
     local: list[dict[int, Vec3]] = []
     for body, bk, jr in zip(bodies, kin.bodies, joints, strict=True):
         j = body.joint
-        S = bk.S.rows
+        S = _mat(bk.S)
         R_pc, o_pc = joint_transform(j)
         c_c = body.com
         i = row[body.name]
         parent = None if body.parent == WORLD else system.body(body.parent)
         for w in jr.wrenches:
-            F, T = w[:3], w[3:]
+            F: Vec3 = (w[0], w[1], w[2])
+            T: Vec3 = (w[3], w[4], w[5])
             col: dict[int, se.Basic] = {}
             SF = _mv(S, F)
             rot_c = _add(T, _scale(_cross(c_c, F), -1))  # lever arm: from the COM to O
@@ -215,7 +216,7 @@ def reactions(ne: NewtonEuler) -> Reactions:
     verified = _checked_joints(system)
     singular, inv = _singular_rows(system)
     # N̂, k̂, q̂ body by body over the regular rows (M̄ block diagonal)
-    N = [[[] for _ in range(q)] for _ in range(q)]
+    N: list[list[list[se.Basic]]] = [[[] for _ in range(q)] for _ in range(q)]
     kh: list[list[se.Basic]] = [[] for _ in range(q)]
     qh: list[list[se.Basic]] = [[] for _ in range(q)]
     qc, qe = ne.q_c, ne.q_e

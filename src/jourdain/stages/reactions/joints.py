@@ -21,7 +21,7 @@ import symengine as se
 from ...errors import ModelError
 from ...graph import evaluate_arrays
 from ...model.joints import IDENTITY, Joint, Mat3, Rot, Vec3, rotation_matrix
-from ..kinematics import Z3, _add, _cross, _dot, _mm, _mtv, _mv, _scale
+from ..kinematics import Z3, _add, _cross, _dot, _mm, _mtv, _mv, _scale, step_axis
 
 if TYPE_CHECKING:
     from ...model.system import System
@@ -38,7 +38,7 @@ _UNIT = {
 
 
 def _unit(name: str) -> Wrench:
-    return tuple(se.Integer(c) for c in _UNIT[name])  # type: ignore[return-value]
+    return tuple(se.Integer(c) for c in _UNIT[name])
 
 
 # --- constrained directions of one joint ---------------------------------------------------------
@@ -72,19 +72,19 @@ def _perpendicular(u: Vec3, joint: Joint, what: str) -> list[tuple[str, Vec3]]:
     for k, ax in enumerate("xyz"):
         if abs(abs(uv[k]) - 1.0) < 1e-15:
             others = [a for a in "xyz" if a != ax]
-            return [(a, tuple(se.Integer(int(a == b)) for b in "xyz")) for a in others]  # type: ignore[misc]
+            return [(a, tuple(se.Integer(int(a == b)) for b in "xyz")) for a in others]
     k = int(np.argmin(np.abs(uv)))
     e = np.zeros(3)
     e[k] = 1.0
     e1 = np.cross(uv, e)
     e1 /= np.linalg.norm(e1)
     e2 = np.cross(uv, e1)
-    return [("1", tuple(se.Float(float(x)) for x in e1)),  # type: ignore[misc]
+    return [("1", tuple(se.Float(float(x)) for x in e1)),
             ("2", tuple(se.Float(float(x)) for x in e2))]
 
 
 def _wrench(F: Vec3 = Z3, T: Vec3 = Z3) -> Wrench:
-    return (*F, *T)  # type: ignore[return-value]
+    return (*F, *T)
 
 
 def relative_twist(joint: Joint, coordinates: Sequence[se.Symbol]) -> list[tuple[Vec3, Vec3]]:
@@ -115,7 +115,7 @@ def relative_twist(joint: Joint, coordinates: Sequence[se.Symbol]) -> list[tuple
         for Rb, vec in trans:
             dv = tuple(se.diff(c, y) for c in vec)
             if any(c != 0 for c in dv):
-                v = _add(v, _mv(Rb, dv))  # type: ignore[arg-type]
+                v = _add(v, _mv(Rb, dv))
         out.append((_mtv(R, v), _mtv(R, w)))
     return out
 
@@ -144,27 +144,27 @@ def constrained_directions(joint: Joint, coordinates: Sequence[se.Symbol] = (),
     if kind == "spherical":
         return [(n, _unit(n)) for n in ("F_x", "F_y", "F_z")]
     if kind == "revolute":
-        u = steps[0].axis
+        u = step_axis(steps[0])
         return ([(n, _unit(n)) for n in ("F_x", "F_y", "F_z")]
                 + [(f"T_{a}", _wrench(T=e)) for a, e in _perpendicular(u, joint, "rotation")])
     if kind == "prismatic":
-        u = steps[0].axis
+        u = step_axis(steps[0])
         return ([(f"F_{a}", _wrench(F=e)) for a, e in _perpendicular(u, joint, "translation")]
                 + [(n, _unit(n)) for n in ("T_x", "T_y", "T_z")])
     if kind == "cylindrical":
-        u = steps[0].axis
+        u = step_axis(steps[0])
         perp = _perpendicular(u, joint, "cylinder")
         return ([(f"F_{a}", _wrench(F=e)) for a, e in perp]
                 + [(f"T_{a}", _wrench(T=e)) for a, e in perp])
     if kind == "planar":
-        n = steps[2].axis
+        n = step_axis(steps[2])
         ax = "xyz"[[abs(int(c)) for c in n].index(1)]
         return [(f"F_{ax}", _unit(f"F_{ax}"))] + [
             (f"T_{a}", _unit(f"T_{a}")) for a in "xyz" if a != ax]
     if kind == "universal":
         (w1, w2) = (w for _, w in relative_twist(joint, joint.coordinates))
         n = _cross(w1, w2)
-        u1, u2 = steps[0].axis, steps[1].axis
+        u1, u2 = step_axis(steps[0]), step_axis(steps[1])
         norm = se.sqrt(_dot(_cross(u1, u2), _cross(u1, u2)))  # constant: |A2ᵀu1 × u2| = |u1 × u2|
         if not any(c.free_symbols for c in (*u1, *u2)):
             norm = se.Float(float(norm)) if float(norm) != 1.0 else ONE
@@ -194,7 +194,7 @@ def _user_directions(joint: Joint) -> list[tuple[str, Wrench]]:
         w = as_vector(vec, where, n=6)
         if all(c == 0 for c in w):
             raise ModelError(f"{where}: the wrench direction {name!r} is zero")
-        out.append((name, w))  # type: ignore[arg-type]
+        out.append((name, w))
     names = [n for n, _ in out]
     dup = {n for n in names if names.count(n) > 1}
     if dup:
@@ -261,7 +261,7 @@ def _derived_directions(joint: Joint, coordinates: Sequence[se.Symbol],
         rank_A = int((sv > 1e-9 * max(1.0, sv[0])).sum())
         for k, v in enumerate(Vt[rank_A:rank_A + need - len(chosen)], start=1):
             v = np.where(np.abs(v) < 1e-15, 0.0, v)
-            extra.append((f"W_{k}", tuple(se.Float(float(x)) if x else ZERO for x in v)))  # type: ignore[misc]
+            extra.append((f"W_{k}", tuple(se.Float(float(x)) if x else ZERO for x in v)))
     if len(chosen) + len(extra) < need:
         raise ModelError(
             f'joint "{joint.name}": cannot derive its {need} constrained directions from its '
@@ -276,7 +276,7 @@ def _derived_directions(joint: Joint, coordinates: Sequence[se.Symbol],
             if np.ptp(norm) < 1e-12 * norm.max():  # constant length: normalize symbolically
                 w = tuple(x / se.Float(float(norm[0])) if float(norm[0]) != 1.0 else x for x in w)
         out.append((name, w))
-    return out + extra  # type: ignore[return-value]
+    return out + extra
 def _sample_values(exprs: list[se.Basic], coordinates: Sequence[se.Symbol],
                    parameters: Mapping[str, float], rng: np.random.Generator,
                    samples: int) -> np.ndarray:

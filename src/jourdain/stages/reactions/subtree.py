@@ -13,7 +13,7 @@ import symengine as se
 from ...errors import JourdainError
 from ...model.joints import Vec3
 from ...symbolic import SymMatrix
-from ..kinematics import Z3, _add, _cross, _dot, _mtv, _mv, _scale
+from ..kinematics import Z3, _add, _cross, _dot, _mat, _mtv, _mv, _scale
 from ..newton_euler import NewtonEuler
 
 if TYPE_CHECKING:
@@ -40,7 +40,7 @@ def _subtree_parts(ne: NewtonEuler, child: str) -> tuple[Wrench, list[Wrench]]:
     f = len(kin.y)
     forces = {bf.name: bf for bf in ne.forces}
     bc = kin[child]
-    Sc = bc.S.rows
+    Sc = _mat(bc.S)
     rO = _v(bc.r_O)
     W0: list[se.Basic] = [ZERO] * 6
     Wy: list[list[se.Basic]] = [[ZERO] * 6 for _ in range(f)]
@@ -48,7 +48,7 @@ def _subtree_parts(ne: NewtonEuler, child: str) -> tuple[Wrench, list[Wrench]]:
     def add(acc: list[se.Basic], name: str, F: Vec3, tau: Vec3, arm: Vec3) -> None:
         # move a force (inertial, at the COM) and a torque (body frame) to the child frame
         Fc = _mtv(Sc, F)
-        tau_c = tau if name == child else _mtv(Sc, _mv(kin[name].S.rows, tau))  # type: ignore[arg-type]
+        tau_c = tau if name == child else _mtv(Sc, _mv(_mat(kin[name].S), tau))
         T = _add(tau_c, _cross(arm, Fc))
         for a in range(3):
             acc[a] = acc[a] + Fc[a]
@@ -73,7 +73,7 @@ def _subtree_parts(ne: NewtonEuler, child: str) -> tuple[Wrench, list[Wrench]]:
             Fj = _scale(bk.cols_T.get(j, Z3), m)
             tj = _mv(I, bk.cols_R[j]) if body.has_inertia and j in bk.cols_R else Z3
             add(Wy[j], name, Fj, tj, arm)
-    return tuple(W0), [tuple(w) for w in Wy]  # type: ignore[return-value]
+    return tuple(W0), [tuple(w) for w in Wy]
 
 
 def _subtree_wrench(ne: NewtonEuler, child: str) -> Wrench:
@@ -81,7 +81,7 @@ def _subtree_wrench(ne: NewtonEuler, child: str) -> Wrench:
     the symbols ``<coordinate>_dd``."""
     W0, Wy = _subtree_parts(ne, child)
     ydd = ne.kinematics.ydd
-    return tuple(se.Add(W0[a], *(Wy[j][a] * ydd[j] for j in range(len(Wy))))  # type: ignore[return-value]
+    return tuple(se.Add(W0[a], *(Wy[j][a] * ydd[j] for j in range(len(Wy))))
                  for a in range(6))
 
 
