@@ -1,0 +1,195 @@
+"""The recursion of the kinematics (``docs/method.md`` §1): one elementary transformation at a
+time along the tree (rotations merged about fixed axes, translations), carrying the position,
+the rotation, the Jacobians J_T, J_R and the local accelerations; the shared expression graph
+this builds grows linearly with the depth of the tree.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+import symengine as se
+
+from ...identity import IdentityMap
+from ...model.joints import IDENTITY, Joint, Mat3, Rot, Trans, Vec3, rotation_matrix
+
+if TYPE_CHECKING:
+    pass
+from .frames import ROOT, FrameTag
+from .vectors import Z3, ZERO, _add, _cross, _is_zero, _mm, _mtv, _mv, _scale
+
+
+@dataclass
+class _Frame:
+    """State of a moving frame during the recursion (mutable scratch, never returned)."""
+
+    r: Vec3 = Z3
+    JT: dict[int, Vec3] = field(default_factory=dict)
+    v_bar: Vec3 = Z3
+    a_bar: Vec3 = Z3
+    JR: dict[int, Vec3] = field(default_factory=dict)
+    omega: Vec3 = Z3
+    omega_bar: Vec3 = Z3
+    alpha_bar: Vec3 = Z3
+    # a_bar as the sum of its pieces S_k·v_k: ((tag of frame k, v_k), ...)
+    a_pieces: tuple = ()
+    # the orientation: S, and the single axis when all rotations so far are about one
+    tag: FrameTag = ROOT
+
+    @property
+    def S(self) -> Mat3:
+        return self.tag.S
+
+    @property
+    def identity(self) -> bool:
+        return self.tag is ROOT
+
+    def copy(self) -> _Frame:
+        return _Frame(self.r, dict(self.JT), self.v_bar, self.a_bar, dict(self.JR), self.omega,
+                      self.omega_bar, self.alpha_bar, self.a_pieces, self.tag)
+
+
+class _Rates:
+    """Time derivatives of a scalar expression s(y, t) of the elementary steps."""
+
+    __slots__ = ("dy", "dt", "d1", "d2_local")
+
+    def __init__(self, s: se.Basic, ctx: _Context) -> None:
+        idx = ctx.index.get(s) if isinstance(s, se.Symbol) else None
+        if idx is not None:  # s is a coordinate itself
+            self.dy = {idx: se.Integer(1)}
+            self.dt = ZERO
+            self.d1 = ctx.yd[idx]
+            self.d2_local = ZERO
+            return
+        free = s.free_symbols
+        self.dy = {}
+        for sym in free:
+            j = ctx.index.get(sym)
+            if j is not None:
+                self.dy[j] = se.diff(s, sym)
+        self.dt = se.diff(s, ctx.t) if ctx.t in free else ZERO
+        self.d1 = sum((c * ctx.yd[j] for j, c in self.dy.items()), self.dt)
+        # d²s/dt² without the ÿ terms: d/dt of ṡ at constant ÿ
+        d2 = se.diff(self.d1, ctx.t) if (ctx.t in free) else ZERO
+        for sym in free:
+            j = ctx.index.get(sym)
+            if j is not None:
+                d2 = d2 + se.diff(self.d1, sym) * ctx.yd[j]
+        self.d2_local = d2
+
+    @property
+    def constant(self) -> bool:
+        return not self.dy and self.dt == 0
+
+
+@dataclass
+class _Context:
+    index: dict[se.Symbol, int]
+    yd: tuple[se.Symbol, ...]
+    t: se.Symbol
+    # columns of J_T as sums of rotated local vectors S_k·v_k: col -> ((tag, v), ...)
+    pieces: IdentityMap[tuple] = field(default_factory=IdentityMap)
+
+
+def _rotate(F: _Frame, u: Vec3, angle: se.Basic, ctx: _Context) -> None:
+    """Apply the elementary rotation about u (current frame) by ``angle``."""
+    if angle == 0:
+        return
+    rt = _Rates(angle, ctx)
+    A = rotation_matrix(u, angle)
+    # orientation, merging rotations about one fixed axis into a single angle
+    axis = F.tag.axis
+    if F.identity:
+        S, axis = A, (u, angle)
+    elif axis is not None and axis[0] == u:
+        theta = axis[1] + angle
+        S, axis = rotation_matrix(u, theta), (u, theta)
+    else:
+        S, axis = _mm(F.S, A), None
+    F.tag = FrameTag(F.tag, A, S, axis)
+    # angular velocity and acceleration in the new frame: ω' = Aᵀ(ω + u·θ̇)
+    keys = set(F.JR) | set(rt.dy)
+    F.JR = {
+        j: _mtv(A, _add(F.JR.get(j, Z3), _scale(u, rt.dy[j])) if j in rt.dy else F.JR[j])
+        for j in keys
+    }
+    F.omega_bar = _mtv(A, _add(F.omega_bar, _scale(u, rt.dt)))
+    w_rel = _scale(u, rt.d1)
+    F.alpha_bar = _mtv(A, _add(_add(F.alpha_bar, _scale(u, rt.d2_local)), _cross(F.omega, w_rel)))
+    F.omega = _mtv(A, _add(F.omega, w_rel))
+
+
+def _reorient(F: _Frame, R0: Mat3) -> None:
+    """Apply a constant change of axes R0 (new axes in current-frame components)."""
+    if R0 == IDENTITY:
+        return
+    F.tag = FrameTag(F.tag, R0, R0 if F.identity else _mm(F.S, R0), None)
+    F.JR = {j: _mtv(R0, c) for j, c in F.JR.items()}
+    F.omega, F.omega_bar, F.alpha_bar = (_mtv(R0, F.omega), _mtv(R0, F.omega_bar),
+                                         _mtv(R0, F.alpha_bar))
+
+
+def _append(pieces: tuple, tag: FrameTag, v: Vec3) -> tuple:
+    """pieces + S_tag·v, added to the last piece when that is in the same frame."""
+    if pieces and pieces[-1][0] is tag:
+        return (*pieces[:-1], (tag, _add(pieces[-1][1], v)))
+    return (*pieces, (tag, v))
+
+
+def _translate(F: _Frame, d: Vec3, ctx: _Context) -> None:
+    """Apply the elementary translation by the vector d(y, t) given in the current frame."""
+    if _is_zero(d):
+        return
+    rates = [_Rates(c, ctx) for c in d]
+    S = F.S
+    toI = (lambda v: v) if F.identity else (lambda v: _mv(S, v))
+    F.r = _add(F.r, toI(d))
+    keys = set(F.JT) | set(F.JR) | {j for rt in rates for j in rt.dy}
+    newJT = {}
+    for j in keys:
+        local = Z3
+        if j in F.JR:
+            local = _cross(F.JR[j], d)
+        dj = tuple(rt.dy.get(j, ZERO) for rt in rates)
+        if not _is_zero(dj):
+            local = _add(local, dj)
+        if _is_zero(local):
+            newJT[j] = F.JT.get(j, Z3)
+            continue
+        # remember the column as pieces S_k·v_k: dot products of columns are then formed from
+        # the local vectors (no sin² + cos² of components, see jourdain.stages.projection)
+        old = F.JT.get(j)
+        if old is None:
+            col = toI(local)
+            pieces: tuple | None = ((F.tag, local),)
+        else:
+            col = _add(old, toI(local))
+            rec = ctx.pieces.get(old)
+            pieces = None if rec is None else _append(rec, F.tag, local)
+        newJT[j] = col
+        if pieces is not None:
+            ctx.pieces[col] = pieces
+    F.JT = newJT
+    d_t: Vec3 = tuple(rt.dt for rt in rates)
+    d_1: Vec3 = tuple(rt.d1 for rt in rates)
+    d_2: Vec3 = tuple(rt.d2_local for rt in rates)
+    F.v_bar = _add(F.v_bar, toI(_add(_cross(F.omega_bar, d), d_t)))
+    acc = _add(_cross(F.alpha_bar, d), _cross(F.omega, _cross(F.omega, d)))
+    if not _is_zero(d_1):
+        acc = _add(acc, _add(_scale(_cross(F.omega, d_1), se.Integer(2)), d_2))
+    F.a_bar = _add(F.a_bar, toI(acc))
+    if not _is_zero(acc):
+        F.a_pieces = _append(F.a_pieces, F.tag, acc)
+
+
+def _joint_steps(F: _Frame, joint: Joint, ctx: _Context) -> None:
+    """Apply a joint's constant orientation and its elementary steps to the frame at the joint
+    point."""
+    _reorient(F, joint.orientation)
+    for step in joint.steps:
+        if isinstance(step, Rot):
+            _rotate(F, step.axis, step.angle, ctx)
+        elif isinstance(step, Trans):
+            _translate(F, step.vector, ctx)
