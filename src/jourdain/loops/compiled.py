@@ -26,7 +26,7 @@ from ..numeric.ccode import HEADER, argument_names, function_source
 from ..numeric.toolchain import build, content_key
 from .closed_loop import ClosedLoopSystem, LoopEvaluator, Partition, constraints
 
-_VERSION = "loop-c1"
+_VERSION = "loop-c2"
 #: reasons in ``info[2]`` (``loop_c.h``)
 REASONS = {1: "Newton found no configuration on the manifold (Φ_d singular or divergence)",
            2: "the condition number of Φ_d passed the limit",
@@ -77,7 +77,7 @@ class LoopKernel:
         n, m = ev.n, len(ev.labels)
         self.n, self.m = n, m
         self.z = ev.z_guess.astype(float).copy()
-        self.info = np.zeros(6)
+        self.info = np.zeros(7)
         self.struct = _Loop()
         self.cond_limit = float(cond_limit)
         self.set_partition(ev.part)
@@ -101,6 +101,14 @@ class LoopKernel:
         s.piv, s.info = _ptr(self.piv), _ptr(self.info)
         s.newton_tol, s.cond_limit, s.max_newton = self.ev.newton_tol, self.cond_limit, \
             self.ev.max_newton
+
+    def restart(self, z: np.ndarray, y: np.ndarray) -> None:
+        """Start the next solve from the configuration ``z`` with independent coordinates
+        ``y`` (on the manifold): no prediction, continuation from ``y``."""
+        self.z[:] = z
+        self.y_last[:len(y)] = y
+        self.info[4] = 0.0
+        self.info[6] = 1.0
 
     def set_cond_limit(self, limit: float) -> None:
         self.cond_limit = float(limit)

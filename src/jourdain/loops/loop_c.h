@@ -20,7 +20,8 @@ typedef struct {
     double *y_last;        /* f: its independent coordinates */
     double *work;          /* jd_loop_work(n, m, f) doubles */
     long *piv;             /* r */
-    double *info;          /* [cond_1(Phi_d), Newton steps, reason, |Phi|, have y_last, nfail] */
+    double *info;          /* [cond_1(Phi_d), Newton steps, reason, |Phi|, J_z and y_last
+                            * valid (the prediction), failures, y_last valid] */
     double newton_tol, cond_limit;
     long max_newton;
 } jd_loop;
@@ -195,7 +196,7 @@ static int jdl_manifold(const jd_loop *L, const double *y, const double *yd, dou
     for (long i = 0; i < n; ++i) s->g[i] = 0.0;
     for (long i = 0; i < r; ++i) s->g[L->dep[i]] = -s->v1[i];
     memcpy(L->y_last, y, f * sizeof(double));
-    info[4] = 1.0;
+    info[4] = info[6] = 1.0;
     return JD_LOOP_OK;
 }
 
@@ -290,7 +291,7 @@ long jd_loop_samples(const jd_loop *L, long N, const double *t, const double *x,
         /* far from the last solution: continuation in steps of at most JD_LOOP_DY in y, so
          * that the dependent coordinates follow their branch (Newton from afar may land on
          * the same configuration with an angle 2 pi away, or on another assembly mode) */
-        if (L->info[4] != 0.0) {
+        if (L->info[6] != 0.0) {
             double *y0 = s.v4, *yi = s.v4 + f, dmax = 0.0;
             memcpy(y0, L->y_last, f * sizeof(double));
             for (long j = 0; j < f; ++j) if (fabs(y[j] - y0[j]) > dmax) dmax = fabs(y[j] - y0[j]);

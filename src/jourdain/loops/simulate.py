@@ -55,7 +55,7 @@ from .closed_loop import (
     SingularConfiguration,
     constraint_function,
 )
-from .compiled import LoopKernel
+from .compiled import REASONS, LoopKernel
 from .redundant import simulate_penalty, simulate_redundant
 from .results import LoopResults
 from .scipy_run import SOLVERS, run_scipy
@@ -206,10 +206,14 @@ def _run_c(ev: LoopEvaluator, t0: float, t1: float, x: np.ndarray, tev: np.ndarr
             mark = max(kernel.cond, 10.0)
         kernel.set_cond_limit(min(cond_limit, 10 * mark) if repartition else cond_limit)
         seg = _Segment(kernel, t, state, tev[i_eval:], method, rtol, atol, max_step)
+        z_start, y_start = kernel.z.copy(), state[:f].copy()
         code = seg.run(t1)
         nfev += int(seg.cnt[0])
+        # before the samples overwrite them: why it stopped and where (a trial state)
+        reason, c_now, z_fail = int(kernel.info[2]), kernel.cond, kernel.z.copy()
         k = int(seg.n_out[0])
-        if k:
+        if k:  # the samples, followed from the segment's start
+            kernel.restart(z_start, y_start)
             _record(out, kernel, con, seg.out_t[:k], seg.out_x[:k, :2 * f])
             i_eval += k
         if code == 0:
@@ -220,16 +224,17 @@ def _run_c(ev: LoopEvaluator, t0: float, t1: float, x: np.ndarray, tev: np.ndarr
             message = (f"the integration failed at t = {seg.fail[0]:.9g}: "
                        f"{_FAILED.get(code, f'code {code}')}")
             break
-        reason, c_now = int(kernel.info[2]), kernel.cond
-        ev.z_guess = kernel.z.copy()
+        # Newton's start at the last accepted state: the last sample (or the segment's start;
+        # the failed evaluation may have left the kernel's configuration anywhere)
+        ev.z_guess = kernel.z.copy() if k else z_start
         ev._last = None
         if reason == 2:
-            d = decide(ev, t, state, c_now, repartition, cond_limit)
+            d = decide(ev, t, state, c_now, repartition, cond_limit, z_fail, float(seg.fail[0]))
             if d.action == "switch":
                 assert d.partition is not None and d.z is not None and d.zd is not None
                 ev.set_partition(d.partition)
                 kernel.set_partition(d.partition)
-                kernel.z[:] = d.z
+                kernel.restart(d.z, d.z[list(d.partition.independent)])
                 partitions.append((t, tuple(ev.independent_names)))
                 ind = list(d.partition.independent)
                 state = np.concatenate([d.z[ind], d.zd[ind], state[-1:]])
@@ -237,6 +242,8 @@ def _run_c(ev: LoopEvaluator, t0: float, t1: float, x: np.ndarray, tev: np.ndarr
                 continue
             if d.action == "continue":  # no better partition here: watch for more
                 mark = d.cond
+                assert d.z is not None
+                kernel.restart(d.z, state[:f])
                 continue
             singular = d.singular or SingularConfiguration(
                 f"{ev.loop.name}: singular configuration at t = {t:.9g}: the condition "
@@ -244,7 +251,7 @@ def _run_c(ev: LoopEvaluator, t0: float, t1: float, x: np.ndarray, tev: np.ndarr
         else:
             singular = SingularConfiguration(
                 f"{ev.loop.name}: at t ≈ {seg.fail[0]:.9g} (last accepted state t = {t:.9g}, "
-                f"independent {', '.join(ev.independent_names)}): {kernel.reason()}",
+                f"independent {', '.join(ev.independent_names)}): {REASONS.get(reason, reason)}",
                 t=float(seg.fail[0]), z=kernel.z.copy(), cond=c_now)
         status, message = "singular", str(singular)
         break
@@ -255,7 +262,10 @@ def _run_c(ev: LoopEvaluator, t0: float, t1: float, x: np.ndarray, tev: np.ndarr
 def _record(out: dict[str, list], kernel: LoopKernel, con: Any, t: np.ndarray,
             x: np.ndarray) -> None:
     """Samples at ``t`` of the states ``x = [y, ẏ]`` on the manifold (C), with T and V."""
-    s, _ = kernel.samples(t, x)
+    s, bad = kernel.samples(t, x)
+    if bad >= 0:  # a sample off the manifold's reach (at a singular position): cut there
+        t = t[:bad]
+        s = {k: v[:bad] for k, v in s.items()}
     ev = kernel.ev
     e = con.batch(s["z"], s["zd"], t, ev.p, ev.u)
     out["t"].extend(t.tolist())
