@@ -84,3 +84,23 @@ def test_refusals(f):
 def test_large_f_left_to_the_loop():
     assert ldl_source(WRITTEN_OUT_MAX_F + 1) == ""
     assert ldl_source(0) == ""
+
+
+@pytest.mark.parametrize("n", [1, 4, 9])  # f = 2, 5, 10: the written-out solve in the loop
+def test_the_loop_accelerations_are_lapacks(n):
+    """ÿ that the C loop computed with the written-out solve (jd_accel, kept as the results'
+    ydd) against LAPACK's solve of the same M, k, q at the same states."""
+    from jourdain import numeric
+    from jourdain.models import n_link_pendulum_on_cart
+
+    s = n_link_pendulum_on_cart(n)
+    assert s.f <= WRITTEN_OUT_MAX_F
+    y0 = np.concatenate([[0.0], np.linspace(np.pi + 0.3, np.pi - 0.3, n)])
+    res = s.simulate((0, 2.0), y0, np.zeros(n + 1), inputs={"F": 0.5}, rtol=1e-9, atol=1e-9)
+    fn = numeric.mkq_function(s)
+    out = fn.batch(res.y, res.yd, res.t, numeric.parameter_vector(s, None), res.u)
+    M, k, q = out["M"], out["k"][:, :, 0], out["q"][:, :, 0]
+    ref = np.linalg.solve(M, (q - k)[:, :, None])[:, :, 0]
+    cond = np.linalg.cond(M)
+    tol = 20 * s.f * cond[:, None] * np.finfo(float).eps * np.abs(ref).max(axis=1, keepdims=True)
+    assert np.all(np.abs(res.ydd - ref) <= tol)
