@@ -134,8 +134,12 @@ def run_report(model: Any, out: Path, parameters: Mapping[str, float] | None = N
     cols = ["t", *names, *[f"{n}_d" for n in names], *[f"Phi[{r}]" for r in res.labels],
             *[f"Phi_d[{r}]" for r in res.labels], *[f"lambda[{r}]" for r in res.labels],
             "T", "V"]
+    wrenches = res.closing_reactions()
+    for name in wrenches:
+        cols += [f"{name}.{q}{c}" for q in "FT" for c in "xyz"]
     data = np.column_stack([res.t, res.z, res.zd, res.Phi, res.Phi_dot, res.lam, res.T,
-                            res.V])
+                            res.V, *[np.column_stack([w["F"], w["T"]])
+                                     for w in wrenches.values()]])
     np.savetxt(out / "motion.csv", data, delimiter=",", header=",".join(cols), comments="")
     figs = []
     fig, ax = plt.subplots(figsize=(7, 3.5))
@@ -160,6 +164,20 @@ def run_report(model: Any, out: Path, parameters: Mapping[str, float] | None = N
     ax.set_ylabel("closing-joint reactions λ")
     ax.legend()
     figs.append(("reactions.png", fig))
+    if wrenches:  # force and torque of each closing joint in its body A's axes
+        fig, axs = plt.subplots(1, 2, figsize=(9, 3.5))
+        for name, w in wrenches.items():
+            for j, c in enumerate("xyz"):
+                if np.any(w["F"][:, j]):
+                    axs[0].plot(res.t, w["F"][:, j], label=f"{name} F{c}")
+                if np.any(w["T"][:, j]):
+                    axs[1].plot(res.t, w["T"][:, j], label=f"{name} T{c}")
+        for a, what in zip(axs, ("force / N", "torque / N m"), strict=True):
+            a.set_xlabel("t / s")
+            a.set_ylabel(f"closing joint {what}")
+            if a.get_legend_handles_labels()[0]:
+                a.legend()
+        figs.append(("closing_joint_wrenches.png", fig))
     fig, ax = plt.subplots(figsize=(7, 3.5))
     E = res.total_energy
     ax.plot(res.t, E - E[0])
@@ -183,7 +201,8 @@ def run_report(model: Any, out: Path, parameters: Mapping[str, float] | None = N
         f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{html.escape(loop.name)}"
         f"</title></head><body><h1>{html.escape(loop.name)}</h1>{body}{imgs}"
         "<p>motion.csv: tree coordinates, rates, constraint residuals, closing-joint "
-        "reactions and energies at every sample.</p></body></html>")
+        "multipliers, energies and each closing joint's force and torque (B on A at A's "
+        "joint point, in A's axes) at every sample.</p></body></html>")
     return lines
 
 

@@ -11,6 +11,7 @@ import numpy as np
 
 from ..errors import EvaluationError
 from .closed_loop import ClosedLoopSystem, SingularConfiguration
+from .reactions import closing_reactions
 
 
 @dataclass
@@ -84,6 +85,12 @@ class LoopResults:
             raise EvaluationError(f'unknown constraint row "{label}"; rows are {self.labels}')
         return self.lam[:, self.labels.index(label)]
 
+    def closing_reactions(self) -> dict[str, dict[str, np.ndarray]]:
+        """Force ``F`` and torque ``T`` (N × 3, in body A's frame, B on A at A's joint point)
+        of every closing joint with points, by name (:mod:`jourdain.loops.reactions`)."""
+        p = np.array([self.parameters[k] for k, _ in self.loop.tree.parameters])
+        return closing_reactions(self.loop, self.z, self.lam, self.t, p)
+
     def summary(self) -> str:
         parts = "; ".join(f"t ≥ {t0:.6g}: {', '.join(n)}" for t0, n in self.partitions)
         return "\n".join([
@@ -93,7 +100,19 @@ class LoopResults:
             f"  independent coordinates: {parts}",
             f"  constraint residuals: max |Φ| = {self.max_Phi:.3e}, max |Φ̇| = "
             f"{self.max_Phi_dot:.3e}",
-            f"  relative energy drift {self.energy_drift:.3e} (meaningful when conservative)"])
+            f"  relative energy drift {self.energy_drift:.3e} (meaningful when conservative)",
+            *self._reaction_lines()])
+
+    def _reaction_lines(self) -> list[str]:
+        if not len(self.t):
+            return []
+        lines = []
+        for name, w in self.closing_reactions().items():
+            F, T = np.abs(w["F"]).max(axis=0), np.abs(w["T"]).max(axis=0)
+            lines.append(f"  closing joint {name}: max |F| = ({F[0]:.4g}, {F[1]:.4g}, "
+                         f"{F[2]:.4g}), max |T| = ({T[0]:.4g}, {T[1]:.4g}, {T[2]:.4g}) in "
+                         "its body A's axes")
+        return lines
 
     def tree_results(self) -> Any:
         """The motion as :class:`jourdain.Results` of the tree (its coordinates z), for the

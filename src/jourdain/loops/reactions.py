@@ -1,0 +1,114 @@
+"""Reactions of the closing joints by name (issue 11): the multipliers λ of each closing
+joint's rows assembled into the force ``F`` and the torque ``T`` that body B exerts on body
+A at A's joint point, in A's frame (the joint's axes: ``axis`` and ``point_a`` are given in
+it), like the tree joints' reactions (:mod:`jourdain.stages.reactions`). Body B feels
+``−F`` and ``−T − (p_A − p_B) × F`` about its own joint point.
+
+The virtual work of the constraint forces is ``δΦᵀλ`` (:mod:`jourdain.loops.constraints`):
+
+* a row ``p_A − p_B`` (component k, inertial) contributes the force ``λ·e_k``;
+* a row ``a·b`` (``a`` fixed in A, ``b`` in B) contributes the torque ``λ·(a × b)``;
+* a row ``(p_B − p_A)·w`` (``w`` fixed in A: prismatic, point on a line or a plane)
+  contributes the force ``−λ·w`` acting at ``p_B``: about ``p_A`` also the torque
+  ``(p_B − p_A) × (−λ·w)``.
+
+A ``constraint`` closing joint (scalar expressions) has no points: its reactions stay the
+generalized multipliers λ (``<name>.1``, …). Where a planar model drops the out-of-plane rows
+their components are zero (not determined by a planar motion).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+from typing import Any
+
+import numpy as np
+import symengine as se
+
+from ..numeric import CompiledFunction, lambdify, parameter_vector
+from ..stages.kinematics import _cross, _mv, kinematics
+from ..symbolic import SymMatrix
+from .closed_loop import ClosedLoopSystem, constraints
+from .constraints import ZERO3, Vec3
+
+_IDENT = ((se.Integer(1), se.Integer(0), se.Integer(0)),
+          (se.Integer(0), se.Integer(1), se.Integer(0)),
+          (se.Integer(0), se.Integer(0), se.Integer(1)))
+
+
+@dataclass(frozen=True)
+class ClosingReactions:
+    """The wrench map of the closing joints: ``W`` (6 × m, symbolic in z): the force (rows
+    0–2) and torque (rows 3–5) on A in A's frame per unit multiplier of each constraint
+    row; ``joints``: the closing joints with points, each with the indices of its rows."""
+
+    W: SymMatrix
+    joints: tuple[tuple[str, tuple[int, ...]], ...]
+
+
+@lru_cache(maxsize=16)
+def closing_wrench_map(loop: ClosedLoopSystem) -> ClosingReactions:
+    """The symbolic wrench map of :class:`ClosingReactions` for ``loop``."""
+    kin = kinematics(loop.tree)
+    con = constraints(loop)
+    by_name = {cj.name: cj for cj in loop.closing}
+    cols: list[list[se.Basic]] = []
+    joints: dict[str, list[int]] = {}
+    for i, row in enumerate(con.rows):
+        cj = by_name[row.joint]
+        if cj.type == "constraint" or row.direction is None:
+            cols.append([se.Integer(0)] * 6)
+            continue
+        joints.setdefault(cj.name, []).append(i)
+        rA, SA = _frame(kin, cj.body_a)
+        rB, SB = _frame(kin, cj.body_b)
+        pA = tuple(rA[k] + _mv(SA, cj.point_a)[k] for k in range(3))
+        pB = tuple(rB[k] + _mv(SB, cj.point_b)[k] for k in range(3))
+        d = row.direction
+        if row.kind == "force":
+            F: Vec3 = d
+            # rows (p_B − p_A)·w act at p_B: their moment about p_A
+            T: Vec3 = (ZERO3 if cj.type in ("spherical", "revolute", "universal")
+                       else _cross(tuple(pB[k] - pA[k] for k in range(3)), d))  # type: ignore[arg-type]
+        else:
+            F, T = ZERO3, d
+        # into A's frame: S_Aᵀ·v
+        SAt = tuple(tuple(SA[r][c] for r in range(3)) for c in range(3))
+        cols.append([*_mv(SAt, F), *_mv(SAt, T)])
+    W = SymMatrix.from_rows([[cols[j][k] for j in range(len(cols))] for k in range(6)])
+    return ClosingReactions(W, tuple((n, tuple(ix)) for n, ix in joints.items()))
+
+
+def _frame(kin: Any, body: str) -> tuple[Vec3, Any]:
+    if body == "world":
+        return ZERO3, _IDENT
+    bk = kin[body]
+    return tuple(bk.r_O.rows[i][0] for i in range(3)), bk.S.rows  # type: ignore[return-value]
+
+
+@lru_cache(maxsize=16)
+def _wrench_function(loop: ClosedLoopSystem) -> CompiledFunction:
+    return lambdify(loop.tree, {"W": closing_wrench_map(loop).W})
+
+
+def closing_reactions(loop: ClosedLoopSystem, z: Any, lam: Any, t: Any = 0.0,
+                      p: Any = None) -> dict[str, dict[str, np.ndarray]]:
+    """The force ``F`` and torque ``T`` (N × 3 each, in A's frame, B on A at A's joint point)
+    of every closing joint with points, from configurations ``z`` (N × n) and multipliers
+    ``lam`` (N × m, in the order of ``constraints(loop).labels``). ``p``: the parameter
+    vector (default: the tree's values)."""
+    z = np.atleast_2d(np.asarray(z, dtype=float))
+    lam = np.atleast_2d(np.asarray(lam, dtype=float))
+    fn = _wrench_function(loop)
+    pv = parameter_vector(loop.tree, None) if p is None else np.asarray(p, dtype=float)
+    W = fn.batch(z, np.zeros_like(z), t, pv, np.zeros(len(loop.tree.inputs)))["W"]
+    out: dict[str, dict[str, np.ndarray]] = {}
+    for name, ix in closing_wrench_map(loop).joints:
+        cols = list(ix)
+        w = np.einsum("nij,nj->ni", W[:, :, cols], lam[:, cols])
+        out[name] = {"F": w[:, :3], "T": w[:, 3:]}
+    return out
+
+
+__all__ = ["ClosingReactions", "closing_reactions", "closing_wrench_map"]
