@@ -8,6 +8,8 @@ import json
 import re
 from pathlib import Path
 
+import pytest
+
 import jourdain.io.report.equations as equations
 from jourdain.io import load_model
 from jourdain.io.report import write_report
@@ -129,3 +131,32 @@ def test_display_counts_operations_of_the_equations():
     assert set(display.nominal) == {n.name for n in model.nominal}
     assert json.loads(display.json_text)["format"] == "jourdain-eom/1"
 
+
+
+def test_figures_of_a_lost_worker_are_drawn_here():
+    import os
+    import signal
+    import time
+
+    import numpy as np
+
+    from jourdain.io.report import figures, workers
+
+    if workers.cores() < 2:
+        pytest.skip("one core: the report forks no workers")
+    t = np.linspace(0.0, 1.0, 11)
+    expected = figures.time_plot(t, {"x": t}, "x / m", "coordinates")
+    pool = workers.fork_workers(None, workers=1)
+    assert pool is not None
+    try:
+        queued = figures.Figures(pool)
+        first = queued.add(figures.time_plot, t, {"x": t}, "x / m", "coordinates")
+        assert queued.fill(first) == expected  # drawn by the worker, the same bytes
+        for pid in list(pool._processes):  # the worker killed (out of memory, say)
+            os.kill(pid, signal.SIGKILL)
+        time.sleep(0.5)
+        lost = figures.Figures(pool)
+        page = lost.add(figures.time_plot, t, {"x": t}, "x / m", "coordinates")
+        assert lost.fill(page) == expected
+    finally:
+        pool.shutdown()

@@ -8,6 +8,7 @@ import json
 import time
 from collections.abc import Mapping
 from concurrent.futures import Future, ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 from typing import Any
 
@@ -94,6 +95,7 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
         if parallel:  # two workers, Matplotlib imported in each while this process computes
             set_pending(model, max_ops)
             pool = fork_workers(prepare_worker)
+            set_pending(None, max_ops)  # the workers have their copy
         if pool is not None:
             display = pool.submit(display_in_worker)
         values = system.parameter_values
@@ -112,7 +114,10 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
             info.message = (f"interrupted by the user (Ctrl-C) after section {len(sections)} "
                             f"of {SECTIONS}; the sections after it are missing")
         if display is not None:  # the worker's display, and its files
-            run.display = display.result()
+            try:
+                run.display = display.result()
+            except BrokenProcessPool:  # the worker's process was lost: the display here
+                run.display = cached_display(model, max_ops)
             html, _ = equations_section(run.display, model, out)
             sections = [html if s == _EQUATIONS else s for s in sections]
         page = _page(run, sections, t_start)

@@ -190,10 +190,10 @@ def display_in_worker() -> Display:
     return cached_display(*_PENDING)
 
 
-def set_pending(model: ModelFile, max_ops: int) -> None:
-    """The model whose display the next forked worker computes."""
+def set_pending(model: ModelFile | None, max_ops: int) -> None:
+    """The model whose display the next forked worker computes (None: no more)."""
     global _PENDING
-    _PENDING = (model, max_ops)
+    _PENDING = None if model is None else (model, max_ops)
 
 
 def equations_section(display: Display, model: ModelFile, out: Path) -> tuple[str, list[Path]]:

@@ -8,6 +8,7 @@ import io
 import signal
 from collections.abc import Callable, Mapping
 from concurrent.futures import Future, ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 from typing import Any
 
 import numpy as np
@@ -154,19 +155,30 @@ class Figures:
 
     def __init__(self, pool: ProcessPoolExecutor | None = None) -> None:
         self.pool = pool
-        self.items: list[str | Future[str]] = []
+        self.items: list[tuple[str | Future[str], Callable[..., str], tuple[Any, ...]]] = []
 
     def add(self, draw: Callable[..., str], *args: Any) -> str:
         """A placeholder for ``draw(*args)`` (a module-level function of this module, so that
         a worker can be sent it)."""
         key = f"<!--jourdain-figure-{len(self.items)}-->"
-        self.items.append(self.pool.submit(draw, *args) if self.pool is not None
-                          else draw(*args))
+        item: str | Future[str]
+        try:
+            item = self.pool.submit(draw, *args) if self.pool is not None else draw(*args)
+        except BrokenProcessPool:  # the worker's process was lost: drawn here
+            item = draw(*args)
+        self.items.append((item, draw, args))
         return key
 
     def fill(self, page: str) -> str:
-        """``page`` with every placeholder replaced by its figure (waiting for the worker)."""
-        for k, item in enumerate(self.items):
-            text = item if isinstance(item, str) else item.result()
+        """``page`` with every placeholder replaced by its figure (waiting for the worker; a
+        figure that the worker could not deliver, its process lost, is drawn here)."""
+        for k, (item, draw, args) in enumerate(self.items):
+            if isinstance(item, str):
+                text = item
+            else:
+                try:
+                    text = item.result()
+                except BrokenProcessPool:
+                    text = draw(*args)
             page = page.replace(f"<!--jourdain-figure-{k}-->", text, 1)
         return page
