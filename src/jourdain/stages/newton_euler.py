@@ -1,6 +1,9 @@
-"""Newton–Euler equations of the free bodies (METHOD.md §2):
+"""Newton–Euler equations of the free bodies (``docs/method.md`` §2):
 
     M̄ · J̄ · ÿ + q̄^c = q̄^e + Q̄ · g
+
+Produces M̄ (``M_bar``), J̄ (``J_bar``), q̄^c (``q_c``), q̄^e (``q_e``) and the forces on each
+body (:class:`NewtonEuler`); Q̄ and g are the reactions stage's (:mod:`jourdain.stages.reactions`).
 
 Rows are ordered as in the seed: the 3p translational rows of all bodies (inertial frame), then the
 3p rotational rows (each body's own frame, about its centre of mass).

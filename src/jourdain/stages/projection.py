@@ -1,6 +1,8 @@
-"""Projection with J̄ᵀ, which eliminates the reaction forces (METHOD.md §3):
+"""Projection with J̄ᵀ, which eliminates the reaction forces (``docs/method.md`` §3):
 
     M(y,t)·ÿ + k(y,ẏ,t) = q(y,ẏ,t),   M = J̄ᵀ M̄ J̄,  k = J̄ᵀ q̄^c,  q = J̄ᵀ q̄^e
+
+Produces M, k, q (:class:`EquationsOfMotion`).
 
 The products are formed body by body from the sparse columns of J_T and J_R, never as dense
 6p×6p products; terms that share the same Jacobian columns are collected first (so M_jk of a chain
