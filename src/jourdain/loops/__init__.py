@@ -14,7 +14,7 @@ from .closed_loop import (
     evaluate,
     partition,
 )
-from .constraints import KINDS, ClosingJoint, ConstraintRow, grubler
+from .closing_joints import KINDS, ClosingJoint, ConstraintRow, grubler
 
 __all__ = ["KINDS", "Assembly", "AssemblyError", "ClosedLoopSystem", "ClosingJoint",
            "ConstraintRow", "Constraints", "LoopEvaluator", "Partition",

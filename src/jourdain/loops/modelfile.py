@@ -11,7 +11,7 @@ from typing import Any
 
 from ..errors import ModelError
 from .closed_loop import ClosedLoopSystem
-from .constraints import KINDS, ClosingJoint
+from .closing_joints import KINDS, ClosingJoint
 
 #: keys of a [closing_joints.<name>] table, by its type
 _KEYS: dict[str, set[str]] = {

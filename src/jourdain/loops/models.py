@@ -5,7 +5,7 @@ from __future__ import annotations
 from ..model import Body, Gravity, Prismatic, Revolute, rod, symbols
 from ..pipeline import System  # jourdain.System: the model with its stages (issue 16)
 from .closed_loop import ClosedLoopSystem
-from .constraints import ClosingJoint
+from .closing_joints import ClosingJoint
 
 
 def four_bar(independent: tuple[str, ...] | None = ("theta1",)) -> ClosedLoopSystem:

@@ -4,7 +4,7 @@ A at A's joint point, in A's frame (the joint's axes: ``axis`` and ``point_a`` a
 it), like the tree joints' reactions (:mod:`jourdain.stages.reactions`). Body B feels
 ``−F`` and ``−T − (p_A − p_B) × F`` about its own joint point.
 
-The virtual work of the constraint forces is ``δΦᵀλ`` (:mod:`jourdain.loops.constraints`):
+The virtual work of the constraint forces is ``δΦᵀλ`` (:mod:`jourdain.loops.closing_joints`):
 
 * a row ``p_A − p_B`` (component k, inertial) contributes the force ``λ·e_k``;
 * a row ``a·b`` (``a`` fixed in A, ``b`` in B) contributes the torque ``λ·(a × b)``;
@@ -30,7 +30,7 @@ from ..numeric import CompiledFunction, lambdify, parameter_vector
 from ..stages.kinematics import _cross, _mv, kinematics
 from ..symbolic import SymMatrix
 from .closed_loop import ClosedLoopSystem, constraints
-from .constraints import ZERO3, Vec3
+from .closing_joints import ZERO3, Vec3
 
 _IDENT = ((se.Integer(1), se.Integer(0), se.Integer(0)),
           (se.Integer(0), se.Integer(1), se.Integer(0)),
