@@ -42,11 +42,8 @@ from dataclasses import dataclass
 import symengine as se
 
 from ..errors import ModelError
-from ..model.expressions import as_expr, as_vector, axis_vector, free_names
+from ..model.expressions import Expr, Vec3, as_expr, as_vector, axis_vector, free_names
 from ..stages.kinematics import _cross, _dot, _mv
-
-Expr = se.Basic
-Vec3 = tuple[Expr, Expr, Expr]
 
 #: the kinds of closing joint and the rows each contributes before dropping zero rows
 KINDS = ("revolute", "spherical", "universal", "prismatic", "point_on_line", "point_on_plane",
@@ -176,7 +173,7 @@ def perpendiculars(u: Vec3) -> tuple[Vec3, Vec3]:
     n = se.sqrt(_dot(w, w))
     n1 = tuple(c / n for c in w)
     n2 = _cross(u, n1)
-    return n1, n2  # type: ignore[return-value]
+    return n1, n2
 
 
 _IDENT = ((se.Integer(1), se.Integer(0), se.Integer(0)),
@@ -208,7 +205,7 @@ def constraint_rows(kin: object, closing: Sequence[ClosingJoint]) -> list[Constr
             return ZERO3, _IDENT
         bk = kin[body]  # type: ignore[index]
         r = tuple(bk.r_O.rows[i][0] for i in range(3))
-        return r, bk.S.rows  # type: ignore[return-value]
+        return r, bk.S.rows
 
     rows: list[ConstraintRow] = []
     for cj in closing:
@@ -223,7 +220,7 @@ def constraint_rows(kin: object, closing: Sequence[ClosingJoint]) -> list[Constr
         pB = tuple(rB[i] + _mv(SB, cj.point_b)[i] for i in range(3))
         ex = _IDENT
         if cj.type in ("spherical", "revolute", "universal"):
-            d = _sub(pA, pB)  # type: ignore[arg-type]
+            d = _sub(pA, pB)
             for i, c in enumerate("xyz"):
                 rows.append(ConstraintRow(n, f"{n}.F{c}", d[i], "force", ex[i]))
         if cj.type == "revolute":
@@ -236,7 +233,7 @@ def constraint_rows(kin: object, closing: Sequence[ClosingJoint]) -> list[Constr
             b = _mv(SB, cj.axis_b)  # type: ignore[arg-type]
             rows.append(ConstraintRow(n, f"{n}.M", _dot(a, b), "moment", _cross(a, b)))
         elif cj.type in ("prismatic", "point_on_line", "point_on_plane"):
-            d = _sub(pB, pA)  # type: ignore[arg-type]
+            d = _sub(pB, pA)
             normals = ((cj.axis,) if cj.type == "point_on_plane"
                        else perpendiculars(cj.axis))  # type: ignore[arg-type]
             for k, nv in enumerate(normals, 1):

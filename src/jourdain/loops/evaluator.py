@@ -6,7 +6,7 @@ The compiled counterpart for simulations is :mod:`jourdain.loops.compiled`."""
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -278,7 +278,8 @@ class LoopEvaluator:
 
 
 def evaluate(loop: LoopModel, z: Any, zd: Any = None, t: float = 0.0,
-             parameters: Mapping[str, float] | None = None, inputs: Any = None
+             parameters: Mapping[str, float] | None = None,
+             inputs: Sequence[float] | None = None
              ) -> dict[str, Any]:
     """Assemble ``z, zd`` (independent coordinates held) and evaluate there: ``M, k, q`` in
     the independent coordinates, ``J_z``, ``J_bar = J̄_tree·J_z``, ``ydd``, the multipliers
@@ -296,7 +297,7 @@ def evaluate(loop: LoopModel, z: Any, zd: Any = None, t: float = 0.0,
     s["orthogonality"] = float(np.max(np.abs(s["Phi_z"][list(ev.part.rows)] @ s["J_z"])))
     tree = tree_evaluate(loop.tree, s["z"], s["zd"], t, parameters,
                          None if not loop.tree.inputs else
-                         (np.zeros(len(loop.tree.inputs)) if inputs is None else inputs))
+                         ([0.0] * len(loop.tree.inputs) if inputs is None else inputs))
     s["J_bar"] = tree["J_bar"] @ s["J_z"]
     s["M_bar"] = tree["M_bar"]
     s["assembly"] = asm

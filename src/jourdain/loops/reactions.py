@@ -26,11 +26,12 @@ from typing import Any
 import numpy as np
 import symengine as se
 
+from ..model.expressions import Mat3, Vec3
 from ..numeric import CompiledFunction, lambdify, parameter_vector
 from ..stages.kinematics import _cross, _mv, kinematics
 from ..symbolic import SymMatrix
 from .closed_loop import ClosedLoopSystem, constraints
-from .closing_joints import ZERO3, Vec3
+from .closing_joints import ZERO3
 
 _IDENT = ((se.Integer(1), se.Integer(0), se.Integer(0)),
           (se.Integer(0), se.Integer(1), se.Integer(0)),
@@ -70,11 +71,12 @@ def closing_wrench_map(loop: ClosedLoopSystem) -> ClosingReactions:
             F: Vec3 = d
             # rows (p_B − p_A)·w act at p_B: their moment about p_A
             T: Vec3 = (ZERO3 if cj.type in ("spherical", "revolute", "universal")
-                       else _cross(tuple(pB[k] - pA[k] for k in range(3)), d))  # type: ignore[arg-type]
+                       else _cross((pB[0] - pA[0], pB[1] - pA[1], pB[2] - pA[2]), d))
         else:
             F, T = ZERO3, d
         # into A's frame: S_Aᵀ·v
-        SAt = tuple(tuple(SA[r][c] for r in range(3)) for c in range(3))
+        SAt: Mat3 = ((SA[0][0], SA[1][0], SA[2][0]), (SA[0][1], SA[1][1], SA[2][1]),
+                     (SA[0][2], SA[1][2], SA[2][2]))
         cols.append([*_mv(SAt, F), *_mv(SAt, T)])
     W = SymMatrix.from_rows([[cols[j][k] for j in range(len(cols))] for k in range(6)])
     return ClosingReactions(W, tuple((n, tuple(ix)) for n, ix in joints.items()))
@@ -84,7 +86,8 @@ def _frame(kin: Any, body: str) -> tuple[Vec3, Any]:
     if body == "world":
         return ZERO3, _IDENT
     bk = kin[body]
-    return tuple(bk.r_O.rows[i][0] for i in range(3)), bk.S.rows  # type: ignore[return-value]
+    r = bk.r_O.rows
+    return (r[0][0], r[1][0], r[2][0]), bk.S.rows
 
 
 @lru_cache(maxsize=16)
