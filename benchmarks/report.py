@@ -10,8 +10,10 @@ the process to its exit (imports included), in two states of the compile cache:
   libraries and the display are read from the cache).
 
 Reported per example: the best of ``--repeat`` runs in each state (the machine is shared: the
-best is the least disturbed), its exit status, and the ratio of the warm time to the 2 s
-target; then the worst example of each state. Before the timings, one untimed run writes the
+best is the least disturbed), its exit status, the ratio of the warm time to the 2 s target
+and the processor time (user + system, the process and its workers) of the warm run, which
+a loaded machine inflates much less than the wall time; then the worst example of each
+state. Before the timings, one untimed run writes the
 bytecode of every module imported (a fresh checkout's first run compiles them). The floor of
 every run, ``python -c "import jourdain.cli"``, is timed the same way and printed first.
 
@@ -27,6 +29,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import resource
 import subprocess
 import sys
 import tempfile
@@ -51,15 +54,20 @@ def examples(only: list[str] | None) -> list[Path]:
     return found
 
 
-def timed(cmd: list[str], cache: Path) -> tuple[float, int, str]:
-    """Seconds from the start of ``cmd`` to its exit, its exit status and its last line of
-    error output (the process's own compile cache ``cache``)."""
+def timed(cmd: list[str], cache: Path) -> tuple[float, int, str, float]:
+    """Seconds from the start of ``cmd`` to its exit, its exit status, its last line of
+    error output (the process's own compile cache ``cache``) and the processor seconds (user
+    and system) of it and its children: on a machine shared with other work the wall time
+    grows with the load, the processor time much less."""
     env = {**os.environ, "JOURDAIN_CACHE": str(cache), "PYTHONPATH": str(ROOT / "src")}
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     proc = subprocess.run(cmd, env=env, capture_output=True, text=True, check=False)
     wall = time.perf_counter() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
     err = (proc.stderr.strip().splitlines() or [""])[-1]
-    return wall, proc.returncode, err
+    return wall, proc.returncode, err, cpu
 
 
 def run_cmd(model: Path, out: Path) -> list[str]:
@@ -79,31 +87,37 @@ def main() -> int:
         base = Path(tmp)
         # bytecode of every module a run imports, written once, untimed
         timed(run_cmd(models[0], base / "warmup"), base / "warmup-cache")
-        floor = min(timed([sys.executable, "-c", "import jourdain.cli"], base / "c")[0]
+        floor = min(timed([sys.executable, "-c", "import jourdain.cli"], base / "c")[0::3]
                     for _ in range(args.repeat))
         print(f"python {sys.version.split()[0]}, {os.cpu_count()} cores; best of "
               f"{args.repeat}; target {TARGET_SECONDS:g} s per example")
-        print(f"floor: python -c 'import jourdain.cli': {floor:.2f} s\n")
-        print(f"{'example':<28} {'empty cache':>12} {'warm cache':>11} {'warm/target':>12}")
+        print(f"floor: python -c 'import jourdain.cli': {floor[0]:.2f} s "
+              f"(processor {floor[1]:.2f} s)\n")
+        print(f"{'example':<28} {'empty cache':>12} {'warm cache':>11} {'warm/target':>12} "
+              f"{'warm, processor':>16}")
         for k, model in enumerate(models):
             out = base / f"out{k}"
-            empty, warm = [], []
+            empty, warm, warm_cpu = [], [], []
             status: list[tuple[int, str]] = []
             for r in range(args.repeat):
                 cache = base / f"cache{k}-{r}"
-                wall, rc, err = timed(run_cmd(model, out), cache)  # empty cache
+                wall, rc, err, _ = timed(run_cmd(model, out), cache)  # empty cache
                 empty.append(wall)
                 status.append((rc, err))
-                wall, rc, err = timed(run_cmd(model, out), cache)  # the same cache, warm
+                wall, rc, err, cpu = timed(run_cmd(model, out), cache)  # the same, warm
                 warm.append(wall)
+                warm_cpu.append(cpu)
                 status.append((rc, err))
             bad = [(rc, err) for rc, err in status if rc != 0]
-            row: dict[str, Any] = {"example": model.name, "empty_s": min(empty), "warm_s": min(warm),
-                   "exit": bad[0][0] if bad else 0, "error": bad[0][1] if bad else ""}
+            row: dict[str, Any] = {
+                "example": model.name, "empty_s": min(empty), "warm_s": min(warm),
+                "warm_cpu_s": min(warm_cpu),
+                "exit": bad[0][0] if bad else 0, "error": bad[0][1] if bad else ""}
             rows.append(row)
             flag = "" if not bad else f"   exit {bad[0][0]}: {bad[0][1][:60]}"
             print(f"{model.name:<28} {row['empty_s']:>10.2f} s {row['warm_s']:>9.2f} s "
-                  f"{row['warm_s'] / TARGET_SECONDS:>11.2f}×{flag}", flush=True)
+                  f"{row['warm_s'] / TARGET_SECONDS:>11.2f}× {row['warm_cpu_s']:>14.2f} s{flag}",
+                  flush=True)
     worst_empty = max(rows, key=lambda r: r["empty_s"])
     worst_warm = max(rows, key=lambda r: r["warm_s"])
     print(f"\nworst, empty cache: {worst_empty['example']} {worst_empty['empty_s']:.2f} s "
@@ -111,7 +125,8 @@ def main() -> int:
     print(f"worst, warm cache:  {worst_warm['example']} {worst_warm['warm_s']:.2f} s "
           f"({worst_warm['warm_s'] / TARGET_SECONDS:.2f}× the target)")
     if args.json:
-        Path(args.json).write_text(json.dumps({"floor_s": floor, "examples": rows}, indent=1))
+        Path(args.json).write_text(json.dumps({"floor_s": floor[0], "examples": rows},
+                                              indent=1))
     return 0
 
 
