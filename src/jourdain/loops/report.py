@@ -185,7 +185,7 @@ def run_report(model: Any, out: Path, parameters: Mapping[str, float] | None = N
     ax.set_ylabel("E − E₀ / J")
     figs.append(("energy.png", fig))
     for fname, fg in figs:
-        fg.tight_layout()
+        fg.subplots_adjust(left=0.1, right=0.97, bottom=0.14, top=0.95, wspace=0.3)
         fg.savefig(out / fname, dpi=90)
         plt.close(fg)
     info = {"name": loop.name, "status": res.status, "message": res.message,

@@ -10,13 +10,13 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
-from scipy.integrate import BDF, DOP853, RK45, Radau
 
 from .charts import decide
 from .closed_loop import LoopEvaluator, SingularConfiguration
 
-#: the steppers, by ``method``
-SOLVERS = {"DOP853": DOP853, "RK45": RK45, "Radau": Radau, "BDF": BDF}
+#: the steppers, by ``method`` (SciPy's classes, imported when a run needs them: scipy.integrate
+#: takes 0.1–0.4 s to import, which the C engine does not need)
+SOLVERS = ("DOP853", "RK45", "Radau", "BDF")
 
 
 def run_scipy(ev: LoopEvaluator, t0: float, t1: float, x: np.ndarray, tev: np.ndarray,
@@ -24,6 +24,9 @@ def run_scipy(ev: LoopEvaluator, t0: float, t1: float, x: np.ndarray, tev: np.nd
               u_of: Callable[[float], Any], repartition: bool, cond_limit: float) -> dict:
     """Integrate from ``x = [y, ẏ]`` at ``t0``; the samples at ``tev`` (evaluated on the
     manifold by the evaluator), the partitions, status, message and the singularity."""
+    import scipy.integrate  # noqa: PLC0415 (heavy, needed by this driver only)
+
+    stepper = getattr(scipy.integrate, method)
     out: dict[str, list] = {k: [] for k in ("t", "z", "zd", "zdd", "Phi", "Phi_dot", "lam",
                                              "T", "V")}
     partitions = [(t0, tuple(ev.independent_names))]
@@ -45,7 +48,7 @@ def run_scipy(ev: LoopEvaluator, t0: float, t1: float, x: np.ndarray, tev: np.nd
 
     watermark = max(ev.part.cond, 10.0)
     while True:
-        solver = SOLVERS[method](rhs, t, x, t1, rtol=rtol, atol=atol, max_step=max_step)
+        solver = stepper(rhs, t, x, t1, rtol=rtol, atol=atol, max_step=max_step)
         if k_eval < len(tev) and tev[k_eval] == t:
             record(t, x)
             k_eval += 1
