@@ -25,15 +25,17 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import JourdainError
-from ..graph import Graph, free_symbol_names, jet_float
+from ..errors import EvaluationError, JourdainError
+from ..graph import Graph, evaluate_float, free_symbol_names, jet_float
+from ..numeric import mkq_function, parameter_vector
 from ..stages.kinematics import kinematics  # the model has no stage methods (issue 16)
+from ..stages.linearization.nominal import _perturbed
 from ..stages.newton_euler import newton_euler
-from ..stages.projection import projection
+from ..stages.projection import EquationsOfMotion, projection
+from .state_space import ZERO_RTOL
 
 if TYPE_CHECKING:
     from ..model.system import System
-    from ..stages.projection import EquationsOfMotion
 
 #: a derivative ``∂e/∂y_c`` counts as zero below this fraction of the largest value or
 #: derivative of M, k, q at the trial state (an identity test: round-off of terms that cancel,
@@ -55,9 +57,6 @@ def cyclic_coordinates(source: System | EquationsOfMotion) -> tuple[str, ...]:
     :data:`CYCLIC_RTOL` of the largest value or derivative there. The result is a property of
     the model, for all parameter values.
     """
-    from ..graph import evaluate_float
-    from ..stages.linearization.nominal import _perturbed
-    from ..stages.projection import EquationsOfMotion
 
     eom = source if isinstance(source, EquationsOfMotion) else projection(newton_euler(kinematics(source)))
     system = eom.system
@@ -133,8 +132,6 @@ def _screen_compiled(system: System, candidates: list[int]) -> set[int] | None:
     :data:`CYCLIC_RTOL` of the largest. This takes microseconds where the exact derivatives of
     the expression graph in Python took 0.3–0.5 s for a 7-joint arm. None (the caller then
     differentiates) when there is no compiler or a state has no real value."""
-    from ..numeric import mkq_function, parameter_vector
-    from ..stages.linearization.nominal import _perturbed
 
     try:
         fn = mkq_function(system)
@@ -191,8 +188,6 @@ def check_cyclic(A: np.ndarray, coordinate_names: tuple[str, ...] | list[str],
     """The names in ``cyclic``, checked: each must be a coordinate, and its position must not
     act on the motion at this nominal motion (the column of ``A`` of ``η_c`` is zero to
     round-off of A). Raises :class:`jourdain.errors.EvaluationError` otherwise."""
-    from ..errors import EvaluationError
-    from .modes import ZERO_RTOL
 
     names = list(coordinate_names)
     out = []

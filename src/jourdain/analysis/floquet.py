@@ -33,7 +33,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import EvaluationError, warn
+from ..numeric import parameter_vector
 from ..stages.linearization import CompiledLinearization, Linearization, NominalMotionWarning
+from .cyclic import check_cyclic, cyclic_coordinates
 from .modes import ASYMPTOTICALLY_STABLE, MARGINALLY_STABLE, UNSTABLE
 
 #: default relative tolerance of the integration of Φ̇ = A(t)·Φ
@@ -153,8 +155,6 @@ def floquet(lin: Linearization | CompiledLinearization, period: float, t0: float
     from scipy.integrate import solve_ivp
     from scipy.linalg import cho_factor, cho_solve
 
-    from ..numeric import parameter_vector
-    from .cyclic import check_cyclic, cyclic_coordinates
 
     T = float(period)
     if not np.isfinite(T) or T <= 0:

@@ -32,14 +32,11 @@ import numpy as np
 from ..errors import warn
 from ..stages.linearization import NominalMotionWarning
 from .cyclic import check_cyclic, cyclic_coordinates, reduced_matrix
-from .state_space import AnyLinearization, StateSpace, state_space
+from .state_space import ZERO_RTOL, AnyLinearization, StateSpace, state_space
 
 ASYMPTOTICALLY_STABLE = "asymptotically stable"
 MARGINALLY_STABLE = "marginally stable"
 UNSTABLE = "unstable"
-#: real parts (and, in tables, imaginary parts) below this fraction of the largest |λ| (at
-#: least 1) count as zero: the default ``rtol`` of :func:`stability`
-ZERO_RTOL = 1e-8
 
 
 @dataclass(frozen=True)

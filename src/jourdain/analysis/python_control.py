@@ -24,47 +24,15 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import symengine as se
 
-from ..errors import EvaluationError, JourdainError
+from ..errors import EvaluationError
+from ..stages.linearization import Linearization
+from ..stages.linearization.nominal import _nominal
 from .state_space import AnyLinearization, StateSpace, state_space
+from .state_space import MissingDependency as MissingDependency
+from .state_space import output_matrix as output_matrix
 
 if TYPE_CHECKING:
     from ..model.system import System
-
-
-class MissingDependency(JourdainError, ImportError):
-    """An optional dependency of jourdain is not installed; the message names the extra."""
-
-
-def _control() -> Any:
-    try:
-        import control
-    except ImportError:
-        raise MissingDependency(
-            "this needs python-control, an optional dependency of jourdain: "
-            'pip install "jourdain[control]" (or pip install control)') from None
-    return control
-
-
-def output_matrix(ss: StateSpace, outputs: Sequence[str] | None = None
-                  ) -> tuple[np.ndarray, tuple[str, ...]]:
-    """``C`` (p, 2f) selecting ``outputs`` among the states ``[η; η̇]`` (all of them, C = I,
-    when None), and the output names."""
-    names = ss.state_names
-    if outputs is None:
-        return np.eye(len(names)), tuple(names)
-    if isinstance(outputs, str):
-        outputs = [outputs]
-    chosen = list(outputs)
-    unknown = [o for o in chosen if o not in names]
-    if unknown:
-        raise EvaluationError(f"to_control: unknown output(s) {unknown}; outputs are states: "
-                              f"{', '.join(names)}")
-    if len(set(chosen)) != len(chosen):
-        raise EvaluationError(f"to_control: outputs {chosen} name a state twice")
-    C = np.zeros((len(chosen), len(names)))
-    for row, o in enumerate(chosen):
-        C[row, names.index(o)] = 1.0
-    return C, tuple(chosen)
 
 
 def to_control(lin: AnyLinearization | StateSpace, t: float | None = None,
@@ -96,7 +64,6 @@ def to_control(lin: AnyLinearization | StateSpace, t: float | None = None,
     MissingDependency
         Without python-control (the message names the extra ``jourdain[control]``).
     """
-    control = _control()
     if isinstance(lin, StateSpace):
         if t is not None or parameters:
             raise EvaluationError("to_control: a StateSpace holds numbers for one t and one set "
@@ -104,15 +71,10 @@ def to_control(lin: AnyLinearization | StateSpace, t: float | None = None,
         ss = lin
     else:
         ss = state_space(lin, t, parameters, allow_time_variant=allow_time_variant)
-    C, out_names = output_matrix(ss, outputs)
-    m = ss.B.shape[1]
-    D = np.zeros((C.shape[0], m))
     if name is None:
         base = lin.linearization if hasattr(lin, "linearization") else lin
         name = getattr(getattr(base, "system", None), "name", None)
-    kw = {} if name is None else {"name": str(name)}
-    return control.ss(ss.A, ss.B, C, D, states=list(ss.state_names),
-                      inputs=list(ss.input_names), outputs=list(out_names), **kw)
+    return ss.to_control(outputs, name=name)
 
 
 def state_names(system: System) -> list[str]:
@@ -150,8 +112,6 @@ def state_feedback(system: System, K: Any, nominal: Mapping[Any, Any] | Any,
     ModelError
         A nominal motion that names unknown coordinates or leaves some out.
     """
-    from ..stages.linearization import Linearization
-    from ..stages.linearization.nominal import _nominal
 
     f, names = system.f, system.input_names
     try:

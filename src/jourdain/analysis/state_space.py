@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import EvaluationError, JourdainError, SingularMassMatrix
+from ..numeric import parameter_vector
 from ..stages.linearization import (
     CompiledLinearization,
     Linearization,
@@ -23,6 +24,11 @@ from ..stages.linearization import (
     NumericLinearization,
     TimeVariantError,
 )
+
+#: real parts (and, in tables, imaginary parts) below this fraction of the largest |λ| (at
+#: least 1) count as zero: the default ``rtol`` of :func:`jourdain.analysis.stability`, and the
+#: tolerance of a zero column of A (a cyclic coordinate)
+ZERO_RTOL = 1e-8
 
 AnyLinearization = Linearization | CompiledLinearization | NumericLinearization
 
@@ -77,10 +83,50 @@ class StateSpace:
 
     def to_control(self, outputs: Sequence[str] | None = None, name: str | None = None) -> Any:
         """This system as a named ``control.StateSpace`` (python-control, the extra
-        ``jourdain[control]``); see :func:`jourdain.analysis.python_control.to_control`."""
-        from .python_control import to_control
+        ``jourdain[control]``): A, B, C selecting ``outputs`` among the states (all when None),
+        D = 0; see :func:`jourdain.analysis.python_control.to_control`."""
+        control = _control()
+        C, out_names = output_matrix(self, outputs)
+        D = np.zeros((C.shape[0], self.B.shape[1]))
+        kw = {} if name is None else {"name": str(name)}
+        return control.ss(self.A, self.B, C, D, states=list(self.state_names),
+                          inputs=list(self.input_names), outputs=list(out_names), **kw)
 
-        return to_control(self, outputs=outputs, name=name)
+
+class MissingDependency(JourdainError, ImportError):
+    """An optional dependency of jourdain is not installed; the message names the extra."""
+
+
+def _control() -> Any:
+    try:
+        import control
+    except ImportError:
+        raise MissingDependency(
+            "this needs python-control, an optional dependency of jourdain: "
+            'pip install "jourdain[control]" (or pip install control)') from None
+    return control
+
+
+def output_matrix(ss: StateSpace, outputs: Sequence[str] | None = None
+                  ) -> tuple[np.ndarray, tuple[str, ...]]:
+    """``C`` (p, 2f) selecting ``outputs`` among the states ``[η; η̇]`` (all of them, C = I,
+    when None), and the output names."""
+    names = ss.state_names
+    if outputs is None:
+        return np.eye(len(names)), tuple(names)
+    if isinstance(outputs, str):
+        outputs = [outputs]
+    chosen = list(outputs)
+    unknown = [o for o in chosen if o not in names]
+    if unknown:
+        raise EvaluationError(f"to_control: unknown output(s) {unknown}; outputs are states: "
+                              f"{', '.join(names)}")
+    if len(set(chosen)) != len(chosen):
+        raise EvaluationError(f"to_control: outputs {chosen} name a state twice")
+    C = np.zeros((len(chosen), len(names)))
+    for row, o in enumerate(chosen):
+        C[row, names.index(o)] = 1.0
+    return C, tuple(chosen)
 
 
 def numbers(lin: AnyLinearization, t: float | None = None,
@@ -157,7 +203,6 @@ def state_space(lin: AnyLinearization, t: float | None = None,
 
 def _from_numbers(base: Linearization | NumericLinearization, num: Mapping[str, np.ndarray],
                   t: float, parameters: Mapping[str, float] | None) -> StateSpace:
-    from ..numeric import parameter_vector
 
     M, P, Q, Bu, h = num["M_tilde"], num["P"], num["Q"], num["B"], num["h"]
     f = M.shape[0]
