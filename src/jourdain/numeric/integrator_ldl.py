@@ -11,9 +11,11 @@ product over the columns before it) is bound by latency, each column waiting for
 ``j`` dependent multiply-adds before its pivot and again before its entries; in the
 right-looking form the chain from one pivot to the next is one division, one multiplication
 and one multiply-add, and the rest of the updates are independent of each other, which the
-compiler schedules freely once the loops and their bounds are gone. The trailing matrix lives
-in registers while it fits; beyond that its updates go through the stack and the advantage is
-gone. Measured end to end (``benchmarks/simulation.py``'s run of the n-link pendulum on a cart,
+compiler schedules freely once the loops and their bounds are gone. Beyond about f = 11 the
+written-out code is slower than the loop although it executes half the instructions (valgrind,
+f = 13: 2 500 against 5 400 per solve; a left-looking form written out is slower still),
+probably because that much straight-line code no longer fits beside M, k, q in the instruction
+caches. Measured end to end (``benchmarks/simulation.py``'s run of the n-link pendulum on a cart,
 10 s at rtol = atol = 5e-8, the same right-hand-side evaluations, best of 30 rounds, both forms in
 one process, 2-core AMD EPYC, gcc 12 -O2): n = 2 (f = 3) 0.34 → 0.30 ms, n = 4 (f = 5)
 0.63 → 0.50 ms, n = 8 (f = 9) 1.40 → 1.29 ms, n = 10 (f = 11) 1.97 → 1.94 ms, but n = 12
