@@ -32,8 +32,8 @@ right-hand side the LDLᵀ loop of the 13×13 M 5 400 instructions, M, k, q 2 00
 (numeric/integrator_ldl.py) halves the solve's instructions but is slower at f = 13
 (probably: its code no longer fits beside M, k, q in the instruction caches), hence used up to
 f = 10; the articulated-body recursion (numeric.dynamics_function) is 4× (n = 12) to 11×
-(n = 4) slower per run here; -march=native on the step loop is slower (AVX-512 on 27-long vectors). 10× PyDy at
-n = 12 needs about 420 ns per right-hand side against 580-600 ns now.
+(n = 4) slower per run here; -march=native on the step loop is slower (AVX-512 on 27-long
+vectors). 10× PyDy at n = 12 needs about 420 ns per right-hand side against 580-600 ns now.
 
 PyDy's symbolic linear solver can take long for large n; it is
 skipped above ``--sympy-max-n`` (default 12: its code generation takes about 5 s at n = 12)
