@@ -20,11 +20,13 @@ many reports at a time; the compiled libraries go to ``$JOURDAIN_CACHE`` as for 
 from __future__ import annotations
 
 import html
+import logging
 import os
 import re
 import subprocess
 import sys
 import tempfile
+import time
 import tomllib
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -34,6 +36,8 @@ ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = ROOT / "examples"
 # the jourdain command of the interpreter that runs mkdocs (the project's .venv)
 JOURDAIN = Path(sys.executable).with_name("jourdain")
+
+log = logging.getLogger("mkdocs.plugins.jourdain.gallery")
 
 # the sections of a tree model's report whose first picture the gallery shows, in this order
 TREE_FIGURES = (("Snapshots of the motion", "snapshots"), ("Animation", "animation"),
@@ -164,8 +168,11 @@ def main() -> None:
     workers = int(os.environ.get("JOURDAIN_DOCS_WORKERS", min(4, os.cpu_count() or 1)))
     with tempfile.TemporaryDirectory(prefix="jourdain-gallery-") as tmp:
         jobs = [(model, Path(tmp) / model.stem) for model in models()]
+        start = time.perf_counter()
         with ThreadPoolExecutor(max_workers=max(1, workers)) as pool:
             outs = list(pool.map(lambda job: run_report(*job), jobs))
+        log.info("gallery: %d reports by `jourdain run` in %.1f s (%d at a time)", len(jobs),
+                 time.perf_counter() - start, max(1, workers))
         entries = [write_page(gen, model, out, paragraphs.get(model.name, ""))
                    for (model, _), out in zip(jobs, outs, strict=True)]
     index = ["# Gallery", "",
