@@ -100,8 +100,16 @@ def equilibrium(loop: ClosedLoopSystem, z_guess: Any, t: float = 0.0,
         # the Newton step in the coordinates Q and h are in: the linearization's own
         ind = [loop.coordinate_names.index(c) for c in lin.names]
         z = lin.z_s.copy()
-        z[ind] += np.linalg.solve(lin.Q, lin.h)
-    raise AssemblyError(f"{loop.name}: no equilibrium found near {list(z_guess)}")
+        try:
+            z[ind] += np.linalg.solve(lin.Q, lin.h)
+        except np.linalg.LinAlgError:
+            raise AssemblyError(f"{loop.name}: no isolated equilibrium near z = "
+                                f"{np.round(np.asarray(z_guess, dtype=float), 6).tolist()}: "
+                                "the stiffness Q in the independent coordinates "
+                                f"{', '.join(lin.names)} is singular there (a neutral "
+                                "direction)") from None
+    raise AssemblyError(f"{loop.name}: no equilibrium found near z = "
+                        f"{np.round(np.asarray(z_guess, dtype=float), 6).tolist()}")
 
 
 __all__ = ["LoopLinearization", "equilibrium", "linearize_loop"]

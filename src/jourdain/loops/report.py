@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import JourdainError
+from .cli import linearize_near
 from .closed_loop import ClosedLoopSystem, constraints
 
 
@@ -102,7 +103,6 @@ def run_report(model: Any, out: Path, parameters: Mapping[str, float] | None = N
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from .linearization import equilibrium, linearize_loop
     from .simulate import SOLVERS, simulate_loop
 
     loop: ClosedLoopSystem = model.loops
@@ -123,11 +123,10 @@ def run_report(model: Any, out: Path, parameters: Mapping[str, float] | None = N
     # linearization about the equilibrium nearest the initial configuration
     lin = None
     try:
-        zeq = equilibrium(loop, res.z[0], parameters=parameters)
-        lin = linearize_loop(loop, zeq, parameters=parameters)
+        lin, about = linearize_near(loop, res.z[0] if len(res.t) else sim.y0, parameters)
         eig = ", ".join(f"{v.real:.6g}{v.imag:+.6g}j" for v in lin.eigenvalues)
-        lines.append(f"  equilibrium z = {np.round(zeq, 6).tolist()}; eigenvalues in "
-                     f"{', '.join(lin.names)}: {eig}")
+        lines.append(f"  linearized about the {about}: z = {np.round(lin.z_s, 6).tolist()}; "
+                     f"eigenvalues in {', '.join(lin.names)}: {eig}")
     except (JourdainError, np.linalg.LinAlgError) as exc:
         lines.append(f"  no linearization: {exc}")
     # CSV of the motion, residuals and reactions

@@ -1,0 +1,66 @@
+"""``jourdain linearize`` and ``jourdain run`` on loop models (jourdain.loops.cli, report):
+the linearization in the independent coordinates with the parameters of --set, the fallback
+where the model has no isolated equilibrium, the closing joint's wrench in the report."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from jourdain.cli import main
+from jourdain.io.modelfile import load_model
+from jourdain.loops.linearization import equilibrium, linearize_loop
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
+
+def test_linearize_a_loop_model_with_set(capsys: pytest.CaptureFixture) -> None:
+    """The document's eigenvalues are those of linearize_loop about the equilibrium
+    (checked against the closed-form four-bar in tests/test_loops.py) at the --set values,
+    and a heavier coupler lowers the frequency."""
+    path = str(EXAMPLES / "four_bar.toml")
+    mf = load_model(path)
+    docs = {}
+    for m2 in (2.0, 4.0):
+        assert main(["linearize", path, "--json", "--set", f"m2={m2}"]) == 0
+        docs[m2] = json.loads(capsys.readouterr().out)
+        z = equilibrium(mf.loops, mf.simulation.y0, parameters={"m2": m2})
+        lin = linearize_loop(mf.loops, z, parameters={"m2": m2})
+        got = np.array([complex(*v) for v in docs[m2]["eigenvalues"]])
+        w = float(np.max(np.abs(lin.eigenvalues)))
+        # the same central differences at the same points: rounding of the Newton solves
+        assert np.max(np.abs(got - lin.eigenvalues)) <= 1e-6 * w
+        assert docs[m2]["independent"] == ["theta1"]
+        assert docs[m2]["frequencies_hz"] == pytest.approx([w / (2 * math.pi)], rel=1e-6)
+    assert docs[4.0]["frequencies_hz"][0] < docs[2.0]["frequencies_hz"][0]
+    assert main(["linearize", path]) == 0
+    text = capsys.readouterr().out
+    assert "M_tilde" in text and "eigenvalues" in text and "Hz" in text
+
+
+def test_linearize_without_isolated_equilibrium_falls_back(capsys: pytest.CaptureFixture
+                                                           ) -> None:
+    """The spatial RSSR's coupler spins freely about the line of its ball joints: no isolated
+    equilibrium (Q singular), so the linearization is about the initial configuration, and
+    the free spin gives a double zero eigenvalue."""
+    assert main(["linearize", str(EXAMPLES / "spatial_rssr.toml"), "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["about"].startswith("initial configuration at rest")
+    assert "no isolated equilibrium" in doc["about"]
+    ev = np.array([complex(*v) for v in doc["eigenvalues"]])
+    scale = float(np.max(np.abs(ev)))
+    assert int(np.sum(np.abs(ev) <= 1e-6 * scale)) == 2
+
+
+def test_run_report_has_the_closing_joint_wrench(tmp_path: Path) -> None:
+    out = tmp_path / "rep"
+    assert main(["run", str(EXAMPLES / "four_bar.toml"), "--out", str(out), "--t-end",
+                 "0.5"]) == 0
+    header = (out / "motion.csv").read_text().splitlines()[0].split(",")
+    assert [h for h in header if h.startswith("closure.")] == [
+        "closure.Fx", "closure.Fy", "closure.Fz", "closure.Tx", "closure.Ty", "closure.Tz"]
+    assert (out / "closing_joint_wrenches.png").stat().st_size > 0
