@@ -152,6 +152,10 @@ def display_scales(values: dict[str, np.ndarray]) -> dict[str, Any]:
 
 def cmd_linearize(args: argparse.Namespace) -> int:
     model = load(args.model)
+    if getattr(model, "loops", None) is not None:  # LOOPS-LINEARIZE (H2): independent coordinates
+        from ..loops.cli import linearize_command  # SciPy's linear algebra: loop models only
+
+        return linearize_command(model, overrides(model.system, args.set), args.json, args.about)
     tree_only(model, "linearize")
     system = model.system
     require(system, "linearize", "the linearization")
