@@ -15,18 +15,22 @@ jourdain's C integrator with them: one C call per step loop, no Python per right
 from __future__ import annotations
 
 import ctypes
+from collections.abc import Mapping
 from functools import lru_cache
 from importlib import resources
 from typing import Any
 
 import numpy as np
+import symengine as se
 
-from ..numeric import mkq_function
+from ..errors import EvaluationError
+from ..numeric import CompiledFunction, lambdify, mkq_function
 from ..numeric.ccode import HEADER, argument_names, function_source
 from ..numeric.toolchain import build, content_key
+from ..symbolic import SymMatrix
 from .closed_loop import ClosedLoopSystem, LoopEvaluator, Partition, constraints
 
-_VERSION = "loop-c2"
+_VERSION = "loop-c3"
 #: reasons in ``info[2]`` (``loop_c.h``)
 REASONS = {1: "Newton found no configuration on the manifold (Φ_d singular or divergence)",
            2: "the condition number of Φ_d passed the limit",
@@ -40,7 +44,8 @@ class _Loop(ctypes.Structure):
                 ("z", ctypes.c_void_p), ("y_last", ctypes.c_void_p), ("work", ctypes.c_void_p),
                 ("piv", ctypes.c_void_p), ("info", ctypes.c_void_p),
                 ("newton_tol", ctypes.c_double), ("cond_limit", ctypes.c_double),
-                ("max_newton", ctypes.c_long)]
+                ("max_newton", ctypes.c_long), ("uexpr", ctypes.c_void_p),
+                ("u_buf", ctypes.c_void_p)]
 
 
 def _ptr(a: np.ndarray) -> int:
@@ -66,6 +71,30 @@ def loop_library(loop: ClosedLoopSystem) -> ctypes.CDLL:
     return lib
 
 
+def input_function(loop: ClosedLoopSystem, inputs: Mapping[str, Any]) -> CompiledFunction:
+    """The inputs of ``loop``'s tree as compiled expressions of t and the parameters (an
+    input not given is 0); an expression in anything else is refused, naming it."""
+    tree = loop.tree
+    names = tree.input_names
+    unknown = sorted(set(inputs) - set(names))
+    if unknown:
+        raise EvaluationError(f"unknown input(s) {unknown}; inputs are {names}")
+    allowed = {tree.t, *tree.parameter_symbols}
+    exprs = []
+    for name in names:
+        v = inputs.get(name, 0.0)
+        if isinstance(v, bool) or not isinstance(v, (int, float, se.Basic)):
+            raise EvaluationError(f'input "{name}": expected a number or an expression, got '
+                                  f"{type(v).__name__}")
+        e = se.Float(float(v)) if isinstance(v, (int, float)) else v
+        extra = sorted(str(s) for s in e.free_symbols - allowed)
+        if extra:
+            raise EvaluationError(f'input "{name}" = {e}: the inputs of a loop model may depend '
+                                  f"on t and the parameters only, not on {', '.join(extra)}")
+        exprs.append(e)
+    return lambdify(tree, {"u": SymMatrix.column(exprs)})
+
+
 class LoopKernel:
     """The C-side state of one evaluator: call :meth:`set_partition` after the evaluator's
     partition changes; :meth:`samples` evaluates states on the manifold."""
@@ -81,6 +110,7 @@ class LoopKernel:
         self.struct = _Loop()
         self.cond_limit = float(cond_limit)
         self.set_partition(ev.part)
+        self.set_inputs(None)
 
     def set_partition(self, part: Partition) -> None:
         n, m = self.n, self.m
@@ -101,6 +131,14 @@ class LoopKernel:
         s.piv, s.info = _ptr(self.piv), _ptr(self.info)
         s.newton_tol, s.cond_limit, s.max_newton = self.ev.newton_tol, self.cond_limit, \
             self.ev.max_newton
+
+    def set_inputs(self, fn: CompiledFunction | None) -> None:
+        """Inputs as compiled expressions of t and the parameters (``fn(·, ·, t, p, ·)``,
+        one output per input; :func:`input_function`), or None: the constant ``ev.u``."""
+        self.inputs_fn = fn
+        self.u_buf = np.zeros(max(len(self.ev.loop.tree.inputs), 1))
+        self.struct.uexpr = None if fn is None else fn.address
+        self.struct.u_buf = _ptr(self.u_buf)
 
     def restart(self, z: np.ndarray, y: np.ndarray) -> None:
         """Start the next solve from the configuration ``z`` with independent coordinates
@@ -159,4 +197,4 @@ class LoopKernel:
         raise TypeError("LoopKernel holds C pointers and cannot be pickled")
 
 
-__all__ = ["LoopKernel", "loop_library"]
+__all__ = ["LoopKernel", "input_function", "loop_library"]

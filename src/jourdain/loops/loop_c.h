@@ -24,7 +24,16 @@ typedef struct {
                             * valid (the prediction), failures, y_last valid] */
     double newton_tol, cond_limit;
     long max_newton;
+    jd_tree_fn uexpr;      /* the inputs as functions of t and the parameters, or NULL */
+    double *u_buf;         /* their values */
 } jd_loop;
+
+/* the inputs at t: the integrator's (constants), or the compiled expressions */
+static const double *jdl_inputs(const jd_loop *L, double t, const double *u) {
+    if (!L->uexpr) return u;
+    L->uexpr(L->z, L->z, t, L->p, u, L->u_buf);
+    return L->u_buf;
+}
 
 /* reasons in info[2] */
 #define JD_LOOP_OK 0
@@ -267,6 +276,7 @@ int jd_loop_accel(const double *y, const double *yd, double t, const double *p,
                   const double *u, double *ydd, double *power) {
     const jd_loop *L = (const jd_loop *)(const void *)p;
     jdl_parts s = jdl_carve(L);
+    u = jdl_inputs(L, t, u);
     int reason = jdl_manifold(L, y, yd, t, u, &s);
     if (reason) {
         L->info[2] = reason;
@@ -282,11 +292,11 @@ int jd_loop_accel(const double *y, const double *yd, double t, const double *p,
  * tree's equations M_tree zdd + k_tree - q_tree = Phi_z^T lambda (rows not kept: 0). Returns
  * the index of the first state that failed, or -1. */
 long jd_loop_samples(const jd_loop *L, long N, const double *t, const double *x, long sx,
-                     const double *u, double *out) {
+                     const double *u_const, double *out) {
     long n = L->n, m = L->m, f = L->f, r = L->r, w = 3 * n + 3 * m + 1;
     jdl_parts s = jdl_carve(L);
     for (long k = 0; k < N; ++k) {
-        const double *y = x + k * sx, *yd = y + f;
+        const double *y = x + k * sx, *yd = y + f, *u = jdl_inputs(L, t[k], u_const);
         double *o = out + k * w, *ydd = s.b + f, pw;
         /* far from the last solution: continuation in steps of at most JD_LOOP_DY in y, so
          * that the dependent coordinates follow their branch (Newton from afar may land on

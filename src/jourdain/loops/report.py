@@ -117,7 +117,8 @@ def run_report(model: Any, out: Path, parameters: Mapping[str, float] | None = N
     atol = sim.atol if sim.atol != DEFAULT_ATOL else 1e-12
     method = sim.method if sim.method in SOLVERS else "DOP853"
     res = simulate_loop(loop, (0.0, t1), sim.y0, sim.yd0, samples=sim.samples,
-                        parameters=parameters, rtol=rtol, atol=atol, method=method)
+                        parameters=parameters, rtol=rtol, atol=atol, method=method,
+                        inputs=dict(sim.inputs) if sim.inputs else None)
     names = loop.coordinate_names
     lines = res.summary().splitlines()
     # linearization about the equilibrium nearest the initial configuration

@@ -47,6 +47,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import EvaluationError
+from ..numeric import CompiledFunction, parameter_vector
 from ..simulation.simulate import _Problem, check_t_span, integrator_library
 from .charts import decide
 from .closed_loop import (
@@ -55,7 +56,7 @@ from .closed_loop import (
     SingularConfiguration,
     constraint_function,
 )
-from .compiled import REASONS, LoopKernel
+from .compiled import REASONS, LoopKernel, input_function
 from .redundant import simulate_penalty, simulate_redundant
 from .results import LoopResults
 from .scipy_run import SOLVERS, run_scipy
@@ -69,7 +70,8 @@ def simulate_loop(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: Any,
                   zd0: Any = None, *, t_eval: Sequence[float] | None = None,
                   samples: int = 501, rtol: float = 1e-10, atol: float = 1e-12,
                   method: str = "DOP853", parameters: Mapping[str, float] | None = None,
-                  inputs: Callable[[float], Any] | Sequence[float] | None = None,
+                  inputs: Callable[[float], Any] | Sequence[float] | Mapping[str, Any]
+                  | None = None,
                   repartition: bool = True, cond_limit: float = 1e6,
                   max_step: float = math.inf, engine: str = "c") -> LoopResults:
     """Integrate a closed-loop system from approximate ``z0, zd0`` (assembled first, the
@@ -78,6 +80,9 @@ def simulate_loop(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: Any,
     Returns :class:`LoopResults` at ``t_eval`` (default: ``samples`` equally spaced times).
     A singular configuration stops the run with ``status="singular"`` and the exception in
     ``singular`` (the results up to there are kept) unless a new partition resolves it.
+    ``inputs``: constants (in the order of the tree's inputs), a mapping of input names to
+    numbers or expressions of t and the parameters (compiled; the C engine evaluates them at
+    every right-hand side), or a Python function of t (the SciPy engine).
     ``engine``: "c" (the compiled right-hand side in jourdain's C integrator; methods
     DOP853, RK45, Radau) or "scipy" (SciPy's steppers from Python; also BDF).
     """
@@ -88,16 +93,8 @@ def simulate_loop(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: Any,
         raise EvaluationError(f"method must be one of {', '.join(SOLVERS)}, got {method!r}")
     if engine not in ("c", "scipy"):
         raise EvaluationError(f'engine must be "c" or "scipy", got {engine!r}')
-    n_u = len(loop.tree.inputs)
-    if callable(inputs):
-        u_of = inputs
-    else:
-        u_const = np.zeros(n_u) if inputs is None else np.asarray(inputs, dtype=float)
-        if u_const.size != n_u:
-            raise EvaluationError(f"inputs must have {n_u} entries")
-
-        def u_of(_t: float) -> Any:
-            return u_const
+    fn_u = input_function(loop, inputs) if isinstance(inputs, Mapping) else None
+    u_of = _input_values(loop, inputs, fn_u, parameters)
     ev = LoopEvaluator(loop, z0, t0, parameters, u_of(t0))
     asm = ev.assemble(z0, zd0, t0)
     tev = (np.linspace(t0, t1, samples) if t_eval is None
@@ -108,7 +105,8 @@ def simulate_loop(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: Any,
     ind = list(ev.part.independent)
     x = np.concatenate([asm.z[ind], asm.zd[ind]])
     if engine == "c" and method in C_METHODS and not callable(inputs):
-        run = _run_c(ev, t0, t1, x, tev, method, rtol, atol, max_step, repartition, cond_limit)
+        run = _run_c(ev, t0, t1, x, tev, method, rtol, atol, max_step, repartition, cond_limit,
+                     fn_u)
         run_method = method
     else:
         run = run_scipy(ev, t0, t1, x, tev, method, rtol, atol, max_step, u_of, repartition,
@@ -126,6 +124,22 @@ def simulate_loop(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: Any,
         run["message"], run["nfev"], time.perf_counter() - started, run["singular"],
         dict(zip([k for k, _ in loop.tree.parameters], ev.p.tolist(), strict=True)),
         run_method)
+
+
+def _input_values(loop: ClosedLoopSystem, inputs: Any, fn_u: CompiledFunction | None,
+                  parameters: Mapping[str, float] | None) -> Callable[[float], Any]:
+    """The inputs as a function of time (for the evaluator and the SciPy engine)."""
+    n_u = len(loop.tree.inputs)
+    if fn_u is not None:  # expressions of t and the parameters, compiled
+        p_u, zeros, u_zero = (parameter_vector(loop.tree, parameters), np.zeros(loop.n),
+                              np.zeros(n_u))
+        return lambda t: fn_u(zeros, zeros, t, p_u, u_zero)["u"][:, 0]
+    if callable(inputs):
+        return inputs
+    u_const = np.zeros(n_u) if inputs is None else np.asarray(inputs, dtype=float)
+    if u_const.size != n_u:
+        raise EvaluationError(f"inputs must have {n_u} entries")
+    return lambda _t: u_const
 
 
 def _ptr(a: np.ndarray | None) -> int | None:
@@ -185,10 +199,11 @@ _FAILED = {-2: "NaN or inf in the state or its derivative", -3: "step size under
 
 def _run_c(ev: LoopEvaluator, t0: float, t1: float, x: np.ndarray, tev: np.ndarray,
            method: str, rtol: float, atol: float, max_step: float, repartition: bool,
-           cond_limit: float) -> dict:
+           cond_limit: float, fn_u: CompiledFunction | None = None) -> dict:
     """The C integrator with the compiled loop right-hand side, segment by segment (a new
     segment after each change of partition)."""
     kernel = LoopKernel(ev)
+    kernel.set_inputs(fn_u)
     kernel.z[:] = ev.z_guess
     out: dict[str, list] = {k: [] for k in ("t", *_KEYS, "T", "V")}
     partitions = [(t0, tuple(ev.independent_names))]
