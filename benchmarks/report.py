@@ -17,11 +17,17 @@ state. Before the timings, one untimed run writes the
 bytecode of every module imported (a fresh checkout's first run compiles them). The floor of
 every run, ``python -c "import jourdain.cli"``, is timed the same way and printed first.
 
+``--compare``: besides, for each example and the warm cache, the way reports were made before
+the workers and the display cache (everything in the command's process, the symbolic display
+computed each time: ``write_report(parallel=False)`` with the cache bypassed), in a fresh
+process too, and the ratio of its time to ``jourdain run``'s, both measured in turn in one run.
+
 Usage::
 
     python benchmarks/report.py                       # every example, 3 repetitions
     python benchmarks/report.py --repeat 1 --only double_pendulum robot_arm
     python benchmarks/report.py --json times.json
+    python benchmarks/report.py --compare --only robot_arm
 """
 
 from __future__ import annotations
@@ -75,11 +81,40 @@ def run_cmd(model: Path, out: Path) -> list[str]:
             "--force"]
 
 
+#: the report as made before the workers and the display cache (for --compare)
+IN_PROCESS = """
+import sys
+from pathlib import Path
+import jourdain as jd
+from jourdain.io.report import document, equations
+document.cached_display = equations.compute_display  # the display computed every time
+path = sys.argv[1]
+model = jd.load_urdf(path) if path.endswith(".urdf") else jd.load_model(path)
+info = document.write_report(model, Path(sys.argv[2]), parallel=False)
+sys.exit(0 if info.status == "complete" else 1)
+"""
+
+
+def compare(model: Path, base: Path, repeat: int) -> tuple[float, float]:
+    """Best seconds of the in-process report without the display cache and of ``jourdain
+    run``, timed in turn, the compile cache warm."""
+    cache = base / f"compare-{model.stem}"
+    timed(run_cmd(model, base / "c0"), cache)  # compiled once, untimed
+    before, after = [], []
+    for _ in range(repeat):
+        before.append(timed([sys.executable, "-c", IN_PROCESS, str(model), str(base / "c1")],
+                            cache)[0])
+        after.append(timed(run_cmd(model, base / "c2"), cache)[0])
+    return min(before), min(after)
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--repeat", type=int, default=3, help="runs per example and state")
     ap.add_argument("--only", nargs="*", help="example names (file stems)")
     ap.add_argument("--json", help="write the times to this file")
+    ap.add_argument("--compare", action="store_true",
+                    help="also time the in-process report without the display cache")
     args = ap.parse_args()
     models = examples(args.only)
     rows: list[dict[str, Any]] = []
@@ -113,6 +148,11 @@ def main() -> int:
                 "example": model.name, "empty_s": min(empty), "warm_s": min(warm),
                 "warm_cpu_s": min(warm_cpu),
                 "exit": bad[0][0] if bad else 0, "error": bad[0][1] if bad else ""}
+            if args.compare:
+                row["in_process_s"], row["run_s"] = compare(model, base, args.repeat)
+                print(f"{'':<28} in-process, display computed {row['in_process_s']:.2f} s; "
+                      f"jourdain run {row['run_s']:.2f} s: "
+                      f"{row['in_process_s'] / row['run_s']:.2f}× faster", flush=True)
             rows.append(row)
             flag = "" if not bad else f"   exit {bad[0][0]}: {bad[0][1][:60]}"
             print(f"{model.name:<28} {row['empty_s']:>10.2f} s {row['warm_s']:>9.2f} s "

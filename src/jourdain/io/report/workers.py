@@ -1,6 +1,6 @@
 """Worker processes of ``jourdain run``: the report's symbolic display and its figures are
-computed in two processes forked from the command's while it computes the numbers (where
-the machine has two cores or more)."""
+computed in a process forked from the command's while it computes the numbers (where the
+machine has two cores or more)."""
 
 from __future__ import annotations
 
@@ -23,7 +23,7 @@ def cores() -> int:
 
 
 def fork_workers(initializer: Callable[[], None] | None = None,
-                 workers: int = 2) -> ProcessPoolExecutor | None:
+                 workers: int = 1) -> ProcessPoolExecutor | None:
     """A pool of ``workers`` processes forked from this one now (they share what this process
     has computed so far: the symbolic equations), or None where processes cannot be forked
     or a single core would run them by turns with this one (the work then stays here)."""
