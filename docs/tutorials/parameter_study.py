@@ -33,8 +33,11 @@ import jourdain as jd
 import jourdain.study as st
 
 # the repository's examples/ folder, from wherever the notebook runs inside the repository
-EXAMPLES = next(p / "examples" for p in (Path.cwd(), *Path.cwd().parents)
-                if (p / "examples" / "rotor_internal_damping.toml").is_file())
+EXAMPLES = next((p / "examples" for p in (Path.cwd(), *Path.cwd().parents)
+                 if (p / "examples" / "rotor_internal_damping.toml").is_file()), None)
+if EXAMPLES is None:
+    raise FileNotFoundError(f"examples/rotor_internal_damping.toml is not in {Path.cwd()} or "
+                            "a folder above it: run this notebook inside the jourdain repository")
 model = jd.load_model(EXAMPLES / "rotor_internal_damping.toml")
 defaults = dict(model.system.parameters)
 print(model.description)
@@ -127,6 +130,7 @@ ax.set_xlabel("Ω [rad/s]")
 ax.set_ylabel("max Re λ [1/s]")
 ax.legend()
 ax.set_title("dotted: the closed-form thresholds")
+fig.tight_layout()
 
 # %% [markdown]
 # And on the grid, the verdicts agree with the formula at every point not within one grid
