@@ -19,7 +19,7 @@ EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 
 def test_linearize_a_loop_model_with_set(capsys: pytest.CaptureFixture) -> None:
-    """The document's eigenvalues are those of linearize_loop about the equilibrium
+    """The document's eigenvalues (exact linearization) equal linearize_loop's about the equilibrium
     (checked against the closed-form four-bar in tests/test_loops.py) at the --set values,
     and a heavier coupler lowers the frequency."""
     path = str(EXAMPLES / "four_bar.toml")
@@ -32,7 +32,7 @@ def test_linearize_a_loop_model_with_set(capsys: pytest.CaptureFixture) -> None:
         lin = linearize_loop(mf.loops, z, parameters={"m2": m2})
         got = np.array([complex(*v) for v in docs[m2]["eigenvalues"]])
         w = float(np.max(np.abs(lin.eigenvalues)))
-        # the same central differences at the same points: rounding of the Newton solves
+        # the exact linearization (CLI) against central differences (error ~ ε^(2/3))
         assert np.max(np.abs(got - lin.eigenvalues)) <= 1e-6 * w
         assert docs[m2]["independent"] == ["theta1"]
         assert docs[m2]["frequencies_hz"] == pytest.approx([w / (2 * math.pi)], rel=1e-6)

@@ -1,7 +1,8 @@
 """``jourdain linearize`` on a loop model (the command line dispatches here for models with
 closing joints): the linearization in the independent coordinates about the equilibrium
-nearest the model file's initial configuration (:func:`jourdain.loops.linearization.equilibrium`),
-or about the initial configuration at rest where no equilibrium is found nearby.
+nearest the model file's initial configuration (:func:`jourdain.loops.linearization.equilibrium`;
+exact: :func:`~jourdain.loops.linearization.linearize_loop_exact`), or about the initial
+configuration at rest where no equilibrium is found nearby (finite differences).
 """
 
 from __future__ import annotations
@@ -15,7 +16,12 @@ import numpy as np
 
 from ..errors import JourdainError
 from .closed_loop import ClosedLoopSystem
-from .linearization import LoopLinearization, equilibrium, linearize_loop
+from .linearization import (
+    LoopLinearization,
+    equilibrium,
+    linearize_loop,
+    linearize_loop_exact,
+)
 
 
 def linearize_near(loop: ClosedLoopSystem, z0: Any,
@@ -25,11 +31,12 @@ def linearize_near(loop: ClosedLoopSystem, z0: Any,
     with the words saying which."""
     try:
         z_s = equilibrium(loop, z0, parameters=parameters)
-        about = "equilibrium nearest the initial configuration"
     except JourdainError as exc:
         about = f"initial configuration at rest (no equilibrium: {exc})"
-        z_s = np.asarray(z0, dtype=float)
-    return linearize_loop(loop, z_s, parameters=parameters), about
+        return linearize_loop(loop, np.asarray(z0, dtype=float), parameters=parameters), about
+    # at an equilibrium the symbolic derivatives apply (the exact linearization)
+    return (linearize_loop_exact(loop, z_s, parameters=parameters),
+            "equilibrium nearest the initial configuration")
 
 
 def linearize_document(model: Any, parameters: Mapping[str, float] | None = None
@@ -38,7 +45,11 @@ def linearize_document(model: Any, parameters: Mapping[str, float] | None = None
     ``.simulation``) as a JSON-able document."""
     loop: ClosedLoopSystem = model.loops
     lin, about = linearize_near(loop, model.simulation.y0, parameters)
-    return _document(loop, lin, about)
+    doc = _document(loop, lin, about)
+    if about.startswith("equilibrium"):
+        doc["method"] = ("symbolic derivatives of the tree's k, q and of Φ (with the "
+                         "constraint forces' geometric stiffness), projected with J_z")
+    return doc
 
 
 def _document(loop: ClosedLoopSystem, lin: LoopLinearization, about: str) -> dict[str, Any]:

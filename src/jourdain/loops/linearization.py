@@ -16,11 +16,19 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
+import symengine as se
 
-from .closed_loop import AssemblyError, ClosedLoopSystem, LoopEvaluator
+from ..model.forces import rate
+from ..numeric import CompiledFunction, lambdify
+from ..stages.kinematics import kinematics
+from ..stages.newton_euler import newton_euler
+from ..stages.projection import projection
+from ..symbolic import SymMatrix
+from .closed_loop import AssemblyError, ClosedLoopSystem, LoopEvaluator, constraints
 
 
 @dataclass(frozen=True)
@@ -87,6 +95,59 @@ def linearize_loop(loop: ClosedLoopSystem, z_s: Any, zd_s: Any = None, t: float 
                              lam[order])
 
 
+@lru_cache(maxsize=16)
+def _exact_parts(loop: ClosedLoopSystem) -> CompiledFunction:
+    """Compiled ``∂(k − q)/∂z``, ``∂(k − q)/∂ż`` of the tree and the Hessians ``∂²Φ_i/∂z²``
+    (stacked, m·n × n)."""
+    tree = loop.tree
+    eom = projection(newton_euler(kinematics(tree)))
+    z = tree.coordinates
+    zd = [rate(c) for c in z]
+    r = [eom.k.rows[i][0] - eom.q.rows[i][0] for i in range(len(z))]
+    con = constraints(loop)
+    H = [[se.diff(con.Phi_z.rows[i][j], zk) for zk in z]
+         for i in range(len(con.rows)) for j in range(len(z))]
+    return lambdify(tree, {"R_z": SymMatrix.from_rows([[se.diff(e, c) for c in z] for e in r]),
+                           "R_zd": SymMatrix.from_rows([[se.diff(e, c) for c in zd]
+                                                        for e in r]),
+                           "H": SymMatrix.from_rows(H)})
+
+
+def linearize_loop_exact(loop: ClosedLoopSystem, z_s: Any, t: float = 0.0,
+                         parameters: Mapping[str, float] | None = None) -> LoopLinearization:
+    """The linearization about an equilibrium at rest (``ẏ_s = ÿ_s = 0``, scleronomic
+    constraints) from symbolic derivatives instead of differences. With the multipliers λ of
+    the equilibrium (``Φ_zᵀλ = k − q`` there) and ``J_z`` of the partition::
+
+        M̃ = J_zᵀ M_tree J_z,  P = J_zᵀ ∂(k − q)/∂ż J_z,
+        Q = J_zᵀ (∂(k − q)/∂z − Σ λ_i ∂²Φ_i/∂z²) J_z
+
+    (the derivative of ``J_zᵀ(k − q)`` along the manifold: ``J_zᵀΦ_zᵀ = 0`` turns the change
+    of ``J_z`` into the constraint forces' geometric stiffness ``−Σ λ_i H_i``)."""
+    ev = LoopEvaluator(loop, z_s, t, parameters)
+    asm = ev.assemble(z_s, None, t)
+    ind = list(ev.part.independent)
+    f = len(ind)
+    s = ev.accelerations(asm.z[ind], np.zeros(f), t)
+    lam = ev.multipliers(s)
+    n = loop.n
+    parts = _exact_parts(loop).split(_exact_parts(loop).raw(
+        np.ascontiguousarray(asm.z), np.zeros(n), t, ev.p, ev.u))
+    H = parts["H"].reshape(len(lam), n, n)
+    J = s["J_z"]
+    M0 = J.T @ s["M_tree"] @ J
+    P = J.T @ parts["R_zd"] @ J
+    Q = J.T @ (parts["R_z"] - np.einsum("i,ijk->jk", lam, H)) @ J
+    h = s["q"] - s["k"]
+    A = np.block([[np.zeros((f, f)), np.eye(f)],
+                  [-np.linalg.solve(M0, Q), -np.linalg.solve(M0, P)]])
+    eig = np.linalg.eigvals(A)
+    order = np.lexsort((eig.imag, eig.real))
+    return LoopLinearization(tuple(ev.independent_names), asm.z[ind], asm.z, M0, P, Q, h,
+                             (P + P.T) / 2, (P - P.T) / 2, (Q + Q.T) / 2, (Q - Q.T) / 2, A,
+                             eig[order])
+
+
 def equilibrium(loop: ClosedLoopSystem, z_guess: Any, t: float = 0.0,
                 parameters: Mapping[str, float] | None = None, tol: float = 1e-12,
                 max_iter: int = 50) -> np.ndarray:
@@ -112,4 +173,4 @@ def equilibrium(loop: ClosedLoopSystem, z_guess: Any, t: float = 0.0,
                         f"{np.round(np.asarray(z_guess, dtype=float), 6).tolist()}")
 
 
-__all__ = ["LoopLinearization", "equilibrium", "linearize_loop"]
+__all__ = ["LoopLinearization", "equilibrium", "linearize_loop", "linearize_loop_exact"]
