@@ -7,8 +7,9 @@ import symengine as se
 import sympy
 
 import jourdain as jd
+from jourdain.analysis.reactions import check_orthogonality
 from jourdain.models import double_pendulum, n_link_pendulum_on_cart, spatial_chain
-from jourdain.stages.reactions import check_orthogonality, graph_values
+from jourdain.stages.reactions import graph_values
 from tests.tolerance import (
     eom_terms,
     eval_tol,

@@ -171,7 +171,7 @@ class TimeHistories:
 
     def _reactions(self) -> None:
         system = self._need_system("the reaction forces")
-        from ...stages.reactions.solution import _reactions_function, projected_reactions, solve_g
+        from ...analysis.reactions import _reactions_function, projected_reactions, solve_g
 
         lay, fn = _reactions_function(system)
         p = np.array([self.parameters[k] for k, _ in system.parameters])

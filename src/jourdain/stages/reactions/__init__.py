@@ -1,7 +1,8 @@
 """Reaction forces (``docs/method.md`` §4): Q̄ from the joints, N̂·g = k̂ − q̂.
 
 Produces Q̄ (``Q_bar``), N̂ (``N_hat``), k̂ (``k_hat``), q̂ (``q_hat``) and the reactions g
-(:class:`Reactions`); in numbers, g at a state (:func:`evaluate_reactions`).
+(:class:`Reactions`); in numbers, g at a state
+(:func:`jourdain.analysis.reactions.evaluate_reactions`).
 
 Every joint transmits a *wrench* (force and torque) in the directions it constrains. The wrench
 is written in the child body's frame (the frame at the end of the joint) and acts at that frame's
@@ -46,26 +47,16 @@ Modules
 * :mod:`.rows`: the rows of M̄ without inertia;
 * :mod:`.subtree`: the wrench of one joint from the sub-tree it carries;
 * :mod:`.formation`: Q̄, N̂, k̂, q̂ (:func:`reactions`, :class:`Reactions`);
-* :mod:`.solution`: the reactions in numbers (:func:`evaluate_reactions`, :func:`solve_g`).
+The reactions in numbers are on the analysis floor, above the compiled code:
+:mod:`jourdain.analysis.reactions` (``evaluate_reactions``, ``joint_reactions``, ``solve_g``).
 """
 
 from ...graph import evaluate_arrays as graph_values
 from .checks import check_joints
-from .formation import Reactions, check_orthogonality, reactions
+from .formation import Reactions, reactions
 from .joints import JointReactions, constrained_directions, joint_directions, relative_twist
-from .solution import (
-    ReactionLayout,
-    check_reactions,
-    evaluate_keys,
-    evaluate_reactions,
-    joint_reactions,
-    projected_reactions,
-    solve_g,
-)
 
 __all__ = [
-    "JointReactions", "ReactionLayout", "Reactions", "check_joints", "check_orthogonality",
-    "check_reactions", "constrained_directions", "evaluate_keys", "evaluate_reactions",
-    "graph_values", "joint_directions", "joint_reactions", "projected_reactions", "reactions",
-    "relative_twist", "solve_g",
+    "JointReactions", "Reactions", "check_joints", "constrained_directions", "graph_values",
+    "joint_directions", "reactions", "relative_twist",
 ]

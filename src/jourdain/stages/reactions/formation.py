@@ -1,12 +1,12 @@
 """Formation of the reaction matrices (``docs/method.md`` §4): Q̄ (6p×q) from the joints'
 directions, and ``N̂ = Q̄ᵀM̄⁻¹Q̄``, ``k̂ = Q̄ᵀM̄⁻¹q̄^c``, ``q̂ = Q̄ᵀM̄⁻¹q̄^e`` over the rows of M̄ with
 inertia (:func:`reactions`, giving :class:`Reactions`), after the joint-by-joint check of
-``J̄ᵀ·Q̄ = 0``; :func:`check_orthogonality` checks the assembled matrices.
+``J̄ᵀ·Q̄ = 0``; :func:`jourdain.analysis.reactions.check_orthogonality` checks the assembled
+matrices.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -21,10 +21,9 @@ from ..newton_euler import NewtonEuler, joint_transform
 
 if TYPE_CHECKING:
     from ...model.system import System
-from .checks import _check_assembled, _checked_joints
+from .checks import _checked_joints
 from .joints import ZERO, JointReactions, joint_directions
 from .rows import _body_rows, _singular_rows
-from .solution import evaluate_reactions
 from .subtree import _project, _subtree_wrench
 
 
@@ -50,7 +49,9 @@ class Reactions:
         Rows of the 6p-vectors where M̄ is zero (no inertia); see the module docstring.
     orthogonality : tuple of (joint name, "symbolic" | "numeric")
         How ``J̄ᵀ·Q̄ = 0`` was verified for each joint's directions (:func:`check_joints`); the
-        assembled matrices are checked by :func:`check_orthogonality` before numbers are made.
+        assembled matrices are checked by
+        :func:`jourdain.analysis.reactions.check_orthogonality` before numbers are made;
+        numbers: :func:`jourdain.analysis.reactions.evaluate_reactions`.
     newton_euler : NewtonEuler
         The stage this came from.
     """
@@ -141,13 +142,6 @@ class Reactions:
         jr = self.joint(name)
         W = _subtree_wrench(self.newton_euler, jr.child)
         return SymMatrix.column(_project(jr, W))
-
-    def evaluate(self, y: Any, yd: Any, t: float = 0.0,
-                 parameters: Mapping[str, float] | None = None,
-                 inputs: Mapping[str, float] | Sequence[float] | None = None
-                 ) -> dict[str, Any]:
-        """Numbers at one state; see :func:`evaluate_reactions`."""
-        return evaluate_reactions(self.system, y, yd, t, parameters, inputs)
 
 def reactions(ne: NewtonEuler) -> Reactions:
     """Q̄ from the joints and N̂, k̂, q̂ (METHOD.md §4); checks ``J̄ᵀQ̄ = 0``.
@@ -258,21 +252,3 @@ def reactions(ne: NewtonEuler) -> Reactions:
         g_names=tuple(names), joints=tuple(joints), singular_rows=singular,
         orthogonality=tuple(verified.items()),
     )
-
-def check_orthogonality(r: Reactions, samples: int = 3, seed: int = 7, fn: Any = None) -> float:
-    """The orthogonality relation ``J̄ᵀ·Q̄ = 0`` of the assembled symbolic matrices of ``r``,
-    checked with J̄ and Q̄ compiled (``fn``: a compiled function giving ``J_bar`` and ``Q_bar``,
-    compiled here from ``r`` when not given) at random states (coordinates in (−π, π), t in
-    (0, 2), parameters within 10 % of their defaults), and that ``[J̄, Q̄]`` is square and
-    regular (no reaction missing). :meth:`jourdain.System.evaluate` checks its own numeric Q̄
-    the same way before it gives reaction forces.
-
-    Returns the largest relative residual ``|J̄ᵀQ̄| / (|J̄|ᵀ|Q̄|)`` over the columns; raises
-    :class:`ModelError` naming the joint and the direction of a column that does work.
-    """
-    system = r.system
-    if fn is None:
-        from ...numeric import lambdify
-
-        fn = lambdify(system, {"J_bar": r.newton_euler.J_bar, "Q_bar": r.Q_bar})
-    return _check_assembled(system, r.joints, fn, samples, seed)

@@ -1,12 +1,13 @@
 """Reaction forces in numbers (``docs/method.md`` §4): N̂, k̂, q̂ from the compiled M̄, Q̄, q̄^c,
 q̄^e (:func:`projected_reactions`), the solution of ``N̂·g = k̂ − q̂`` bordered with the rows
 without inertia, with undetermined components reported as NaN and by name (:func:`solve_g`),
-and the evaluation at one state (:func:`evaluate_reactions`) or for selected joints
-(:func:`joint_reactions`).
+the evaluation at one state (:func:`evaluate_reactions`) or for selected joints
+(:func:`joint_reactions`), the joint wrenches with them (:func:`evaluate_keys`), and the check
+of the assembled ``J̄ᵀ·Q̄ = 0`` in compiled code (:func:`check_orthogonality`,
+:func:`check_reactions`).
 
-Floor: the compiled code comes from :mod:`jourdain.numeric` (a floor above the stages), imported
-inside the functions that need it; moving this module up to the numeric floor is the remaining
-step of issue 16 for it (tests/test_architecture.py lists it as pending).
+Floor: analysis (above the numeric layer, whose compiled code it evaluates, and beside
+:mod:`jourdain.wrenches`); the symbolic matrices are formed by :mod:`jourdain.stages.reactions`.
 """
 
 from __future__ import annotations
@@ -19,19 +20,28 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import symengine as se
 
-from ...errors import EvaluationError, JourdainError, ModelError
-from ...model.bodies import WORLD
-from ...symbolic import SymMatrix
-from ..kinematics import kinematics
-from ..newton_euler import newton_euler
-from ..projection import projection  # the model has no stage methods (issue 16)
+from ..errors import EvaluationError, JourdainError, ModelError, SingularMassMatrix
+from ..model.bodies import WORLD
+from ..numeric import _eom_function, lambdify, state_vectors
+from ..numeric import evaluate as evaluate_eom
+from ..stages.kinematics import kinematics
+from ..stages.newton_euler import newton_euler
+from ..stages.projection import projection  # the model has no stage methods (issue 16)
+from ..stages.reactions.checks import _check_assembled, _checked_joints
+from ..stages.reactions.formation import Reactions
+from ..stages.reactions.joints import (
+    JointReactions,
+    Wrench,
+    constrained_directions,
+    joint_directions,
+)
+from ..stages.reactions.rows import _body_rows, _singular_rows
+from ..stages.reactions.subtree import _subtree_parts
+from ..symbolic import SymMatrix
+from ..wrenches import joint_wrenches
 
 if TYPE_CHECKING:
-    from ...model.system import System
-from .checks import _check_assembled, _checked_joints
-from .joints import JointReactions, Wrench, constrained_directions, joint_directions
-from .rows import _body_rows, _singular_rows
-from .subtree import _subtree_parts
+    from ..model.system import System
 
 
 @dataclass(frozen=True)
@@ -51,7 +61,6 @@ def _reactions_function(system: System) -> tuple[ReactionLayout, Any]:
     """The compiled Newton–Euler matrices with Q̄ (:func:`jourdain.numeric.recursive`), after
     the joint-by-joint check and the check of the assembled J̄ᵀ·Q̄ = 0; ModelError when the
     model's reactions cannot be formed."""
-    from ...numeric import _eom_function
 
     joints = joint_directions(system)
     _checked_joints(system)
@@ -160,7 +169,6 @@ def evaluate_reactions(system: System, y: Any, yd: Any, t: float = 0.0,
     of undetermined components; empty for a well-posed model). ``eom``: the output of
     :func:`jourdain.numeric.evaluate` at the same state, if already at hand.
     """
-    from ...numeric import evaluate as evaluate_eom
 
     lay, _ = _reactions_function(system)
     if eom is None or "Q_bar" not in eom:
@@ -186,7 +194,6 @@ def evaluate_reactions(system: System, y: Any, yd: Any, t: float = 0.0,
 def _joint_function(system: System, joints: tuple[str, ...]) -> tuple[list, Any]:
     """Compiled M, k, q and, per joint, ``Eᵀ·W0``, ``Eᵀ·W_y`` and ``EᵀE`` (E: its constrained
     directions), so that ``EᵀE·g_j = Eᵀ·(W0 + W_y·ÿ)``."""
-    from ...numeric import lambdify
 
     eom = projection(newton_euler(kinematics(system)))
     ne = eom.newton_euler
@@ -226,7 +233,6 @@ def joint_reactions(system: System, joints: str | Sequence[str], y: Any, yd: Any
     Returns ``{"<joint>.<direction>": value}``; directions that others of the same joint repeat
     share their force and come back as NaN (undetermined).
     """
-    from ...numeric import state_vectors
 
     if isinstance(joints, str):
         joints = [joints]
@@ -240,7 +246,6 @@ def joint_reactions(system: System, joints: str | Sequence[str], y: Any, yd: Any
     try:
         ydd = np.linalg.solve(np.atleast_2d(out_["M"]), (out_["q"] - out_["k"]).reshape(-1))
     except np.linalg.LinAlgError:
-        from ...errors import SingularMassMatrix
 
         raise SingularMassMatrix("the mass matrix M is singular at this state") from None
     out: dict[str, float] = {}
@@ -277,7 +282,23 @@ def evaluate_keys(system: System, y: Any, yd: Any, t: float, parameters: Any, in
         out = evaluate_reactions(system, y, yd, t, parameters, inputs, eom=eom)
     except JourdainError as exc:
         return {"reactions_error": str(exc)}
-    from ...wrenches import joint_wrenches
 
     out["joint_wrenches"] = joint_wrenches(system, out["g"], y, yd, t, parameters)
     return out
+
+
+def check_orthogonality(r: Reactions, samples: int = 3, seed: int = 7, fn: Any = None) -> float:
+    """The orthogonality relation ``J̄ᵀ·Q̄ = 0`` of the assembled symbolic matrices of ``r``,
+    checked with J̄ and Q̄ compiled (``fn``: a compiled function giving ``J_bar`` and ``Q_bar``,
+    compiled here from ``r`` when not given) at random states (coordinates in (−π, π), t in
+    (0, 2), parameters within 10 % of their defaults), and that ``[J̄, Q̄]`` is square and
+    regular (no reaction missing). :meth:`jourdain.System.evaluate` checks its own numeric Q̄
+    the same way before it gives reaction forces.
+
+    Returns the largest relative residual ``|J̄ᵀQ̄| / (|J̄|ᵀ|Q̄|)`` over the columns; raises
+    :class:`ModelError` naming the joint and the direction of a column that does work.
+    """
+    system = r.system
+    if fn is None:
+        fn = lambdify(system, {"J_bar": r.newton_euler.J_bar, "Q_bar": r.Q_bar})
+    return _check_assembled(system, r.joints, fn, samples, seed)
