@@ -37,6 +37,7 @@ from .analysis import (
 from .analysis.energy import Energy, energy
 from .analysis.floquet import floquet
 from .analysis.modes import modes
+from .analysis.reactions import evaluate_reactions, joint_reactions
 from .analysis.state_space import state_space
 from .analysis.sweep import sweep
 from .equilibrium import Equilibrium, NoEquilibrium, find_equilibria, find_equilibrium
@@ -113,13 +114,7 @@ from .stages.linearization import (
 )
 from .stages.newton_euler import NewtonEuler, newton_euler
 from .stages.projection import EquationsOfMotion, projection
-from .stages.reactions import (
-    JointReactions,
-    Reactions,
-    evaluate_reactions,
-    joint_reactions,
-    reactions,
-)
+from .stages.reactions import JointReactions, Reactions, reactions
 from .symbolic import SymMatrix
 from .wrenches import JointWrench, joint_wrenches
 
