@@ -17,6 +17,7 @@ from typing import Any, TypeVar
 
 import numpy as np
 
+from ..analysis.reactions import evaluate_keys
 from ..model.system import System as Model
 from ..numeric import evaluate as evaluate_eom
 from ..simulation.results import Results
@@ -25,7 +26,7 @@ from ..stages.kinematics import Kinematics, kinematics
 from ..stages.linearization import Linearization, linearization
 from ..stages.newton_euler import NewtonEuler, newton_euler
 from ..stages.projection import EquationsOfMotion, projection
-from ..stages.reactions import Reactions, evaluate_keys, reactions
+from ..stages.reactions import Reactions, reactions
 
 _T = TypeVar("_T")
 _LOCKS = threading.Lock()  # guards the creation of the per-system locks
@@ -92,7 +93,7 @@ class System(Model):
 
         Keys: ``M_bar, J_bar, q_c, q_e, M, k, q``, and the reactions ``Q_bar, N_hat, k_hat,
         q_hat, g, g_names, g_undetermined`` and ``joint_wrenches``
-        (:func:`jourdain.stages.reactions.evaluate_reactions`; only ``reactions_error`` where
+        (:func:`jourdain.analysis.reactions.evaluate_reactions`; only ``reactions_error`` where
         the model's reactions cannot be formed). ``parameters`` overrides default values by
         name; ``inputs`` gives the inputs by name (or in the order of :attr:`input_names`).
         """
