@@ -6,9 +6,9 @@ from __future__ import annotations
 import argparse
 import json
 
+from ..analysis.reactions import check_reactions
 from ..errors import JourdainError
 from ..io import export
-from ..stages.reactions import check_reactions
 from ..workflow import check_initial_state, eom_matrices, has_capability, summary
 from .arguments import load
 
