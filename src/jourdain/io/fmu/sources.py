@@ -10,9 +10,10 @@ import re
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+from ...analysis.reactions import check_reactions
 from ...errors import EvaluationError, JourdainError, ModelError
 from ...model.system import System
-from ...stages.reactions import check_reactions, joint_directions
+from ...stages.reactions import joint_directions
 from .description import Layout
 
 _C_KEYWORDS = frozenset(
