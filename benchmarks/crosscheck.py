@@ -154,8 +154,8 @@ def errors(c: dict) -> dict:
 def source_digest(system: Any) -> str:
     """SHA-256 over the generated C sources of the equations of motion and the reactions of
     ``system`` (as cached in :func:`jourdain.numeric.cache_dir`, named by their content key)."""
+    from jourdain.analysis.reactions import _reactions_function
     from jourdain.numeric import _eom_function, cache_dir
-    from jourdain.stages.reactions.solution import _reactions_function
 
     keys = dict.fromkeys([_eom_function(system).key, _reactions_function(system)[1].key])
     h = hashlib.sha256()
