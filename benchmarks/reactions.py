@@ -31,13 +31,9 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from jourdain.analysis.reactions import evaluate_reactions, joint_reactions  # noqa: E402
 from jourdain.models import spatial_chain, spatial_chain_data  # noqa: E402
-from jourdain.stages.reactions import (  # noqa: E402
-    evaluate_reactions,
-    graph_values,
-    joint_reactions,
-    reactions,
-)
+from jourdain.stages.reactions import graph_values, reactions  # noqa: E402
 
 
 def run(ns: list[int], states: int = 200, repeat: int = 3, seed: int = 0) -> list[dict]:
