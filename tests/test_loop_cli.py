@@ -14,6 +14,7 @@ import pytest
 from jourdain.cli import main
 from jourdain.io.modelfile import load_model
 from jourdain.loops.linearization import equilibrium, linearize_loop
+from tests.tolerance import EPS
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
@@ -64,3 +65,26 @@ def test_run_report_has_the_closing_joint_wrench(tmp_path: Path) -> None:
     assert [h for h in header if h.startswith("closure.")] == [
         "closure.Fx", "closure.Fy", "closure.Fz", "closure.Tx", "closure.Ty", "closure.Tz"]
     assert (out / "closing_joint_wrenches.png").stat().st_size > 0
+
+
+def test_run_report_files_like_the_tree_report(tmp_path: Path) -> None:
+    """run.json lists the files; wrench-<joint>.csv has the tree report's columns, its
+    inertial force equal to the multipliers of the pin rows (force of B on A, inertial)."""
+    out = tmp_path / "rep"
+    assert main(["run", str(EXAMPLES / "four_bar.toml"), "--out", str(out), "--t-end",
+                 "0.5"]) == 0
+    run = json.loads((out / "run.json").read_text())
+    assert run["format"] == "jourdain-run/1" and run["status"] == "complete"
+    for f in run["files"]:
+        assert (out / f).stat().st_size > 0
+    assert "linearization-equilibrium.json" in run["files"]
+    lin = json.loads((out / "linearization-equilibrium.json").read_text())
+    assert lin["method"].startswith("symbolic")
+    w = np.loadtxt(out / "wrench-closure.csv", delimiter=",", skiprows=1)
+    head = (out / "wrench-closure.csv").read_text().splitlines()[0].split(",")
+    assert head[:4] == ["t", "closure.F_x", "closure.F_y", "closure.F_z"]
+    motion = np.loadtxt(out / "motion.csv", delimiter=",", skiprows=1)
+    mhead = (out / "motion.csv").read_text().splitlines()[0].split(",")
+    lam = motion[:, [mhead.index("lambda[closure.Fx]"), mhead.index("lambda[closure.Fy]")]]
+    Fin = w[:, [head.index("closure.F_x_inertial"), head.index("closure.F_y_inertial")]]
+    assert np.max(np.abs(Fin - lam)) <= 1e3 * EPS * (1 + np.max(np.abs(lam)))

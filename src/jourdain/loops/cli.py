@@ -45,14 +45,12 @@ def linearize_document(model: Any, parameters: Mapping[str, float] | None = None
     ``.simulation``) as a JSON-able document."""
     loop: ClosedLoopSystem = model.loops
     lin, about = linearize_near(loop, model.simulation.y0, parameters)
-    doc = _document(loop, lin, about)
-    if about.startswith("equilibrium"):
-        doc["method"] = ("symbolic derivatives of the tree's k, q and of Φ (with the "
-                         "constraint forces' geometric stiffness), projected with J_z")
-    return doc
+    return linearization_document(loop, lin, about)
 
 
-def _document(loop: ClosedLoopSystem, lin: LoopLinearization, about: str) -> dict[str, Any]:
+def linearization_document(loop: ClosedLoopSystem, lin: LoopLinearization, about: str
+                           ) -> dict[str, Any]:
+    """A linearization of :func:`linearize_near` as a JSON-able document."""
     ev = lin.eigenvalues
 
     def mat(a: np.ndarray) -> list:
@@ -66,7 +64,11 @@ def _document(loop: ClosedLoopSystem, lin: LoopLinearization, about: str) -> dic
         "frequencies_hz": sorted({round(abs(float(v.imag)) / (2 * math.pi), 12)
                                   for v in ev if v.imag > 0}),
         "stable": bool(np.all(ev.real < 0)),
-        "method": "central differences of the compiled M, k, q in the independent coordinates",
+        "method": ("symbolic derivatives of the tree's k, q and of Φ (with the constraint "
+                   "forces' geometric stiffness), projected with J_z"
+                   if about.startswith("equilibrium") else
+                   "central differences of the compiled M, k, q in the independent "
+                   "coordinates"),
     }
 
 
@@ -103,4 +105,4 @@ def linearize_command(model: Any, parameters: Mapping[str, float], as_json: bool
     return 0
 
 
-__all__ = ["linearize_command", "linearize_document", "linearize_near", "linearize_text"]
+__all__ = ["linearization_document", "linearize_command", "linearize_document", "linearize_near", "linearize_text"]

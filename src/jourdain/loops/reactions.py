@@ -46,6 +46,8 @@ class ClosingReactions:
 
     W: SymMatrix
     joints: tuple[tuple[str, tuple[int, ...]], ...]
+    #: the same in inertial components
+    W_inertial: SymMatrix
 
 
 @lru_cache(maxsize=16)
@@ -55,11 +57,13 @@ def closing_wrench_map(loop: ClosedLoopSystem) -> ClosingReactions:
     con = constraints(loop)
     by_name = {cj.name: cj for cj in loop.closing}
     cols: list[list[se.Basic]] = []
+    cols_in: list[list[se.Basic]] = []
     joints: dict[str, list[int]] = {}
     for i, row in enumerate(con.rows):
         cj = by_name[row.joint]
         if cj.type == "constraint" or row.direction is None:
             cols.append([se.Integer(0)] * 6)
+            cols_in.append([se.Integer(0)] * 6)
             continue
         joints.setdefault(cj.name, []).append(i)
         rA, SA = _frame(kin, cj.body_a)
@@ -78,8 +82,10 @@ def closing_wrench_map(loop: ClosedLoopSystem) -> ClosingReactions:
         SAt: Mat3 = ((SA[0][0], SA[1][0], SA[2][0]), (SA[0][1], SA[1][1], SA[2][1]),
                      (SA[0][2], SA[1][2], SA[2][2]))
         cols.append([*_mv(SAt, F), *_mv(SAt, T)])
+        cols_in.append([*F, *T])
     W = SymMatrix.from_rows([[cols[j][k] for j in range(len(cols))] for k in range(6)])
-    return ClosingReactions(W, tuple((n, tuple(ix)) for n, ix in joints.items()))
+    W_in = SymMatrix.from_rows([[cols_in[j][k] for j in range(len(cols))] for k in range(6)])
+    return ClosingReactions(W, tuple((n, tuple(ix)) for n, ix in joints.items()), W_in)
 
 
 def _frame(kin: Any, body: str) -> tuple[Vec3, Any]:
@@ -92,25 +98,28 @@ def _frame(kin: Any, body: str) -> tuple[Vec3, Any]:
 
 @lru_cache(maxsize=16)
 def _wrench_function(loop: ClosedLoopSystem) -> CompiledFunction:
-    return lambdify(loop.tree, {"W": closing_wrench_map(loop).W})
+    cr = closing_wrench_map(loop)
+    return lambdify(loop.tree, {"W": cr.W, "W_inertial": cr.W_inertial})
 
 
 def closing_reactions(loop: ClosedLoopSystem, z: Any, lam: Any, t: Any = 0.0,
                       p: Any = None) -> dict[str, dict[str, np.ndarray]]:
-    """The force ``F`` and torque ``T`` (N × 3 each, in A's frame, B on A at A's joint point)
-    of every closing joint with points, from configurations ``z`` (N × n) and multipliers
+    """The force ``F`` and torque ``T`` (N × 3 each, in A's frame, B on A at A's joint point;
+    ``F_inertial``, ``T_inertial``: inertial components) of every closing joint with points, from configurations ``z`` (N × n) and multipliers
     ``lam`` (N × m, in the order of ``constraints(loop).labels``). ``p``: the parameter
     vector (default: the tree's values)."""
     z = np.atleast_2d(np.asarray(z, dtype=float))
     lam = np.atleast_2d(np.asarray(lam, dtype=float))
     fn = _wrench_function(loop)
     pv = parameter_vector(loop.tree, None) if p is None else np.asarray(p, dtype=float)
-    W = fn.batch(z, np.zeros_like(z), t, pv, np.zeros(len(loop.tree.inputs)))["W"]
+    Ws = fn.batch(z, np.zeros_like(z), t, pv, np.zeros(len(loop.tree.inputs)))
     out: dict[str, dict[str, np.ndarray]] = {}
     for name, ix in closing_wrench_map(loop).joints:
         cols = list(ix)
-        w = np.einsum("nij,nj->ni", W[:, :, cols], lam[:, cols])
-        out[name] = {"F": w[:, :3], "T": w[:, 3:]}
+        w = np.einsum("nij,nj->ni", Ws["W"][:, :, cols], lam[:, cols])
+        wi = np.einsum("nij,nj->ni", Ws["W_inertial"][:, :, cols], lam[:, cols])
+        out[name] = {"F": w[:, :3], "T": w[:, 3:], "F_inertial": wi[:, :3],
+                     "T_inertial": wi[:, 3:]}
     return out
 
 

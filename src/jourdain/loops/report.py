@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import JourdainError
-from .cli import linearize_near
+from .cli import linearization_document, linearize_near
 from .closed_loop import ClosedLoopSystem, constraints
 
 
@@ -125,6 +125,7 @@ def run_report(model: Any, out: Path, parameters: Mapping[str, float] | None = N
     lin = None
     try:
         lin, about = linearize_near(loop, res.z[0] if len(res.t) else sim.y0, parameters)
+        lin_doc = linearization_document(loop, lin, about)
         eig = ", ".join(f"{v.real:.6g}{v.imag:+.6g}j" for v in lin.eigenvalues)
         lines.append(f"  linearized about the {about}: z = {np.round(lin.z_s, 6).tolist()}; "
                      f"eigenvalues in {', '.join(lin.names)}: {eig}")
@@ -141,6 +142,15 @@ def run_report(model: Any, out: Path, parameters: Mapping[str, float] | None = N
                             res.V, *[np.column_stack([w["F"], w["T"]])
                                      for w in wrenches.values()]])
     np.savetxt(out / "motion.csv", data, delimiter=",", header=",".join(cols), comments="")
+    files = ["index.html", "run.json", "loops.json", "motion.csv"]
+    # per closing joint, the tree report's wrench-<joint>.csv columns (A's axes, inertial)
+    for name, w in wrenches.items():
+        head = ["t", *[f"{name}.{q}_{c}{suffix}" for suffix in ("", "_inertial")
+                       for q in "FT" for c in "xyz"]]
+        np.savetxt(out / f"wrench-{name}.csv",
+                   np.column_stack([res.t, w["F"], w["T"], w["F_inertial"], w["T_inertial"]]),
+                   delimiter=",", header=",".join(head), comments="")
+        files.append(f"wrench-{name}.csv")
     figs = []
     fig, ax = plt.subplots(figsize=(7, 3.5))
     for i, n in enumerate(names):
@@ -195,6 +205,16 @@ def run_report(model: Any, out: Path, parameters: Mapping[str, float] | None = N
             "eigenvalues": None if lin is None else [[v.real, v.imag]
                                                      for v in lin.eigenvalues]}
     (out / "loops.json").write_text(json.dumps(info, indent=2))
+    if lin is not None:
+        (out / "linearization-equilibrium.json").write_text(json.dumps(
+            lin_doc, indent=1))
+        files.append("linearization-equilibrium.json")
+    files += [f for f, _ in figs]
+    (out / "run.json").write_text(json.dumps({
+        "format": "jourdain-run/1", "model": loop.name, "file": str(getattr(model, "path", "")),
+        "status": "complete" if res.status == "finished" else res.status,
+        "message": "" if res.status == "finished" else res.message, "files": files,
+        "notes": []}, indent=1))
     body = "\n".join(f"<p>{html.escape(x)}</p>" for x in lines)
     imgs = "\n".join(f'<img src="{f}" alt="{f}">' for f, _ in figs)
     (out / "index.html").write_text(
