@@ -50,6 +50,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -124,7 +125,7 @@ def bench_jourdain(n: int) -> dict:
         toolchain._loaded.clear()
     numeric.clear_cache()
     y0, yd0 = initial_state(n)
-    kw = {"inputs": {"F": 0.0}, "rtol": TOL, "atol": TOL}
+    kw: dict[str, Any] = {"inputs": {"F": 0.0}, "rtol": TOL, "atol": TOL}
     res = s.simulate((0, T_END), y0, yd0, **kw)
     ref = s.simulate((0, T_END), y0, yd0, inputs={"F": 0.0}, rtol=1e-12, atol=1e-12)
     # where the time of a run goes: M, k, q alone at the run's own states (one C call), and a
@@ -280,7 +281,7 @@ def main(argv: list[str] | None = None) -> dict:
         J = bench_jourdain(n)
         params = J["system"].parameter_values
         x_ref = J["x_ref"]
-        rows = [("jourdain DOP853 (C loop)", J)]
+        rows: list[tuple[str, dict[str, Any]]] = [("jourdain DOP853 (C loop)", J)]
         configs = [("lambdify", "numpy")] if args.quick else [("cython", "sympy"),
                                                                ("cython", "numpy")]
         skipped = []
@@ -301,14 +302,15 @@ def main(argv: list[str] | None = None) -> dict:
             if E is not None:
                 rows.insert(1, (f"jourdain DOP853, rtol={E['rtol']:g}", E))
         # interleaved rounds, best of each: a busy machine slows all tools alike
-        for r in rows:
-            r[1]["integrate"] = math.inf
+        for _, tool in rows:
+            tool["integrate"] = math.inf
         for _ in range(args.rounds):
-            for _, r in rows:
-                r["integrate"] = min(r["integrate"], best_of(r["run"], repeat=1, min_time=0.05))
+            for _, tool in rows:
+                tool["integrate"] = min(tool["integrate"],
+                                        best_of(tool["run"], repeat=1, min_time=0.05))
         pydy_times = [r["integrate"] for r in pydy_rows]
         fastest = min(pydy_times) if pydy_times else math.nan
-        entry = {"n": n, "tools": {}}
+        entry: dict[str, Any] = {"n": n, "tools": {}}
         for label, r in rows:
             d = float(np.abs(r["x_final"] - x_ref).max())
             speed = fastest / r["integrate"]
@@ -317,7 +319,8 @@ def main(argv: list[str] | None = None) -> dict:
             print(f"{n:>2} {label:<32} {r['derive']:>9.3f} {r['codegen']:>10.3f} "
                   f"{1e3 * r['integrate']:>13.3f} {r['nfev']:>10d} {r['steps']:>6d} {rej:>8} "
                   f"{per_step:>10.2f} {d:>10.2e} {speed:>8.1f}x")
-            entry["tools"][label] = {k: (float(v) if np.isscalar(v) else None)
+            entry["tools"][label] = {k: (float(v) if isinstance(v, (int, float, np.number))
+                                         else None)
                                      for k, v in r.items() if k in ("derive", "codegen",
                                                                     "integrate", "nfev",
                                                                     "steps", "rejected", "rtol")}

@@ -19,7 +19,7 @@ def pendulum(damping: float = 0.0) -> jd.System:
     phi, m, l, g = jd.symbols("phi m l g")
     bob = jd.Body("bob", "world", jd.Revolute("pivot", phi, "z"), mass=m, com=(0, -l, 0),
                   inertia=jd.point_mass())
-    forces = [jd.Gravity((0, -g, 0))]
+    forces: list = [jd.Gravity((0, -g, 0))]
     if damping:
         forces.append(jd.RotationalSpringDamper("friction", phi, damping=damping))
     return jd.System([phi], [bob], forces, parameters={"m": 1.5, "l": 0.8, "g": 9.81},
