@@ -21,9 +21,9 @@ from ..stages.linearization import (
     CompiledLinearization,
     Linearization,
     NominalCheck,
-    NumericLinearization,
     TimeVariantError,
 )
+from .numeric_linearization import NumericLinearization
 
 #: real parts (and, in tables, imaginary parts) below this fraction of the largest |λ| (at
 #: least 1) count as zero: the default ``rtol`` of :func:`jourdain.analysis.stability`, and the

@@ -1,7 +1,7 @@
 """Linearization about a nominal motion (``docs/method.md`` §5) and its physical split (§6).
 
 Produces M̃ (``M``), P, Q, h, B about a nominal motion and D, G, K, N (:class:`Linearization`,
-:class:`NumericLinearization`, :class:`GeneralLinearization`).
+:class:`GeneralLinearization`; in numbers ``jourdain.analysis.numeric_linearization``).
 
 With ``y = y_s(t) + η`` and inputs ``u = u_s(t) + Δu``, the equations of motion
 ``M(y,t)·ÿ + k(y,ẏ,t) = q(y,ẏ,u,t)`` become, to first order in ``η`` and ``Δu``,
@@ -21,8 +21,8 @@ M only where ÿ_s ≠ 0. M is never inverted.
 
 Three forms: :func:`linearization` (symbolic in the parameters, about a given nominal motion),
 :func:`linearization_general` (symbolic functions of the state: the general form), and
-:func:`linearize_numeric` (numbers for given parameter values: the fast path to eigenvalues of
-large systems).
+``linearize_numeric`` (numbers for given parameter values: the fast path to eigenvalues of
+large systems; :mod:`jourdain.analysis.numeric_linearization`).
 
 For a time-invariant result (M̃, P, Q, B free of t) the matrices split into damping ``D``,
 gyroscopic ``G``, stiffness ``K`` and circulatory ``N`` parts (§6):
@@ -40,8 +40,10 @@ Modules
 * :mod:`.formation`: the symbolic linearization (:func:`linearization`);
 * :mod:`.result`: :class:`Linearization` (the split into D, G, K, N) and
   :class:`CompiledLinearization`;
-* :mod:`.numbers`: the numeric path (:func:`linearize_numeric`);
 * :mod:`.general`: the general form (:func:`linearization_general`).
+
+The numeric path for given parameter values (``linearize_numeric``) is on the analysis floor,
+above the compiled code: :mod:`jourdain.analysis.numeric_linearization`.
 """
 
 from .formation import linearization
@@ -54,11 +56,10 @@ from .nominal import (
     force_scale,
     term_scale,
 )
-from .numbers import NumericLinearization, linearize_numeric
 from .result import CompiledLinearization, Linearization
 
 __all__ = [
     "NOMINAL_RTOL", "CompiledLinearization", "GeneralLinearization", "Linearization",
-    "NominalCheck", "NominalMotionWarning", "NumericLinearization", "TimeVariantError",
-    "force_scale", "linearization", "linearization_general", "linearize_numeric", "term_scale",
+    "NominalCheck", "NominalMotionWarning", "TimeVariantError", "force_scale", "linearization",
+    "linearization_general", "term_scale",
 ]

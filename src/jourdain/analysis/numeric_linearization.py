@@ -2,6 +2,9 @@
 Q, h, B by the floating-point forward mode over the graphs of k, q and J̄
 (:func:`jourdain.graph.jet_float`), the fast path to the eigenvalues of large systems
 (:func:`linearize_numeric`, :class:`NumericLinearization`).
+
+Floor: analysis, above the numeric layer whose parameter and time handling it uses; the
+symbolic linearization is :mod:`jourdain.stages.linearization`.
 """
 
 from __future__ import annotations
@@ -13,15 +16,11 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import symengine as se
 
-from ...errors import EvaluationError, warn
-from ...graph import Graph, evaluate_float, free_symbol_names, jet_float
-from ..kinematics import kinematics  # the model has no stage methods (issue 16)
-from ..newton_euler import newton_euler
-from ..projection import EquationsOfMotion, projection
-
-if TYPE_CHECKING:
-    from ...model.system import System
-from .nominal import (
+from ..errors import EvaluationError, warn
+from ..graph import Graph, evaluate_float, free_symbol_names, jet_float
+from ..numeric import parameter_vector, time_value
+from ..stages.kinematics import kinematics  # the model has no stage methods (issue 16)
+from ..stages.linearization.nominal import (
     NOMINAL_RTOL,
     NominalCheck,
     NominalMotionWarning,
@@ -34,6 +33,11 @@ from .nominal import (
     force_scale,
     term_scale,
 )
+from ..stages.newton_euler import newton_euler
+from ..stages.projection import EquationsOfMotion, projection
+
+if TYPE_CHECKING:
+    from ..model.system import System
 
 
 @dataclass(frozen=True)
@@ -138,7 +142,6 @@ def linearize_numeric(source: System | EquationsOfMotion, nominal: Mapping[Any, 
     matrices: the way to eigenvalues of large systems (a spatial chain of 16 bodies in well
     under a second, derivation included).
     """
-    from ...numeric import parameter_vector, time_value
 
     eom = source if isinstance(source, EquationsOfMotion) else projection(newton_euler(kinematics(source)))
     system = eom.system
