@@ -37,6 +37,7 @@ from .analysis import (
 from .analysis.energy import Energy, energy
 from .analysis.floquet import floquet
 from .analysis.modes import modes
+from .analysis.numeric_linearization import NumericLinearization, linearize_numeric
 from .analysis.reactions import evaluate_reactions, joint_reactions
 from .analysis.state_space import state_space
 from .analysis.sweep import sweep
@@ -106,11 +107,9 @@ from .stages.linearization import (
     Linearization,
     NominalCheck,
     NominalMotionWarning,
-    NumericLinearization,
     TimeVariantError,
     linearization,
     linearization_general,
-    linearize_numeric,
 )
 from .stages.newton_euler import NewtonEuler, newton_euler
 from .stages.projection import EquationsOfMotion, projection
