@@ -17,6 +17,7 @@ import symengine as se
 
 from ..analysis.cyclic import cyclic_coordinates
 from ..analysis.floquet import floquet
+from ..analysis.numeric_linearization import linearize_numeric
 from ..errors import EvaluationError
 from ..simulation.simulate import check_samples, check_t_end
 from ..stages.linearization import NominalMotionWarning
