@@ -1,6 +1,10 @@
 """The general form of the linearization (``docs/method.md`` §5): M, P, Q and the residual as
 symbolic functions of the state y, ẏ, ÿ (:func:`linearization_general`,
 :class:`GeneralLinearization`), for any operating point.
+
+Floor: stages; :meth:`GeneralLinearization.evaluate` reads its state vectors with
+:func:`jourdain.numeric.state_vectors` (a floor above), imported inside it (pending, as for
+:mod:`.result`).
 """
 
 from __future__ import annotations

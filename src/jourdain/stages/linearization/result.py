@@ -2,6 +2,12 @@
 h, B about a nominal motion and, when time-invariant, splits them into damping ``D``,
 gyroscopic ``G``, stiffness ``K`` and circulatory ``N`` parts; :class:`CompiledLinearization`
 evaluates them in numbers.
+
+Floor: stages. :meth:`Linearization.evaluate`, :meth:`Linearization.compile` and
+:meth:`Linearization.check_nominal` give numbers through :mod:`jourdain.numeric` (a floor above),
+imported inside them: the methods are the public way to numbers of a linearization (used across
+the analyses and the tests); moving them above the numeric floor is the remaining step of
+issue 16 here (``tests/test_architecture.py`` lists it as pending).
 """
 
 from __future__ import annotations
