@@ -69,9 +69,12 @@ def linearization_at(model: ModelFile, y: Any, yd: Any, t: float,
     with warnings.catch_warnings():
         # any state, not a claimed equilibrium: h = M·ÿ there is expected
         warnings.simplefilter("ignore", NominalMotionWarning)
-        lin = system.linearize(state_nominal(system, y, yd, t, inputs))
-    num = lin.evaluate(t=t, parameters=dict(parameters) or None)
-    out = {k: num[k] for k in ("M_tilde", "P", "Q", "h")}
+        # numbers at one state: forward-mode differentiation in floating point, the same
+        # equations as the symbolic linearization without forming and compiling it (UR5: 0.19 s
+        # against 2.4 s, equal to rounding)
+        lin = linearize_numeric(system, state_nominal(system, y, yd, t, inputs), t,
+                                dict(parameters) or None)
+    out = {"M_tilde": lin.M_tilde, "P": lin.P, "Q": lin.Q, "h": lin.h}
     out.update(split(out["P"], out["Q"]))
     return out
 
