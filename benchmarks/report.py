@@ -95,17 +95,21 @@ sys.exit(0 if info.status == "complete" else 1)
 """
 
 
-def compare(model: Path, base: Path, repeat: int) -> tuple[float, float]:
+def compare(model: Path, base: Path, repeat: int) -> tuple[float, float, int]:
     """Best seconds of the in-process report without the display cache and of ``jourdain
-    run``, timed in turn, the compile cache warm."""
+    run``, timed in turn, the compile cache warm; the first nonzero exit status (else 0)."""
     cache = base / f"compare-{model.stem}"
     timed(run_cmd(model, base / "c0"), cache)  # compiled once, untimed
-    before, after = [], []
+    before, after, codes = [], [], []
     for _ in range(repeat):
-        before.append(timed([sys.executable, "-c", IN_PROCESS, str(model), str(base / "c1")],
-                            cache)[0])
-        after.append(timed(run_cmd(model, base / "c2"), cache)[0])
-    return min(before), min(after)
+        wall, rc, _, _ = timed([sys.executable, "-c", IN_PROCESS, str(model),
+                                str(base / "c1")], cache)
+        before.append(wall)
+        codes.append(rc)
+        wall, rc, _, _ = timed(run_cmd(model, base / "c2"), cache)
+        after.append(wall)
+        codes.append(rc)
+    return min(before), min(after), next((c for c in codes if c), 0)
 
 
 def main() -> int:
@@ -148,16 +152,17 @@ def main() -> int:
                 "example": model.name, "empty_s": min(empty), "warm_s": min(warm),
                 "warm_cpu_s": min(warm_cpu),
                 "exit": bad[0][0] if bad else 0, "error": bad[0][1] if bad else ""}
-            if args.compare:
-                row["in_process_s"], row["run_s"] = compare(model, base, args.repeat)
-                print(f"{'':<28} in-process, display computed {row['in_process_s']:.2f} s; "
-                      f"jourdain run {row['run_s']:.2f} s: "
-                      f"{row['in_process_s'] / row['run_s']:.2f}× faster", flush=True)
             rows.append(row)
             flag = "" if not bad else f"   exit {bad[0][0]}: {bad[0][1][:60]}"
             print(f"{model.name:<28} {row['empty_s']:>10.2f} s {row['warm_s']:>9.2f} s "
                   f"{row['warm_s'] / TARGET_SECONDS:>11.2f}× {row['warm_cpu_s']:>14.2f} s{flag}",
                   flush=True)
+            if args.compare:
+                row["in_process_s"], row["run_s"], rc = compare(model, base, args.repeat)
+                print(f"{'':<4}in-process, display computed {row['in_process_s']:.2f} s; "
+                      f"jourdain run {row['run_s']:.2f} s: "
+                      f"{row['in_process_s'] / row['run_s']:.2f}× faster"
+                      + (f" (a run exited {rc}: not comparable)" if rc else ""), flush=True)
     worst_empty = max(rows, key=lambda r: r["empty_s"])
     worst_warm = max(rows, key=lambda r: r["warm_s"])
     print(f"\nworst, empty cache: {worst_empty['example']} {worst_empty['empty_s']:.2f} s "
