@@ -19,8 +19,11 @@ from typing import Any
 import numpy as np
 
 from ..errors import JourdainError
+from ..simulation.simulate import DEFAULT_ATOL, DEFAULT_RTOL
 from .cli import linearization_document, linearize_near
 from .closed_loop import ClosedLoopSystem, constraints
+from .figures import Painter
+from .simulate import SOLVERS, simulate_loop
 
 
 def loop_summary(model: Any) -> dict[str, Any]:
@@ -98,18 +101,21 @@ def run_report(model: Any, out: Path, parameters: Mapping[str, float] | None = N
                t_end: float | None = None) -> list[str]:
     """Simulate and linearize a loop model, write ``index.html``, plots and ``motion.csv``
     into ``out``; returns summary lines."""
-    import matplotlib
+    # Matplotlib imported and the figures drawn in a process forked now, while this one
+    # simulates and linearizes (where there are two cores)
+    painter = Painter()
+    try:
+        return _report(model, out, parameters, t_end, painter)
+    finally:
+        painter.close()
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
 
-    from .simulate import SOLVERS, simulate_loop
-
+def _report(model: Any, out: Path, parameters: Mapping[str, float] | None,
+            t_end: float | None, painter: Painter) -> list[str]:
     loop: ClosedLoopSystem = model.loops
     sim = model.simulation
     t1 = float(t_end if t_end is not None else sim.t_end)
     out.mkdir(parents=True, exist_ok=True)
-    from ..simulation.simulate import DEFAULT_ATOL, DEFAULT_RTOL
 
     # the file's method and tolerances where it sets them; else tighter defaults than a tree
     # model's (the energy of a conservative loop is reported to 1e-9)
@@ -151,53 +157,10 @@ def run_report(model: Any, out: Path, parameters: Mapping[str, float] | None = N
                    np.column_stack([res.t, w["F"], w["T"], w["F_inertial"], w["T_inertial"]]),
                    delimiter=",", header=",".join(head), comments="")
         files.append(f"wrench-{name}.csv")
-    figs = []
-    fig, ax = plt.subplots(figsize=(7, 3.5))
-    for i, n in enumerate(names):
-        ax.plot(res.t, res.z[:, i], label=n)
-    ax.set_xlabel("t / s")
-    ax.set_ylabel("tree coordinates")
-    ax.legend()
-    figs.append(("coordinates.png", fig))
-    fig, ax = plt.subplots(figsize=(7, 3.5))
-    tiny = 1e-300
-    ax.semilogy(res.t, np.max(np.abs(res.Phi), axis=1) + tiny, label="max |Φ|")
-    ax.semilogy(res.t, np.max(np.abs(res.Phi_dot), axis=1) + tiny, label="max |Φ̇|")
-    ax.set_xlabel("t / s")
-    ax.set_ylabel("constraint residual")
-    ax.legend()
-    figs.append(("constraint_residual.png", fig))
-    fig, ax = plt.subplots(figsize=(7, 3.5))
-    for i, r in enumerate(res.labels):
-        ax.plot(res.t, res.lam[:, i], label=r)
-    ax.set_xlabel("t / s")
-    ax.set_ylabel("closing-joint reactions λ")
-    ax.legend()
-    figs.append(("reactions.png", fig))
-    if wrenches:  # force and torque of each closing joint in its body A's axes
-        fig, axs = plt.subplots(1, 2, figsize=(9, 3.5))
-        for name, w in wrenches.items():
-            for j, c in enumerate("xyz"):
-                if np.any(w["F"][:, j]):
-                    axs[0].plot(res.t, w["F"][:, j], label=f"{name} F{c}")
-                if np.any(w["T"][:, j]):
-                    axs[1].plot(res.t, w["T"][:, j], label=f"{name} T{c}")
-        for a, what in zip(axs, ("force / N", "torque / N m"), strict=True):
-            a.set_xlabel("t / s")
-            a.set_ylabel(f"closing joint {what}")
-            if a.get_legend_handles_labels()[0]:
-                a.legend()
-        figs.append(("closing_joint_wrenches.png", fig))
-    fig, ax = plt.subplots(figsize=(7, 3.5))
-    E = res.total_energy
-    ax.plot(res.t, E - E[0])
-    ax.set_xlabel("t / s")
-    ax.set_ylabel("E − E₀ / J")
-    figs.append(("energy.png", fig))
-    for fname, fg in figs:
-        fg.subplots_adjust(left=0.1, right=0.97, bottom=0.14, top=0.95, wspace=0.3)
-        fg.savefig(out / fname, dpi=90)
-        plt.close(fg)
+    figs = painter.draw(out, {
+        "t": res.t, "z": res.z, "names": list(names), "Phi": res.Phi, "Phi_dot": res.Phi_dot,
+        "lam": res.lam, "labels": list(res.labels), "E": res.total_energy,
+        "wrenches": {n: {"F": w["F"], "T": w["T"]} for n, w in wrenches.items()}})
     info = {"name": loop.name, "status": res.status, "message": res.message,
             "max_Phi": res.max_Phi, "max_Phi_dot": res.max_Phi_dot,
             "energy_drift": res.energy_drift,
@@ -209,14 +172,14 @@ def run_report(model: Any, out: Path, parameters: Mapping[str, float] | None = N
         (out / "linearization-equilibrium.json").write_text(json.dumps(
             lin_doc, indent=1))
         files.append("linearization-equilibrium.json")
-    files += [f for f, _ in figs]
+    files += figs
     (out / "run.json").write_text(json.dumps({
         "format": "jourdain-run/1", "model": loop.name, "file": str(getattr(model, "path", "")),
         "status": "complete" if res.status == "finished" else res.status,
         "message": "" if res.status == "finished" else res.message, "files": files,
         "notes": []}, indent=1))
     body = "\n".join(f"<p>{html.escape(x)}</p>" for x in lines)
-    imgs = "\n".join(f'<img src="{f}" alt="{f}">' for f, _ in figs)
+    imgs = "\n".join(f'<img src="{f}" alt="{f}">' for f in figs)
     (out / "index.html").write_text(
         f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{html.escape(loop.name)}"
         f"</title></head><body><h1>{html.escape(loop.name)}</h1>{body}{imgs}"

@@ -1,0 +1,114 @@
+"""The figures of a loop model's report (:func:`jourdain.loops.report.run_report`), drawn by
+Matplotlib in a worker process forked when the report starts (:class:`Painter`): the worker
+imports Matplotlib (about a second on a loaded machine) while the command simulates and
+linearizes; in this process where a second core or ``fork`` is missing."""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+from concurrent.futures import Future, ProcessPoolExecutor
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+
+def _import_matplotlib() -> bool:
+    import matplotlib  # noqa: PLC0415 (heavy, optional: the report's figures only)
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot  # noqa: F401, PLC0415
+
+    return True
+
+
+def draw_figures(out: Path, d: dict[str, Any]) -> list[str]:
+    """Write the report's PNG figures into ``out`` from the arrays ``d``; their file names."""
+    _import_matplotlib()
+    import matplotlib.pyplot as plt  # noqa: PLC0415
+
+    t = d["t"]
+    figs = []
+    fig, ax = plt.subplots(figsize=(7, 3.5))
+    for i, n in enumerate(d["names"]):
+        ax.plot(t, d["z"][:, i], label=n)
+    ax.set_xlabel("t / s")
+    ax.set_ylabel("tree coordinates")
+    ax.legend()
+    figs.append(("coordinates.png", fig))
+    fig, ax = plt.subplots(figsize=(7, 3.5))
+    tiny = 1e-300
+    ax.semilogy(t, np.max(np.abs(d["Phi"]), axis=1) + tiny, label="max |Φ|")
+    ax.semilogy(t, np.max(np.abs(d["Phi_dot"]), axis=1) + tiny, label="max |Φ̇|")
+    ax.set_xlabel("t / s")
+    ax.set_ylabel("constraint residual")
+    ax.legend()
+    figs.append(("constraint_residual.png", fig))
+    fig, ax = plt.subplots(figsize=(7, 3.5))
+    for i, r in enumerate(d["labels"]):
+        ax.plot(t, d["lam"][:, i], label=r)
+    ax.set_xlabel("t / s")
+    ax.set_ylabel("closing-joint reactions λ")
+    ax.legend()
+    figs.append(("reactions.png", fig))
+    if d["wrenches"]:  # force and torque of each closing joint in its body A's axes
+        fig, axs = plt.subplots(1, 2, figsize=(9, 3.5))
+        for name, w in d["wrenches"].items():
+            for j, c in enumerate("xyz"):
+                if np.any(w["F"][:, j]):
+                    axs[0].plot(t, w["F"][:, j], label=f"{name} F{c}")
+                if np.any(w["T"][:, j]):
+                    axs[1].plot(t, w["T"][:, j], label=f"{name} T{c}")
+        for a, what in zip(axs, ("force / N", "torque / N m"), strict=True):
+            a.set_xlabel("t / s")
+            a.set_ylabel(f"closing joint {what}")
+            if a.get_legend_handles_labels()[0]:
+                a.legend()
+        figs.append(("closing_joint_wrenches.png", fig))
+    fig, ax = plt.subplots(figsize=(7, 3.5))
+    E = d["E"]
+    ax.plot(t, E - E[0])
+    ax.set_xlabel("t / s")
+    ax.set_ylabel("E − E₀ / J")
+    figs.append(("energy.png", fig))
+    for fname, fg in figs:
+        fg.subplots_adjust(left=0.1, right=0.97, bottom=0.14, top=0.95, wspace=0.3)
+        fg.savefig(out / fname, dpi=90)
+        plt.close(fg)
+    return [f for f, _ in figs]
+
+
+class Painter:
+    """A one-process pool forked at construction (Matplotlib imported there at once), or
+    nothing where that cannot help; :meth:`draw` draws there or here."""
+
+    def __init__(self) -> None:
+        self.pool: ProcessPoolExecutor | None = None
+        self.ready: Future[bool] | None = None
+        try:
+            cores = len(os.sched_getaffinity(0))
+        except AttributeError:  # not on Linux
+            cores = os.cpu_count() or 1
+        if cores < 2:
+            return
+        try:
+            context = multiprocessing.get_context("fork")
+        except ValueError:  # no fork on this platform
+            return
+        self.pool = ProcessPoolExecutor(1, mp_context=context)
+        self.ready = self.pool.submit(_import_matplotlib)
+
+    def draw(self, out: Path, d: dict[str, Any]) -> list[str]:
+        if self.pool is None:
+            return draw_figures(out, d)
+        return self.pool.submit(draw_figures, out, d).result()
+
+    def close(self) -> None:
+        """Let the worker go (after its last drawing)."""
+        if self.pool is not None:
+            self.pool.shutdown()
+            self.pool = None
+
+
+__all__ = ["Painter", "draw_figures"]
