@@ -19,8 +19,10 @@ from .. import export
 from ..modelfile import ModelFile
 from .equations import (
     Display,
+    cached,
     cached_display,
     display_in_worker,
+    display_key,
     equations_section,
     set_pending,
 )
@@ -40,10 +42,12 @@ _EQUATIONS = "<!--jourdain-equations-->"
 def compute_sections(run: Run, sections: list[str], display: Future[Display] | None) -> None:
     """The sections of the report, each appended to ``sections`` when it is complete, with
     their data files (so that an interruption leaves the sections finished before it). The
-    symbolic display (section 2) is ``display``, a worker's, or computed here in turn."""
+    symbolic display (section 2) is ``run.display`` (from the cache), else the worker's
+    ``display``, else computed here in turn."""
     sections.append(model_section(run))
-    if display is None:
+    if run.display is None and display is None:
         run.display = cached_display(run.model, run.max_ops)
+    if run.display is not None:
         html, files = equations_section(run.display, run.model, run.out)
         run.info.files += files
         sections.append(html)
@@ -69,8 +73,9 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
     passed to it), ``run.json`` (``"format": "jourdain-run/1"``: how the run ended, ``status``
     complete, interrupted or failed, and ``message``; the files and notes).
 
-    ``parallel``: the symbolic display and the figures are computed in a process forked from
-    this one while it computes the numbers (``jourdain run``, where the machine has two cores
+    ``parallel``: the figures, and the symbolic display where the cache lacks it, are computed
+    in a process forked from this one (at once: it imports Matplotlib meanwhile) while it
+    computes the numbers (``jourdain run``, where the machine has two cores
     or more; the page is the same). One worker, not two: a second one imported Matplotlib
     again and raised the processor time of a small report by half (double pendulum, warm
     cache: 0.5 s here + 0.8 s in one worker against 0.5 s + 1.2–1.7 s in two; in-process
@@ -92,19 +97,23 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
     system = model.system
     info = ReportInfo(out / "report.html")
     pool: ProcessPoolExecutor | None = None
+    if parallel:  # the worker imports Matplotlib while this process works
+        set_pending(model, max_ops)
+        pool = fork_workers(prepare_worker)
+        set_pending(None, max_ops)  # the worker has its copy
     try:
-        summ = summary(model)  # the symbolic equations and reactions, shared by the fork
+        summ = summary(model)  # the symbolic equations and reactions
         display: Future[Display] | None = None
-        if parallel:  # a worker, Matplotlib imported there while this process computes
-            set_pending(model, max_ops)
-            pool = fork_workers(prepare_worker, workers=1)
-            set_pending(None, max_ops)  # the workers have their copy
-        if pool is not None:
-            display = pool.submit(display_in_worker)
+        known: Display | None = None
+        if pool is not None:  # the display from the cache, else from the worker
+            key = display_key(model, max_ops)
+            known = cached(key)
+            if known is None:
+                display = pool.submit(display_in_worker, key)
         values = system.parameter_values
         values.update(parameters or {})
         run = Run(model, out, dict(parameters or {}), t_end, max_ops, progress, info, summ,
-                  values, Figures(pool), None)
+                  values, Figures(pool), known)
         sections: list[str] = []
         try:
             compute_sections(run, sections, display)

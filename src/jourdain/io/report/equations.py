@@ -5,7 +5,8 @@ This is the report's SymPy work (simplification for reading, LaTeX, MathML). It 
 the symbolic equations only, so it is computed once per model and display code and kept in
 the compile cache (``<cache>/report/<key>.json``, the private one, the key a SHA-256 of the matrices' entries,
 the model's names and numbers, ``max_ops`` and the source of the display code); for
-``jourdain run`` it is computed in a forked worker while the command computes the numbers.
+``jourdain run``, when it is not in the cache, it is computed in a forked worker while the
+command computes the numbers.
 Simplification is bounded (:data:`REPORT_SIMPLIFY_SECONDS`); where the bound cuts it short the
 entries are shown as derived, and the cache keeps what was shown.
 """
@@ -160,22 +161,34 @@ def _cache_file(key: str) -> Path:
     return library_dir() / "report" / f"{key}.json"
 
 
-def cached_display(model: ModelFile, max_ops: int) -> Display:
-    """:func:`compute_display`, from the cache when it holds the display of this model."""
-    key = display_key(model, max_ops)
-    path = _cache_file(key)
+def cached(key: str) -> Display | None:
+    """The display kept under ``key``, None when there is none (or it cannot be read)."""
     try:
-        return Display(**json.loads(path.read_text(encoding="utf-8")))
+        return Display(**json.loads(_cache_file(key).read_text(encoding="utf-8")))
     except (OSError, ValueError, TypeError):
-        pass  # not cached yet (or unreadable): computed and cached
-    display = compute_display(model, max_ops)
+        return None
+
+
+def keep(key: str, display: Display) -> None:
+    """Keep ``display`` under ``key`` (written whole or not at all, for a concurrent reader;
+    a cache that cannot be written costs time, not results)."""
+    path = _cache_file(key)
     try:
         path.parent.mkdir(mode=0o700, exist_ok=True)
         tmp = path.with_name(f".{key}.{os.getpid()}.tmp")
         tmp.write_text(json.dumps(asdict(display)), encoding="utf-8")
-        tmp.replace(path)  # whole or not at all, for a concurrent reader
+        tmp.replace(path)
     except OSError:
-        pass  # a cache that cannot be written costs time, not results
+        pass
+
+
+def cached_display(model: ModelFile, max_ops: int) -> Display:
+    """:func:`compute_display`, from the cache when it holds the display of this model."""
+    key = display_key(model, max_ops)
+    display = cached(key)
+    if display is None:  # not cached yet (or unreadable): computed and kept
+        display = compute_display(model, max_ops)
+        keep(key, display)
     return display
 
 
@@ -183,15 +196,17 @@ def cached_display(model: ModelFile, max_ops: int) -> Display:
 _PENDING: tuple[ModelFile, int] | None = None
 
 
-def display_in_worker() -> Display:
-    """The job of the display worker: :func:`cached_display` of the model set before it was
-    forked (the symbolic equations come with the fork; nothing is sent)."""
-    assert _PENDING is not None, "the display worker was forked without a model"
-    return cached_display(*_PENDING)
+def display_in_worker(key: str) -> Display:
+    """The job of a report worker: :func:`compute_display` of the model set before it was
+    forked (nothing is sent), kept under ``key``."""
+    assert _PENDING is not None, "the report worker was forked without a model"
+    display = compute_display(*_PENDING)
+    keep(key, display)
+    return display
 
 
 def set_pending(model: ModelFile | None, max_ops: int) -> None:
-    """The model whose display the next forked worker computes (None: no more)."""
+    """The model whose display a worker forked next may compute (None: no more)."""
     global _PENDING
     _PENDING = None if model is None else (model, max_ops)
 
