@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 
 from jourdain.loops import evaluate
 from jourdain.loops.models import four_bar
@@ -74,3 +75,110 @@ def test_simulation_results_name_the_closing_joint_wrench() -> None:
                          math.sin(phi) * F[0] + math.cos(phi) * F[1]])
         assert np.max(np.abs(F_in - F_ref)) <= 1e3 * solve_tol(A, 1 + np.max(np.abs(F_ref)))
     assert "closing joint closure: max |F|" in res.summary()
+
+
+def _slider_tree():  # noqa: ANN202
+    from jourdain.model import Body, Gravity, Revolute, System, rod, symbols
+
+    phi, psi, chi = symbols("phi psi chi")
+    r, l, m1, m2, m3, g = symbols("r l m1 m2 m3 g")
+    bodies = [Body("crank", "world", Revolute("main", phi, "z"), mass=m1,
+                   com=(r / 2, 0, 0), inertia=rod(m1, r, "x")),
+              Body("rod", "crank", Revolute("pin", psi, "z", position=(r, 0, 0)), mass=m2,
+                   com=(l / 2, 0, 0), inertia=rod(m2, l, "x")),
+              Body("slider", "rod", Revolute("wrist", chi, "z", position=(l, 0, 0)),
+                   mass=m3, inertia=(0.01, 0.01, 0.01))]
+    return System([phi, psi, chi], bodies, [Gravity((0, -g, 0))],
+                  parameters={"r": 0.3, "l": 1.0, "m1": 1.0, "m2": 1.5, "m3": 2.0, "g": 9.81})
+
+
+def _loops() -> dict:
+    from pathlib import Path
+
+    from jourdain.io.modelfile import loads_model
+    from jourdain.loops import ClosedLoopSystem, ClosingJoint
+
+    ex = Path(__file__).resolve().parents[1] / "examples" / "spatial_rssr.toml"
+    mf = loads_model(ex.read_text(), "spatial_rssr.toml")
+    tree = _slider_tree()
+    return {
+        "revolute": (four_bar(), [1.1, 0.3, 1.9], [1.5, 0, 0]),
+        "spherical": (mf.loops, list(mf.simulation.y0), [1.0, 0.5, 0, 0.3, 0]),
+        "prismatic": (ClosedLoopSystem(tree, [ClosingJoint("guide", "prismatic", "world",
+                                                           "slider", axis="x")], ("phi",)),
+                      [0.5, -0.6, 0.1], [2.0, 0, 0]),
+        "point_on_line": (ClosedLoopSystem(tree, [ClosingJoint(
+            "line", "point_on_line", "crank", "slider", point_a=(0, 0.2, 0), axis=(1, 0.5, 0))],
+            ("phi", "chi")), [0.5, -0.6, 0.1], [2.0, 0, 0.7]),
+    }
+
+
+@pytest.mark.parametrize("kind", ["revolute", "spherical", "prismatic", "point_on_line"])
+def test_closing_wrench_does_the_virtual_work_of_its_rows(kind: str) -> None:
+    """Each row's unit wrench (force and torque on A at A's joint point, the opposite on B)
+    does the power Φ̇_i = Φ_z,i·ż for any motion on the manifold: checked with the bodies'
+    velocities from the tree's kinematics (independent of the row formulas), for every kind
+    of closing joint with points, at rates off the manifold's tangent (Φ̇ ≠ 0) and at the
+    motion's own, where the power vanishes: the orthogonality J̄ᵀQ̄ = 0 of the closing joints
+    (Φ_z·J_z = 0)."""
+    import symengine as se
+
+    from jourdain.loops import constraints
+    from jourdain.loops.reactions import closing_wrench_map
+    from jourdain.model.forces import rate
+    from jourdain.stages.kinematics import kinematics
+
+    loop, z0, zd0 = _loops()[kind]
+    s = evaluate(loop, z0, zd0)
+    tree = loop.tree
+    kin = kinematics(tree)
+    con = constraints(loop)
+    W = closing_wrench_map(loop).W_inertial
+    by_name = {cj.name: cj for cj in loop.closing}
+    n = loop.n
+    # any rates (off the manifold's tangent: Φ̇ ≠ 0) and the motion's own (Φ̇ = 0)
+    rng = np.random.default_rng(7)
+    for yd in (rng.uniform(-1.5, 1.5, n), np.asarray(s["zd"])):
+        values = {c: v for c, v in zip(tree.coordinates, s["z"], strict=True)}
+        values.update({rate(c): v for c, v in zip(tree.coordinates, yd, strict=True)})
+        values.update({se.Symbol(k): v for k, v in tree.parameters})
+        values[tree.t] = 0.0
+
+        def num(e: se.Basic, values: dict = values) -> float:
+            return float(se.sympify(e).subs(values))
+
+        def vec(m, num=num) -> np.ndarray:  # noqa: ANN001
+            return np.array([num(r[0]) for r in m.rows])
+
+        def motion(body: str, point: np.ndarray, num=num, vec=vec, yd=yd  # noqa: ANN001
+                   ) -> tuple[np.ndarray, np.ndarray]:
+            if body == "world":
+                return np.zeros(3), np.zeros(3)
+            bk = kin[body]
+            S = np.array([[num(e) for e in row] for row in bk.S.rows])
+            w = S @ vec(bk.omega)
+            JT = np.array([[num(e) for e in row] for row in bk.J_T_O.rows])
+            v_O = JT @ yd + vec(bk.v_bar_O)
+            return v_O + np.cross(w, point - vec(bk.r_O)), w
+
+        checked, largest = 0, 0.0
+        for i, row in enumerate(con.rows):
+            cj = by_name[row.joint]
+            if cj.body_a == "world":
+                pA = np.array([num(e) for e in cj.point_a])
+            else:
+                bk = kin[cj.body_a]
+                S = np.array([[num(e) for e in r] for r in bk.S.rows])
+                pA = vec(bk.r_O) + S @ np.array([num(e) for e in cj.point_a])
+            vA, wA = motion(cj.body_a, pA)
+            vB, wB = motion(cj.body_b, pA)
+            unit = np.array([num(W.rows[k][i]) for k in range(6)])
+            power = unit[:3] @ (vA - vB) + unit[3:] @ (wA - wB)
+            Phi_dot = float(np.asarray(s["Phi_z"])[i] @ yd)
+            scale = 1.0 + float(np.max(np.abs(yd))) * (1.0 + float(np.max(np.abs(s["z"]))))
+            assert abs(power - Phi_dot) <= 1e3 * 2.2e-16 * scale, row.label
+            largest = max(largest, abs(Phi_dot))
+            checked += 1
+        assert checked == len(con.rows) >= 1
+        if yd is not s["zd"]:
+            assert largest > 1e-2  # the check was not of zeros
