@@ -163,11 +163,13 @@ class _Segment:
         self.u_kind = np.zeros(max(nu, 1), dtype=np.intc)
         self.tab_off = np.zeros(nu + 1, dtype=np.int_)
         self.atol = np.full(n, float(atol))
+        # by field name: the integrator's problem struct (simulation.simulate) may grow
         self.problem = _Problem(
-            f, nu, 0, kernel.tree.address, None, None, None, kernel.state_address,
-            _ptr(self.u_const), _ptr(self.u_kind), _ptr(self.tab_off), None, None, None, None,
-            C_METHODS[method], float(rtol), _ptr(self.atol),
-            float(max_step), 0.0, kernel.accel_address)
+            f=f, nu=nu, nev=0, mkq=kernel.tree.address, uexpr=None, events=None, ucb=None,
+            p=kernel.state_address, u_const=_ptr(self.u_const), u_kind=_ptr(self.u_kind),
+            tab_off=_ptr(self.tab_off), tab_t=None, tab_v=None, ev_dir=None, ev_term=None,
+            method=C_METHODS[method], rtol=float(rtol), atol=_ptr(self.atol),
+            h_max=float(max_step), h_first=0.0, accel=kernel.accel_address)
         self.st = np.array([t, 0.0, 0.0, 0.0])
         self.x = x.copy()
         self.k0 = np.zeros(n)
