@@ -49,6 +49,7 @@ def split_assignments(text: str, option: str) -> list[tuple[str, str]]:
 
 
 def number(text: str, where: str) -> float:
+    """A number of the command line (``pi/4`` too), a :class:`UsageError` naming ``where``."""
     try:
         return parse_number(text)
     except ExpressionError as exc:
@@ -56,6 +57,8 @@ def number(text: str, where: str) -> float:
 
 
 def overrides(system: Any, sets: Sequence[str]) -> dict[str, float]:
+    """The parameter values of ``--set`` (repeatable, comma-separated), checked as the model
+    file's own values are."""
     params = system.parameter_values
     out: dict[str, float] = {}
     for s in sets:
@@ -100,6 +103,7 @@ def state_at(model: Any, at: str | None) -> tuple[np.ndarray, np.ndarray, float,
 
 
 def load(path: str) -> Any:
+    """The model file (TOML, or URDF for a robot) at ``path``."""
     try:  # a model file that is not there is a usage error; what it says, a model error
         with open(path, "rb"):
             pass
@@ -110,7 +114,6 @@ def load(path: str) -> Any:
     except OSError as exc:
         raise UsageError(f"{path}: cannot read the model file: {exc.strerror}") from None
     if path.lower().endswith(".urdf"):  # a robot description (docs/urdf.md)
-
         return load_urdf(path)
     return load_model(path)
 
