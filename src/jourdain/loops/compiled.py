@@ -30,11 +30,13 @@ from ..numeric.toolchain import build, content_key
 from ..symbolic import SymMatrix
 from .closed_loop import ClosedLoopSystem, LoopEvaluator, Partition, constraints
 
-_VERSION = "loop-c3"
+_VERSION = "loop-c4"
 #: reasons in ``info[2]`` (``loop_c.h``)
 REASONS = {1: "Newton found no configuration on the manifold (Φ_d singular or divergence)",
            2: "the condition number of Φ_d passed the limit",
-           3: "M in the independent coordinates is not positive definite"}
+           3: "M in the independent coordinates is not positive definite",
+           4: "Newton's solution left the branch of the motion (a correction far beyond the "
+              "first-order prediction: near a singular position or a step too large)"}
 
 
 class _Loop(ctypes.Structure):

@@ -40,6 +40,7 @@ static const double *jdl_inputs(const jd_loop *L, double t, const double *u) {
 #define JD_LOOP_NEWTON 1   /* Newton found no configuration (Phi_d singular or divergence) */
 #define JD_LOOP_COND 2     /* cond_1(Phi_d) passed cond_limit */
 #define JD_LOOP_MASS 3     /* M not positive definite */
+#define JD_LOOP_BRANCH 4   /* Newton's correction far beyond the prediction: a branch jump */
 #define JD_LOOP_DY 0.05    /* the largest step in y of a continuation between samples */
 
 long jd_loop_work(long n, long m, long f) {
@@ -140,12 +141,17 @@ static int jdl_manifold(const jd_loop *L, const double *y, const double *yd, dou
     long n = L->n, m = L->m, f = L->f, r = L->r;
     double *z = L->z, *info = L->info;
     const double *Phi = s->con, *Pz = s->con + m, *Pt = s->con + m + m * n;
-    /* prediction along the manifold from the last solution */
-    if (info[4] != 0.0)
+    /* prediction along the manifold from the last solution; its size d_pred bounds the
+     * Newton correction on the same branch (second order in y - y_last) */
+    double d_pred = 0.0, *z_pred = s->v4 + 2 * f;  /* after the samples' y0, yi */
+    int predicted = info[4] != 0.0;
+    if (predicted)
         for (long i = 0; i < r; ++i) {
             double d = 0.0;
             for (long j = 0; j < f; ++j) d += s->Jz[L->dep[i] * f + j] * (y[j] - L->y_last[j]);
             z[L->dep[i]] += d;
+            z_pred[i] = z[L->dep[i]];
+            if (fabs(d) > d_pred) d_pred = fabs(d);
         }
     for (long j = 0; j < f; ++j) z[L->ind[j]] = y[j];
     double scale = 1.0, last = INFINITY, res = 0.0;
@@ -171,6 +177,14 @@ static int jdl_manifold(const jd_loop *L, const double *y, const double *yd, dou
     }
     info[1] = (double)it;
     info[3] = res;
+    /* a correction far larger than the prediction: Newton left the branch (another assembly
+     * mode, or the same configuration 2 pi away), which the integrator must not see */
+    if (predicted) {
+        double d_newton = 0.0;
+        for (long i = 0; i < r; ++i)
+            if (fabs(z[L->dep[i]] - z_pred[i]) > d_newton) d_newton = fabs(z[L->dep[i]] - z_pred[i]);
+        if (d_newton > 10.0 * d_pred + 1e-6 * scale) return JD_LOOP_BRANCH;
+    }
     /* Phi_d at the solution: its LU and condition number */
     double norm = 0.0;
     for (long j = 0; j < r; ++j) {
