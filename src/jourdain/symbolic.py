@@ -23,6 +23,9 @@ from typing import Any, TypeAlias, cast
 
 import symengine as se
 
+from .graph import Graph, graph_ops
+from .graph import cse as graph_cse
+
 #: a SymEngine expression (SymEngine has no type information: to the type checker, Any)
 Expr: TypeAlias = se.Basic
 
@@ -254,8 +257,6 @@ def to_sympy_many(exprs: Sequence[Expr]) -> list[Any]:
     """
     import sympy
 
-    from .graph import Graph
-
     g = Graph(list(exprs)).merged()
     memo: dict[int, Any] = {}
     for i in g.order:
@@ -274,8 +275,5 @@ def count_ops(exprs: Sequence[Expr], cse: bool = True) -> int:
     """Operation count of a list of expressions (n-ary + and * count n-1, functions and powers
     one), after common-subexpression elimination (:func:`jourdain.graph.cse`) when ``cse``, else
     counting each distinct node of the shared graph once."""
-    from .graph import cse as graph_cse
-    from .graph import graph_ops
-
     exprs = list(exprs)
     return graph_cse(exprs).count_ops() if cse else graph_ops(exprs)
