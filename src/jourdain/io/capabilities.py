@@ -70,8 +70,9 @@ def linearization_at(model: ModelFile, y: Any, yd: Any, t: float,
         # any state, not a claimed equilibrium: h = M·ÿ there is expected
         warnings.simplefilter("ignore", NominalMotionWarning)
         # numbers at one state: forward-mode differentiation in floating point, the same
-        # equations as the symbolic linearization without forming and compiling it (UR5: 0.19 s
-        # against 2.4 s, equal to rounding)
+        # equations as the symbolic linearization without forming and compiling it (entries
+        # equal to rounding; 0.9-1.5x the speed of the symbolic way on UR5, Solo and
+        # examples/planar_arm.urdf, benchmarks/urdf_reports.py on a loaded 2-core machine)
         lin = linearize_numeric(system, state_nominal(system, y, yd, t, inputs), t,
                                 dict(parameters) or None)
     out = {"M_tilde": lin.M_tilde, "P": lin.P, "Q": lin.Q, "h": lin.h}
