@@ -42,7 +42,6 @@ need the index-2 (GGL) or projected form on top.
 
 from __future__ import annotations
 
-import ctypes
 import math
 import time
 from collections.abc import Callable, Mapping, Sequence
@@ -52,7 +51,8 @@ import numpy as np
 
 from ..errors import EvaluationError
 from ..numeric import CompiledFunction, parameter_vector
-from ..simulation.simulate import _Problem, check_t_span, integrator_library
+from ..simulation.simulate import check_t_span
+from .c_run import C_METHODS, FAILED, Segment
 from .charts import decide
 from .closed_loop import (
     ClosedLoopSystem,
@@ -65,8 +65,6 @@ from .redundant import simulate_penalty, simulate_redundant
 from .results import LoopResults
 from .scipy_run import SOLVERS, run_scipy
 
-#: the C integrator's methods (``jd_problem.method``)
-C_METHODS = {"RK45": 0, "DOP853": 1, "Radau": 2}
 _KEYS = ("z", "zd", "zdd", "Phi", "Phi_dot", "lam")
 
 
@@ -146,63 +144,6 @@ def _input_values(loop: ClosedLoopSystem, inputs: Any, fn_u: CompiledFunction | 
     return lambda _t: u_const
 
 
-def _ptr(a: np.ndarray | None) -> int | None:
-    return None if a is None else int(a.__array_interface__["data"][0])
-
-
-class _Segment:
-    """One call sequence of the C integrator from ``t`` in one partition: its arrays."""
-
-    def __init__(self, kernel: LoopKernel, t: float, x: np.ndarray, te: np.ndarray,
-                 method: str, rtol: float, atol: float, max_step: float) -> None:
-        f = kernel.part.f
-        n = 2 * f + 1
-        nu = len(kernel.ev.loop.tree.inputs)
-        self.u_const = np.zeros(max(nu, 1))
-        self.u_const[:nu] = kernel.ev.u
-        self.u_kind = np.zeros(max(nu, 1), dtype=np.intc)
-        self.tab_off = np.zeros(nu + 1, dtype=np.int_)
-        self.atol = np.full(n, float(atol))
-        # by field name: the integrator's problem struct (simulation.simulate) may grow
-        self.problem = _Problem(
-            f=f, nu=nu, nev=0, mkq=kernel.tree.address, uexpr=None, events=None, ucb=None,
-            p=kernel.state_address, u_const=_ptr(self.u_const), u_kind=_ptr(self.u_kind),
-            tab_off=_ptr(self.tab_off), tab_t=None, tab_v=None, ev_dir=None, ev_term=None,
-            method=C_METHODS[method], rtol=float(rtol), atol=_ptr(self.atol),
-            h_max=float(max_step), h_first=0.0, accel=kernel.accel_address)
-        self.st = np.array([t, 0.0, 0.0, 0.0])
-        self.x = x.copy()
-        self.k0 = np.zeros(n)
-        self.g_old = np.zeros(1)
-        self.cnt = np.zeros(5, dtype=np.int_)
-        self.te = np.ascontiguousarray(te, dtype=float)
-        self.i_eval = np.zeros(1, dtype=np.int_)
-        cap = max(self.te.size, 1)
-        self.out_t = np.empty(cap)
-        self.out_x = np.empty((cap, n))
-        self.out_dx = np.empty((cap, n))
-        self.n_out = np.zeros(1, dtype=np.int_)
-        self.ev_t, self.ev_x = np.empty(1), np.empty((1, n))
-        self.ev_i, self.n_ev = np.empty(1, dtype=np.int_), np.zeros(1, dtype=np.int_)
-        self.fail = np.zeros(n + 1)
-
-    def run(self, t1: float) -> int:
-        lib = integrator_library()
-        while True:
-            code = int(lib.jd_integrate(
-                ctypes.byref(self.problem), t1, _ptr(self.st), _ptr(self.x), _ptr(self.k0),
-                _ptr(self.g_old), _ptr(self.cnt), _ptr(self.te), self.te.size,
-                _ptr(self.i_eval), _ptr(self.out_t), _ptr(self.out_x), _ptr(self.out_dx),
-                self.out_t.size, _ptr(self.n_out), _ptr(self.ev_t), _ptr(self.ev_x),
-                _ptr(self.ev_i), 1, _ptr(self.n_ev), 1 << 20, _ptr(self.fail)))
-            if code != 1:  # JD_CONTINUE: the step budget of one call used
-                return code
-
-
-_FAILED = {-2: "NaN or inf in the state or its derivative", -3: "step size underflow",
-           -5: "out of memory"}
-
-
 def _run_c(ev: LoopEvaluator, t0: float, t1: float, x: np.ndarray, tev: np.ndarray,
            method: str, rtol: float, atol: float, max_step: float, repartition: bool,
            cond_limit: float, fn_u: CompiledFunction | None = None) -> dict:
@@ -226,7 +167,9 @@ def _run_c(ev: LoopEvaluator, t0: float, t1: float, x: np.ndarray, tev: np.ndarr
             kernel.samples(np.array([t]), state[None, :2 * f])
             mark = max(kernel.cond, 10.0)
         kernel.set_cond_limit(min(cond_limit, 10 * mark) if repartition else cond_limit)
-        seg = _Segment(kernel, t, state, tev[i_eval:], method, rtol, atol, max_step)
+        seg = Segment(f, kernel.ev.u, kernel.tree.address, kernel.state_address,
+                      kernel.accel_address, t, state, tev[i_eval:], C_METHODS[method], rtol,
+                      atol, max_step)
         z_start, y_start = kernel.z.copy(), state[:f].copy()
         code = seg.run(t1)
         nfev += int(seg.cnt[0])
@@ -243,7 +186,7 @@ def _run_c(ev: LoopEvaluator, t0: float, t1: float, x: np.ndarray, tev: np.ndarr
         if code != -1:
             status = "failed"
             message = (f"the integration failed at t = {seg.fail[0]:.9g}: "
-                       f"{_FAILED.get(code, f'code {code}')}")
+                       f"{FAILED.get(code, f'code {code}')}")
             break
         # Newton's start at the last accepted state: the last sample (or the segment's start;
         # the failed evaluation may have left the kernel's configuration anywhere)
