@@ -14,7 +14,6 @@ from typing import Any
 import symengine as se
 
 from ...errors import JourdainError, ModelError
-from ...loops.modelfile import read_loops
 from ...pipeline import System  # jourdain.System: the model with its stages (issue 16)
 from ...simulation.simulate import (
     check_atol,
@@ -88,6 +87,10 @@ class _Loader(_Forces):
         sim = self.read_simulation(data, system)
         loops = None
         if "closing_joints" in data or "loops" in data:
+            # imported here, not at the top: jourdain.loops loads scipy.linalg (0.3 s), which
+            # only models with closing joints need (no circle: loops imports nothing of io)
+            from ...loops.modelfile import read_loops
+
             loops = read_loops(self, data, system)
         return ModelFile(self.file, system, description, nominal, sim,
                          tuple(self.descriptions.items()), view, loops)
