@@ -7,8 +7,6 @@ from typing import Any
 
 import numpy as np
 
-from ..differentiate import evaluate_float
-from ..graph import evaluate_float
 from ..errors import JourdainError
 from ..model.expressions import values_at
 
