@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import JourdainError
+from ..graph import evaluate_float
 from ..model.expressions import values_at
 
 #: M counts as singular where its smallest eigenvalue is below this fraction of its largest
