@@ -163,3 +163,24 @@ def test_input_expressions_drive_the_c_engine() -> None:
     with pytest.raises(Exception, match="t and the parameters only"):
         simulate_loop(loop, (0.0, 1.0), [0.5, 0.8, 1.9], None,
                       inputs={"tau": loop.tree.coordinates[0]})
+
+
+def test_penalty_form_in_c_equals_its_scipy_run() -> None:
+    """The augmented-Lagrangian form's C right-hand side (jd_penalty_accel) in the C
+    integrator gives SciPy's run of the same formula in NumPy, through the flat position."""
+    from jourdain.loops.simulate import simulate_penalty
+
+    n = 2
+    loop = n_four_bar(n)
+    from benchmarks.n_four_bar import initial_state, reference
+
+    z, zd = initial_state(n)
+    kw = dict(samples=21, rtol=1e-10, atol=1e-12)
+    c = simulate_penalty(loop, (0.0, 2.0), z, zd, **kw)
+    s = simulate_penalty(loop, (0.0, 2.0), z, zd, engine="scipy", **kw)
+    assert c.method == "DOP853" and s.method == "scipy:DOP853"
+    assert c.status == s.status == "finished"
+    assert float(c.coordinate("th0")[-1]) > math.pi  # through the flat position
+    # both within their tolerance of the same motion (and of the exact one)
+    assert np.max(np.abs(c.z - s.z)) <= 1e4 * 1e-10
+    assert np.max(np.abs(c.coordinate("th0") - reference(n, c.t))) <= 1e-5

@@ -357,3 +357,113 @@ long jd_loop_samples(const jd_loop *L, long N, const double *t, const double *x,
     }
     return -1;
 }
+
+/* ---- the augmented-Lagrangian (penalty) form in all tree coordinates (Bayo & Ledesma) ----
+ * (M + alpha G^T G) zdd = q - k - G^T lam - alpha G^T (c + 2 xi omega Phi_dot + omega^2 Phi),
+ * lam <- lam + alpha (G zdd + c + 2 xi omega Phi_dot + omega^2 Phi), `iterations` times from 0
+ * (G = Phi_z); jourdain.loops.redundant.simulate_penalty. */
+typedef struct {
+    jd_tree_fn tree;
+    const double *p;
+    long n, m, iterations;
+    double alpha, xi, omega;
+    double *work;          /* jd_penalty_work(n, m) doubles */
+    double *lam;           /* m: the multipliers of the last evaluation */
+} jd_penalty;
+
+long jd_penalty_work(long n, long m) {
+    return (2 * m + m * n) + m + (n * n + 2 * n) + n * n + 2 * n + 2 * m;
+}
+
+/* Cholesky factor in the lower triangle of the n x n row-major A; 1 when not positive definite */
+static int jdl_chol(long n, double *A) {
+    double dmax = 0.0;
+    for (long i = 0; i < n; ++i) if (fabs(A[i * n + i]) > dmax) dmax = fabs(A[i * n + i]);
+    for (long j = 0; j < n; ++j) {
+        double d = A[j * n + j];
+        for (long k = 0; k < j; ++k) d -= A[j * n + k] * A[j * n + k];
+        if (!(d > 1e-13 * dmax)) return 1;
+        d = sqrt(d);
+        A[j * n + j] = d;
+        for (long i = j + 1; i < n; ++i) {
+            double a = A[i * n + j];
+            for (long k = 0; k < j; ++k) a -= A[i * n + k] * A[j * n + k];
+            A[i * n + j] = a / d;
+        }
+    }
+    return 0;
+}
+
+static void jdl_chol_solve(long n, const double *C, const double *b, double *x) {
+    for (long i = 0; i < n; ++i) {
+        double a = b[i];
+        for (long k = 0; k < i; ++k) a -= C[i * n + k] * x[k];
+        x[i] = a / C[i * n + i];
+    }
+    for (long i = n - 1; i >= 0; --i) {
+        double a = x[i];
+        for (long k = i + 1; k < n; ++k) a -= C[k * n + i] * x[k];
+        x[i] = a / C[i * n + i];
+    }
+}
+
+int jd_penalty_accel(const double *z, const double *zd, double t, const double *pp,
+                     const double *u, double *zdd, double *power) {
+    const jd_penalty *P = (const jd_penalty *)(const void *)pp;
+    long n = P->n, m = P->m;
+    double *w = P->work;
+    double *con = w; w += 2 * m + m * n;
+    double *gam = w; w += m;
+    double *tr = w; w += n * n + 2 * n;
+    double *A = w; w += n * n;
+    double *b0 = w; w += n;
+    double *b = w; w += n;
+    double *stab = w; w += m;
+    const double *Phi = con, *G = con + m, *Pt = con + m + m * n;
+    jd_con(z, zd, t, P->p, u, con);
+    jd_gam(z, zd, t, P->p, u, gam);
+    P->tree(z, zd, t, P->p, u, tr);
+    const double *M = tr, *k = tr + n * n, *q = k + n;
+    double c2 = 2.0 * P->xi * P->omega, w2 = P->omega * P->omega, pw = 0.0;
+    for (long r = 0; r < m; ++r) {
+        double pd = Pt[r];
+        for (long j = 0; j < n; ++j) pd += G[r * n + j] * zd[j];
+        stab[r] = gam[r] + c2 * pd + w2 * Phi[r];
+    }
+    for (long i = 0; i < n; ++i) {
+        double a = q[i] - k[i];
+        for (long r = 0; r < m; ++r) a -= P->alpha * G[r * n + i] * stab[r];
+        b0[i] = a;
+        pw += zd[i] * q[i];
+        for (long j = 0; j <= i; ++j) A[i * n + j] = M[i * n + j];
+    }
+    /* alpha G^T G row by row of G, over its nonzero entries (a closing joint's rows touch
+     * the coordinates of its loop only) */
+    for (long r = 0; r < m; ++r) {
+        const double *g = G + r * n;
+        for (long i = 0; i < n; ++i) {
+            if (g[i] == 0.0) continue;
+            double ai = P->alpha * g[i];
+            for (long j = 0; j <= i; ++j) if (g[j] != 0.0) A[i * n + j] += ai * g[j];
+        }
+    }
+    *power = pw;
+    if (jdl_chol(n, A)) return isfinite(A[0]) ? 1 : 2;
+    jdl_chol_solve(n, A, b0, zdd);
+    for (long r = 0; r < m; ++r) P->lam[r] = 0.0;
+    for (long it = 0; it < P->iterations; ++it) {
+        for (long r = 0; r < m; ++r) {
+            double a = stab[r];
+            for (long j = 0; j < n; ++j) a += G[r * n + j] * zdd[j];
+            P->lam[r] += P->alpha * a;
+        }
+        for (long i = 0; i < n; ++i) {
+            double a = b0[i];
+            for (long r = 0; r < m; ++r) a -= G[r * n + i] * P->lam[r];
+            b[i] = a;
+        }
+        jdl_chol_solve(n, A, b, zdd);
+    }
+    for (long i = 0; i < n; ++i) if (!isfinite(zdd[i])) return 2;
+    return 0;
+}

@@ -6,14 +6,21 @@ coordinates with SciPy's DOP853 and report the constraint residuals as they are.
 
 from __future__ import annotations
 
+import ctypes
+import math
 import time
 from collections.abc import Callable, Mapping
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
 
+from ..errors import EvaluationError
+from ..numeric import mkq_function
 from ..simulation.simulate import check_t_span
+from .c_run import C_METHODS, FAILED, Segment
 from .closed_loop import ClosedLoopSystem, LoopEvaluator
+from .compiled import loop_library
 from .results import LoopResults
 
 
@@ -56,7 +63,8 @@ def simulate_penalty(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: An
                      zd0: Any = None, *, samples: int = 501, rtol: float = 1e-10,
                      atol: float = 1e-12, alpha: float = 1e7, xi: float = 1.0,
                      omega: float = 30.0, iterations: int = 4,
-                     parameters: Mapping[str, float] | None = None) -> LoopResults:
+                     parameters: Mapping[str, float] | None = None,
+                     engine: str = "c") -> LoopResults:
     """The augmented-Lagrangian (penalty) form in all tree coordinates, for singular
     positions and redundant constraints, where Φ_d of a partition or the bordered matrix of
     :func:`simulate_redundant` is singular (Bayo & Ledesma's formulation):
@@ -70,11 +78,15 @@ def simulate_penalty(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: An
     7e-6 rad (``benchmarks/n_four_bar.py``). The constraints hold to
     the penalty's accuracy (about ‖M‖/α) and the integration error; the residuals are
     reported as they are. ``λ`` of the results are the multipliers of the last iteration.
+    ``engine="c"`` (default): the right-hand side in C (``jd_penalty_accel``) run by jourdain's
+    C integrator (DOP853); "scipy": the same formula in NumPy under SciPy's DOP853.
     """
     from scipy.integrate import solve_ivp
     from scipy.linalg import cho_factor, cho_solve
 
     t0, t1 = check_t_span(t_span)
+    if engine not in ("c", "scipy"):
+        raise EvaluationError(f'engine must be "c" or "scipy", got {engine!r}')
     ev = LoopEvaluator(loop, z0, t0, parameters)
     asm = ev.assemble(z0, zd0, t0)
     n = loop.n
@@ -101,8 +113,15 @@ def simulate_penalty(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: An
         return np.concatenate([x[n:], accel(x[:n], x[n:], t)[0]])
 
     started = time.perf_counter()
-    sol = solve_ivp(rhs, (t0, t1), np.concatenate([asm.z, asm.zd]), method="DOP853",
-                    rtol=rtol, atol=atol, t_eval=np.linspace(t0, t1, samples))
+    tev = np.linspace(t0, t1, samples)
+    if engine == "c":  # the same right-hand side in C (loop_c.h), in jourdain's C integrator
+        sol = _penalty_c(ev, t0, t1, np.concatenate([asm.z, asm.zd]), tev, rtol, atol,
+                         (alpha, xi, omega, iterations))
+        method = "DOP853"
+    else:
+        sol = solve_ivp(rhs, (t0, t1), np.concatenate([asm.z, asm.zd]), method="DOP853",
+                        rtol=rtol, atol=atol, t_eval=tev)
+        method = "scipy:DOP853"
     wall = time.perf_counter() - started
 
     def sample(z: np.ndarray, zd: np.ndarray, t: float) -> tuple[np.ndarray, np.ndarray,
@@ -110,12 +129,48 @@ def simulate_penalty(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: An
         zdd, lam, cd = accel(z, zd, t)
         # the sign of λ in M·z̈ = … − Φ_zᵀλ: −λ is the multiplier of the other forms
         return zdd, -lam, cd
-    return _redundant_results(loop, ev, sol, sample, t0, wall)
+    return _redundant_results(loop, ev, sol, sample, t0, wall, method)
+
+
+class _Penalty(ctypes.Structure):
+    _fields_ = [("tree", ctypes.c_void_p), ("p", ctypes.c_void_p), ("n", ctypes.c_long),
+                ("m", ctypes.c_long), ("iterations", ctypes.c_long),
+                ("alpha", ctypes.c_double), ("xi", ctypes.c_double),
+                ("omega", ctypes.c_double), ("work", ctypes.c_void_p),
+                ("lam", ctypes.c_void_p)]
+
+
+def _penalty_c(ev: LoopEvaluator, t0: float, t1: float, x0: np.ndarray, tev: np.ndarray,
+               rtol: float, atol: float, settings: tuple[float, float, float, int]
+               ) -> SimpleNamespace:
+    """The penalty form's run in the C integrator (DOP853): SciPy's solution's fields."""
+    lib = loop_library(ev.loop)
+    tree = mkq_function(ev.loop.tree)
+    n, m = ev.n, len(ev.labels)
+    alpha, xi, omega, iterations = settings
+    lib.jd_penalty_work.restype = ctypes.c_long
+    lib.jd_penalty_work.argtypes = [ctypes.c_long, ctypes.c_long]
+    work = np.zeros(int(lib.jd_penalty_work(n, m)))
+    lam = np.zeros(max(m, 1))
+    st = _Penalty(tree.address, ev.p.__array_interface__["data"][0], n, m, int(iterations),
+                  float(alpha), float(xi), float(omega), work.__array_interface__["data"][0],
+                  lam.__array_interface__["data"][0])
+    accel = int(ctypes.cast(lib.jd_penalty_accel, ctypes.c_void_p).value or 0)
+    seg = Segment(n, ev.u, tree.address, ctypes.addressof(st), accel, t0,
+                  np.concatenate([x0, [0.0]]), tev, C_METHODS["DOP853"], rtol, atol, math.inf)
+    code = seg.run(t1)
+    k = int(seg.n_out[0])
+    message = ("the integration reached t_end" if code == 0 else
+               f"the integration failed at t = {seg.fail[0]:.9g}: "
+               f"{FAILED.get(code, 'the penalty matrix is not positive definite')}")
+    return SimpleNamespace(t=seg.out_t[:k].copy(), y=seg.out_x[:k, :2 * n].T.copy(),
+                           status=0 if code == 0 else -1, message=message,
+                           nfev=int(seg.cnt[0]))
 
 
 def _redundant_results(loop: ClosedLoopSystem, ev: Any, sol: Any,
                        sample: Callable[[np.ndarray, np.ndarray, float], tuple], t0: float,
-                       wall: float) -> LoopResults:
+                       wall: float, method: str = "scipy:DOP853") -> LoopResults:
     """The results of a redundant-coordinate run (``simulate_redundant``,
     ``simulate_penalty``) from SciPy's solution, each sample evaluated by ``sample(z, ż, t)``
     → ``(z̈, λ, constraint data)``."""
@@ -140,7 +195,7 @@ def _redundant_results(loop: ClosedLoopSystem, ev: Any, sol: Any,
         np.array(out["T"]), np.array(out["V"]), list(ev.labels), [(t0, ())], status,
         str(sol.message), int(sol.nfev), wall, None,
         dict(zip([k for k, _ in loop.tree.parameters], ev.p.tolist(), strict=True)),
-        "scipy:DOP853")
+        method)
 
 
 __all__ = ["simulate_penalty", "simulate_redundant"]
