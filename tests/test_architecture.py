@@ -70,9 +70,8 @@ FLOORS: tuple[tuple[str, ...], ...] = (
 # "Length:" reason; ("floor", importer, imported): an import up the floors; ("cycle", module):
 # a module on an import circle; ("shadow", module): a submodule its package's attribute hides.
 PENDING: set[tuple[str, ...]] = {
-    # stages/ (H6): Linearization.evaluate/compile/check_nominal and GeneralLinearization.evaluate
-    # still evaluate in the stage (deferred imports of numeric); the reactions' numbers are in
-    # jourdain.analysis.reactions, the numeric linearization in analysis.numeric_linearization
+    # stages/linearization (H6): the numeric evaluation of a linearization still imports
+    # jourdain.numeric (the floor above) from the stage
     ("floor", "jourdain.stages.linearization.general", "jourdain.numeric"),
     ("floor", "jourdain.stages.linearization.result", "jourdain.numeric"),
     # the command line, the report, the FMU (H8, H7): `import jourdain` (the public API, the
@@ -80,16 +79,8 @@ PENDING: set[tuple[str, ...]] = {
     ("floor", "jourdain.cli.parser", "jourdain"),
     ("floor", "jourdain.io.report.document", "jourdain"),
     ("floor", "jourdain.io.fmu", "jourdain"),
-    # re-exports that hide a submodule (H2: loops; H7: io.viewer)
-    ("shadow", "jourdain.loops.constraints"), ("shadow", "jourdain.io.viewer.page"),
-    ("shadow", "jourdain.io.viewer.scene"),
-    # modules over 400 lines being split (owners: H1 simulate; H2 loops; H6 stages, results,
-    # differentiate; H7 numeric, io)
-    ("lines", "jourdain.io.expressions"),
-    ("lines", "jourdain.loops.closed_loop"),
-    ("lines", "jourdain.loops.simulate"), ("lines", "jourdain.numeric"),
-    ("lines", "jourdain.numeric.recursive"),
-    ("lines", "jourdain.simulation.simulate"),
+    # io.viewer (H7) re-exports names that hide its submodules page and scene
+    ("shadow", "jourdain.io.viewer.page"), ("shadow", "jourdain.io.viewer.scene"),
 }
 
 
