@@ -42,7 +42,7 @@ MODEL_MAY_IMPORT = ("jourdain.model", "jourdain.errors")
 FLOORS: tuple[tuple[str, ...], ...] = (
     # 0 foundations: the errors, the symbolic matrix, the expression graph (CSE,
     #   differentiation) and identity maps
-    ("jourdain.errors", "jourdain.identity", "jourdain.symbolic", "jourdain.graph"),
+    ("jourdain.errors", "jourdain.version", "jourdain.identity", "jourdain.symbolic", "jourdain.graph"),
     # 1 the model: the description a user writes (pure, immutable data), and its units
     ("jourdain.model", "jourdain.units"),
     # 2 the stages of the method: kinematics → Newton–Euler → projection → reactions →
@@ -74,13 +74,6 @@ PENDING: set[tuple[str, ...]] = {
     # jourdain.numeric (the floor above) from the stage
     ("floor", "jourdain.stages.linearization.general", "jourdain.numeric"),
     ("floor", "jourdain.stages.linearization.result", "jourdain.numeric"),
-    # the command line, the report, the FMU (H8, H7): `import jourdain` (the public API, the
-    # top floor) instead of the modules they use
-    ("floor", "jourdain.cli.parser", "jourdain"),
-    ("floor", "jourdain.io.report.document", "jourdain"),
-    ("floor", "jourdain.io.fmu", "jourdain"),
-    # io.viewer (H7) re-exports names that hide its submodules page and scene
-    ("shadow", "jourdain.io.viewer.page"), ("shadow", "jourdain.io.viewer.scene"),
 }
 
 

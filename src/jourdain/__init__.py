@@ -115,9 +115,8 @@ from .stages.newton_euler import NewtonEuler, newton_euler
 from .stages.projection import EquationsOfMotion, projection
 from .stages.reactions import JointReactions, Reactions, reactions
 from .symbolic import SymMatrix
+from .version import __version__ as __version__
 from .wrenches import JointWrench, joint_wrenches
-
-__version__ = "0.1.0"
 
 #: The public API, by topic (tests/test_architecture.py checks that each name is documented).
 __all__ = [

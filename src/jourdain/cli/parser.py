@@ -8,10 +8,10 @@ import sys
 from collections.abc import Callable
 from typing import Any, NoReturn
 
-from .. import __version__
 from ..io.capabilities import SIM_METHODS
 from ..simulation import simulate as sim
 from ..study.cli import add_study_parser
+from ..version import __version__
 from ..workflow import EVAL_FORMAT
 from .model_commands import cmd_check, cmd_eom
 from .numbers import cmd_eval, cmd_linearize, cmd_reactions

@@ -38,6 +38,7 @@ from ...numeric.ccode import argument_names, function_source
 from ...numeric.integrator_c import tables as rk_tables
 from ...numeric.recursive import recursive_units
 from ...numeric.toolchain import compiler
+from ...version import __version__
 from .binary import FMI_HEADERS, SOURCES, _binary, fmi_header_dir, platform_folder
 from .description import build_description, layout, model_description
 from .sources import (
@@ -124,7 +125,6 @@ def export_fmu(model: Any, path: str | os.PathLike[str], *,
     CompilerError : no C compiler, or the sources did not compile
     MissingDependency : FMPy (the FMI headers) not installed
     """
-    from ... import __version__
 
     system, mf = _model_of(model)
     if getattr(mf, "loops", None) is not None:

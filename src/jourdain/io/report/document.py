@@ -12,8 +12,7 @@ from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 from typing import Any
 
-import jourdain  # its __version__, read when a report is written (set after io is imported)
-
+from ...version import __version__
 from ...workflow import summary
 from .. import export
 from ..modelfile import ModelFile
@@ -168,7 +167,7 @@ def _page(run: Run, sections: list[str], t_start: float) -> str:
             body = body.replace(nominal_placeholder(i), run.display.nominal[nominal.name], 1)
     elapsed = time.perf_counter() - t_start
     name = model.system.name
-    head = (f"<h1>{esc(name)}</h1><p class='meta'>jourdain {jourdain.__version__} report of "
+    head = (f"<h1>{esc(name)}</h1><p class='meta'>jourdain {__version__} report of "
             f"{esc(model.path)}, {_dt.datetime.now().strftime('%Y-%m-%d %H:%M')}, "
             f"computed in {elapsed:.1f} s</p>")
     if info.status != "complete":

@@ -41,9 +41,9 @@ the npm versions pinned in ``tools/viewer/package-lock.json`` and inlined into e
 from __future__ import annotations
 
 from .meshes import Mesh, read_mesh
-from .page import View, embed, model_visuals, page, report_section, view
+from .page import View, embed, model_visuals, report_section, view
 from .poses import body_poses, frame_times, pose_function, quaternions
-from .scene import decode_poses, scene
+from .scene import decode_poses
 from .visuals import (
     FRAMES_PER_SECOND,
     MAX_FRAMES,
@@ -63,5 +63,5 @@ from .visuals import (
 __all__ = ["FRAMES_PER_SECOND", "MAX_FRAMES", "MAX_POSES", "MAX_TRIANGLES", "MIN_THICKNESS",
            "SCENE_FORMAT", "SHAPES", "VISUAL_KINDS", "Mesh", "MeshVisual", "View", "Visual",
            "body_poses", "decode_poses", "embed", "equivalent_shape", "frame_times",
-           "model_visuals", "page", "pose_function", "quaternions", "read_mesh",
-           "report_section", "rpy_matrix", "scene", "view", "visuals_by_body"]
+           "model_visuals", "pose_function", "quaternions", "read_mesh",
+           "report_section", "rpy_matrix", "view", "visuals_by_body"]
