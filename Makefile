@@ -1,6 +1,7 @@
 # Two entry points for a fresh machine (Python 3.11+, a C compiler):
 #   make run   - create .venv, install jourdain, run the main job on the default example
-#   make test  - create .venv, install jourdain with test extras, run ruff and the test suite
+#   make test  - create .venv, install jourdain with test extras, run ruff, mypy (src/, configured
+#                in pyproject.toml) and the test suite
 #                (twice: PYTHONHASHSEED=0 with OPENBLAS_NUM_THREADS=1, and PYTHONHASHSEED=12345)
 #   make docs  - install jourdain with the docs extra and build the documentation site into
 #                site/ (mkdocs build --strict: offline, warnings are errors; see mkdocs.yml)
@@ -31,6 +32,7 @@ run: $(BIN)/.installed-run
 
 lint: $(BIN)/.installed
 	$(BIN)/ruff check src tests benchmarks
+	$(BIN)/mypy
 
 # headless Chromium for the report's browser test: installed when missing and running as root
 # with apt-get (NO_BROWSER=1 skips the install); otherwise that one test is skipped with the reason
