@@ -282,7 +282,7 @@ def test_numeric_path_matches_symbolic(rng):
 def test_general_form_gives_every_operating_point(rng):
     """linearization_general (functions of the state) evaluated at a state equals the
     linearization about a nominal motion through that state (with the same ẏ, ÿ)."""
-    from jourdain.stages.linearization import linearization_general
+    from jourdain import linearization_general  # with evaluate (jourdain.numeric.linearization)
 
     s = double_pendulum()
     gen = linearization_general(s.equations_of_motion())

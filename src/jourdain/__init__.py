@@ -97,20 +97,18 @@ from .model import (
     t,
     velocity,
 )
+from .numeric.linearization import (  # the stage's results with their numbers (issue 16)
+    CompiledLinearization,
+    GeneralLinearization,
+    Linearization,
+    linearization,
+    linearization_general,
+)
 from .pipeline import System
 from .simulation.results import Results
 from .simulation.simulate import Event, IntegrationError, simulate
 from .stages.kinematics import BodyKinematics, Kinematics, kinematics
-from .stages.linearization import (
-    CompiledLinearization,
-    GeneralLinearization,
-    Linearization,
-    NominalCheck,
-    NominalMotionWarning,
-    TimeVariantError,
-    linearization,
-    linearization_general,
-)
+from .stages.linearization import NominalCheck, NominalMotionWarning, TimeVariantError
 from .stages.newton_euler import NewtonEuler, newton_euler
 from .stages.projection import EquationsOfMotion, projection
 from .stages.reactions import JointReactions, Reactions, reactions

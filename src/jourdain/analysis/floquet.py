@@ -34,7 +34,8 @@ import numpy as np
 
 from ..errors import EvaluationError, warn
 from ..numeric import parameter_vector
-from ..stages.linearization import CompiledLinearization, Linearization, NominalMotionWarning
+from ..numeric.linearization import CompiledLinearization, check_nominal, compile_linearization
+from ..stages.linearization import Linearization, NominalMotionWarning
 from .cyclic import check_cyclic, cyclic_coordinates
 from .modes import ASYMPTOTICALLY_STABLE, MARGINALLY_STABLE, UNSTABLE
 
@@ -110,7 +111,7 @@ def _compiled(lin: Linearization | CompiledLinearization) -> CompiledLinearizati
     if isinstance(lin, CompiledLinearization):
         return lin
     if isinstance(lin, Linearization):
-        return lin.compile()
+        return compile_linearization(lin)
     raise EvaluationError(f"floquet: expected a Linearization or CompiledLinearization (a "
                           f"periodic nominal motion, symbolic in t), got {type(lin).__name__}")
 
@@ -296,7 +297,7 @@ def _nominal_text(lin: Linearization) -> str:
 def _nominal_warning(lin: Linearization, reason: str, t0: float, T: float,
                      parameters: Mapping[str, float] | None) -> str:
     for t in (t0, t0 + T / 3):
-        check = lin.check_nominal(t, parameters)
+        check = check_nominal(lin, t, parameters)
         if not check.is_solution:
             text = (f"the nominal motion is not a solution of the equations of motion at "
                     f"t = {t:.6g} (|h| = {np.abs(check.h).max():.3g}, {check.relative:.2g} of "

@@ -17,12 +17,12 @@ import numpy as np
 
 from ..errors import EvaluationError, JourdainError, SingularMassMatrix
 from ..numeric import parameter_vector
-from ..stages.linearization import (
+from ..numeric.linearization import (
     CompiledLinearization,
-    Linearization,
-    NominalCheck,
-    TimeVariantError,
+    check_nominal,
+    evaluate_linearization,
 )
+from ..stages.linearization import Linearization, NominalCheck, TimeVariantError
 from .numeric_linearization import NumericLinearization
 
 #: real parts (and, in tables, imaginary parts) below this fraction of the largest |λ| (at
@@ -136,7 +136,7 @@ def numbers(lin: AnyLinearization, t: float | None = None,
     if isinstance(lin, CompiledLinearization):
         return lin(0.0 if t is None else t, parameters)
     if isinstance(lin, Linearization):
-        return lin.evaluate(0.0 if t is None else t, parameters)
+        return evaluate_linearization(lin, 0.0 if t is None else t, parameters)
     if isinstance(lin, NumericLinearization):
         return lin.evaluate(t, parameters)
     raise EvaluationError(f"expected a Linearization, CompiledLinearization or "
@@ -195,7 +195,7 @@ def state_space(lin: AnyLinearization, t: float | None = None,
     if nominal_check is not _COMPUTED:
         return replace(ss, nominal_check=nominal_check)
     try:
-        check = base.check_nominal(ss.t, parameters)
+        check = check_nominal(base, ss.t, parameters)
     except JourdainError:  # the matrices have numbers, so this is not expected; no verdict on h
         check = None
     return replace(ss, nominal_check=check)

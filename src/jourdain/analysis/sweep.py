@@ -13,7 +13,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import EvaluationError
-from ..stages.linearization import CompiledLinearization, Linearization
+from ..numeric.linearization import CompiledLinearization
+from ..stages.linearization import Linearization
 from .modes import ASYMPTOTICALLY_STABLE, UNSTABLE, _cyclic_of, stability
 from .state_space import _from_numbers, _linearization_of, numbers, state_space
 

@@ -20,10 +20,10 @@ import numpy as np
 from ..analysis.reactions import evaluate_keys
 from ..model.system import System as Model
 from ..numeric import evaluate as evaluate_eom
+from ..numeric.linearization import Linearization, linearization  # with its numbers
 from ..simulation.results import Results
 from ..simulation.simulate import DEFAULT_ATOL, DEFAULT_METHOD, DEFAULT_RTOL, simulate
 from ..stages.kinematics import Kinematics, kinematics
-from ..stages.linearization import Linearization, linearization
 from ..stages.newton_euler import NewtonEuler, newton_euler
 from ..stages.projection import EquationsOfMotion, projection
 from ..stages.reactions import Reactions, reactions
@@ -82,7 +82,9 @@ class System(Model):
                   inputs: Mapping[Any, Any] | None = None) -> Linearization:
         """Linearization M̃·η̈ + P·η̇ + Q·η = h + B·Δu about a nominal motion (METHOD §5), with
         nominal ``inputs`` ``{input: u_s}`` where given (zero otherwise); see
-        :func:`jourdain.stages.linearization.linearization`."""
+        :func:`jourdain.stages.linearization.linearization`. The result has its numbers as
+        methods (``evaluate``, ``compile``, ``check_nominal``:
+        :class:`jourdain.numeric.linearization.Linearization`)."""
         return linearization(self.equations_of_motion(), nominal, inputs)
 
     def evaluate(self, y: Any, yd: Any, t: float = 0.0,

@@ -8,7 +8,8 @@ D, G, K, N).
 Each takes the results of the stages before it and returns a frozen dataclass with the method's
 symbols as field names; this package re-exports nothing, so ``jourdain.stages.projection`` is the
 module (the functions are at ``jourdain.projection`` etc.). Floor: above the model and the
-expression graph (:mod:`jourdain.graph`), below the numeric layer; the numbers of reactions and
-of the numeric linearization are in :mod:`jourdain.analysis` (``reactions``,
-``numeric_linearization``).
+expression graph (:mod:`jourdain.graph`), below the numeric layer; the numbers of the symbolic
+linearization are in :mod:`jourdain.numeric.linearization` (``lin.evaluate``, ``lin.compile``),
+those of reactions and of the numeric linearization in :mod:`jourdain.analysis`
+(``reactions``, ``numeric_linearization``).
 """

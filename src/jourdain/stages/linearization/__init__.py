@@ -1,7 +1,10 @@
 """Linearization about a nominal motion (``docs/method.md`` §5) and its physical split (§6).
 
 Produces M̃ (``M``), P, Q, h, B about a nominal motion and D, G, K, N (:class:`Linearization`,
-:class:`GeneralLinearization`; in numbers ``jourdain.analysis.numeric_linearization``).
+:class:`GeneralLinearization`), symbolic. Their numbers are on the floors above:
+``jourdain.numeric.linearization`` (``lin.evaluate``, ``lin.compile``, ``lin.check_nominal`` on
+the subclasses that ``jourdain.linearization`` and ``jourdain.System.linearize`` return) and
+``jourdain.analysis.numeric_linearization`` (numbers without the symbolic form).
 
 With ``y = y_s(t) + η`` and inputs ``u = u_s(t) + Δu``, the equations of motion
 ``M(y,t)·ÿ + k(y,ẏ,t) = q(y,ẏ,u,t)`` become, to first order in ``η`` and ``Δu``,
@@ -31,15 +34,16 @@ gyroscopic ``G``, stiffness ``K`` and circulatory ``N`` parts (§6):
 A nominal motion may set the inputs too (``u_s``: the motor torque that keeps a rotor turning
 against its damping, the force that holds an arm in its pose). Where an equilibrium or a steady
 motion (ÿ_s = 0) leaves ``h ≠ 0`` it is not a solution of the equations of motion: the
-linearization says so with a :class:`NominalMotionWarning` (:meth:`Linearization.check_nominal`,
-:class:`NominalCheck`), and so does the stability verdict built on it.
+linearization says so with a :class:`NominalMotionWarning` (:class:`NominalCheck`; at other
+times and parameter values ``lin.check_nominal``), and so does the stability verdict built on
+it.
 
 Modules
 -------
 * :mod:`.nominal`: the nominal motion and the check that it solves the equations of motion;
 * :mod:`.formation`: the symbolic linearization (:func:`linearization`);
-* :mod:`.result`: :class:`Linearization` (the split into D, G, K, N) and
-  :class:`CompiledLinearization`;
+* :mod:`.result`: :class:`Linearization` (the split into D, G, K, N) and its numbers at
+  checked values;
 * :mod:`.general`: the general form (:func:`linearization_general`).
 
 The numeric path for given parameter values (``linearize_numeric``) is on the analysis floor,
@@ -56,10 +60,10 @@ from .nominal import (
     force_scale,
     term_scale,
 )
-from .result import CompiledLinearization, Linearization
+from .result import Linearization
 
 __all__ = [
-    "NOMINAL_RTOL", "CompiledLinearization", "GeneralLinearization", "Linearization",
+    "NOMINAL_RTOL", "GeneralLinearization", "Linearization",
     "NominalCheck", "NominalMotionWarning", "TimeVariantError", "force_scale", "linearization",
     "linearization_general", "term_scale",
 ]

@@ -20,15 +20,16 @@ if TYPE_CHECKING:
     from ...model.system import System
     from ..projection import EquationsOfMotion
 from .nominal import ZERO, NominalMotionWarning, _is_zero, _nominal, _perturbed
-from .result import Linearization
+from .result import Linearization, check_nominal_at, values_at
 
 
 def _warn_if_not_solution(lin: Linearization) -> None:
     """A :class:`NominalMotionWarning` when a claimed equilibrium or steady motion leaves
     h ≠ 0 at t = 0 for the default parameter values (a reference trajectory with ÿ_s ≠ 0 is
     not checked: h is its feed-forward)."""
+    defaults = np.array(list(lin.system.parameter_values.values()), dtype=float)
     try:
-        result = lin.check_nominal()
+        result = check_nominal_at(lin, values_at(lin, 0.0, defaults))
     except JourdainError:  # no numbers at the default parameter values: evaluate() will say
         return
     if result.kind != "nominal motion" and not result.is_solution:
@@ -69,7 +70,7 @@ def linearization(eom: EquationsOfMotion, nominal: Mapping[Any, Any] | Any,
     -----
     NominalMotionWarning
         When the nominal motion is an equilibrium or a steady motion (ÿ_s = 0) and ``h ≠ 0`` at
-        t = 0 for the default parameter values (:meth:`Linearization.check_nominal`).
+        t = 0 for the default parameter values (:func:`.result.check_nominal_at`).
     """
     system = eom.system
     y_s, u_s = _nominal(system, nominal, inputs)

@@ -2,21 +2,20 @@
 symbolic functions of the state y, ẏ, ÿ (:func:`linearization_general`,
 :class:`GeneralLinearization`), for any operating point.
 
-Floor: stages; :meth:`GeneralLinearization.evaluate` reads its state vectors with
-:func:`jourdain.numeric.state_vectors` (a floor above), imported inside it (pending, as for
-:mod:`.result`).
+Floor: stages. The result is symbolic; :func:`evaluate_general_at` walks it in floating point
+at a state already checked. The public ``glin.evaluate(y, yd, ydd, t, parameters, inputs)``,
+which checks the state, is on the numeric floor: :mod:`jourdain.numeric.linearization`.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 import symengine as se
 
-from ...errors import EvaluationError
 from ...graph import evaluate_float, jet
 from ...symbolic import SymMatrix
 
@@ -45,30 +44,21 @@ class GeneralLinearization:
     def system(self) -> System:
         return self.equations_of_motion.system
 
-    def evaluate(self, y: Any, yd: Any, ydd: Any, t: float = 0.0,
-                 parameters: Mapping[str, float] | None = None,
-                 inputs: Mapping[str, float] | None = None) -> dict[str, np.ndarray]:
-        """Arrays of ``M_tilde, P, Q, h, B`` at one state."""
-        from ...numeric import state_vectors
 
-        system = self.system
-        yv, ydv, tv, pv, uv = state_vectors(system, y, yd, t, parameters, inputs)
-        yddv = np.asarray(ydd, dtype=float).reshape(-1)
-        if yddv.size != system.f or not np.all(np.isfinite(yddv)):
-            raise EvaluationError(f"ydd must be {system.f} finite numbers")
-        values = {"t": tv}
-        for syms, vals in ((system.y, yv), (system.yd, ydv), (system.ydd, yddv),
-                           (system.parameter_symbols, pv), (system.inputs, uv)):
-            values.update({str(s): float(v) for s, v in zip(syms, vals, strict=True)})
-        mats = {"M_tilde": self.M_tilde, "P": self.P, "Q": self.Q, "h": self.h, "B": self.B}
-        flat = [e for m in mats.values() for e in m.entries()]
-        nums = iter(evaluate_float(flat, values))
-        out: dict[str, np.ndarray] = {}
-        for name, m in mats.items():
-            n, c = m.shape
-            out[name] = np.array([next(nums) for _ in range(n * c)]).reshape(n, c)
-        out["h"] = out["h"].reshape(-1)
-        return out
+def evaluate_general_at(glin: GeneralLinearization, values: Mapping[str, float]
+                        ) -> dict[str, np.ndarray]:
+    """Arrays of ``M_tilde, P, Q, h, B`` (h 1-D) at ``values``: the value of every symbol of
+    the system's ``y``, ``yd``, ``ydd``, parameters and inputs, and of ``t``, by name, already
+    checked (``glin.evaluate`` of :mod:`jourdain.numeric.linearization` checks them)."""
+    mats = {"M_tilde": glin.M_tilde, "P": glin.P, "Q": glin.Q, "h": glin.h, "B": glin.B}
+    flat = [e for m in mats.values() for e in m.entries()]
+    nums = iter(evaluate_float(flat, dict(values)))
+    out: dict[str, np.ndarray] = {}
+    for name, m in mats.items():
+        n, c = m.shape
+        out[name] = np.array([next(nums) for _ in range(n * c)]).reshape(n, c)
+    out["h"] = out["h"].reshape(-1)
+    return out
 
 
 def linearization_general(eom: EquationsOfMotion) -> GeneralLinearization:

@@ -1,13 +1,15 @@
 """The symbolic linearization (``docs/method.md`` §5–6): :class:`Linearization` holds M̃, P, Q,
 h, B about a nominal motion and, when time-invariant, splits them into damping ``D``,
-gyroscopic ``G``, stiffness ``K`` and circulatory ``N`` parts; :class:`CompiledLinearization`
-evaluates them in numbers.
+gyroscopic ``G``, stiffness ``K`` and circulatory ``N`` parts.
 
-Floor: stages. :meth:`Linearization.evaluate`, :meth:`Linearization.compile` and
-:meth:`Linearization.check_nominal` give numbers through :mod:`jourdain.numeric` (a floor above),
-imported inside them: the methods are the public way to numbers of a linearization (used across
-the analyses and the tests); moving them above the numeric floor is the remaining step of
-issue 16 here (``tests/test_architecture.py`` lists it as pending).
+Floor: stages. The result is symbolic; :func:`evaluate_at` and :func:`check_nominal_at` walk
+its expressions in floating point (:func:`jourdain.graph.evaluate_float`) at values that are
+already checked. The public way to numbers — ``lin.evaluate(t, parameters)``,
+``lin.compile()``, ``lin.check_nominal(t, parameters)``, which check their arguments and
+compile — is on the numeric floor above: :mod:`jourdain.numeric.linearization` (its
+``Linearization`` subclass, which :func:`jourdain.linearization` and
+``jourdain.System.linearize`` return, and the free functions ``evaluate_linearization``,
+``compile_linearization``, ``check_nominal``).
 """
 
 from __future__ import annotations
@@ -25,7 +27,6 @@ from ...symbolic import SymMatrix
 
 if TYPE_CHECKING:
     from ...model.system import System
-    from ...numeric import CompiledFunction
     from ..projection import EquationsOfMotion
 from .nominal import (
     HALF,
@@ -161,7 +162,7 @@ class Linearization:
         times = (0.0, 0.37, 1.91) if "t" in free_symbol_names(exprs["h"]) else (0.0,)
         for values in trials:
             for t in times:
-                num = self.evaluate(t=t, parameters=values)
+                num = evaluate_at(self, values_at(self, t, np.array(list(values.values()))))
                 scale = max(1.0, np.abs(num["P"]).max(), np.abs(num["Q"]).max(),
                             np.abs(num["M_tilde"]).max())
                 for n in names:
@@ -169,111 +170,14 @@ class Linearization:
                         return False
         return True
 
-    # --- does the nominal motion solve the equations of motion? -------------------------------
-    def check_nominal(self, t: float = 0.0,
-                      parameters: Mapping[str, float] | None = None) -> NominalCheck:
-        """``h`` at time ``t`` against the forces at work at the nominal state
-        (:class:`NominalCheck`; ``check.is_solution``, ``check.message()``)."""
-        from ...numeric import parameter_vector, time_value
-
-        system = self.system
-        f, m = system.f, len(system.inputs)
-        tv = time_value(t)
-        p = parameter_vector(system, parameters)
-        values = {str(s): float(v) for s, v in zip(system.parameter_symbols, p, strict=True)}
-        values["t"] = tv
-        nums = np.array(evaluate_float(
-            [*self.y_s.entries(), *self.yd_s.entries(), *self.ydd_s.entries(),
-             *self.u_s.entries(), *self.h.entries(), *self.B.entries()], values))
-        ys, yds, ydds, us, h = (nums[:f], nums[f:2 * f], nums[2 * f:3 * f],
-                                nums[3 * f:3 * f + m], nums[3 * f + m:4 * f + m])
-        B = nums[4 * f + m:].reshape(f, m)
-        scale = np.zeros(f)
-        if np.any(h != 0):
-            ne = self.equations_of_motion.newton_euler
-            state = dict(values)
-            for syms, vals in ((system.y, ys), (system.yd, yds), (system.inputs, us)):
-                state.update({str(s): float(v) for s, v in zip(syms, vals, strict=True)})
-            # k = J̄ᵀq̄^c and q = J̄ᵀq̄^e add nothing to the bound (Cauchy–Schwarz); M̄ (36p²
-            # entries) only where the nominal motion accelerates
-            mats = (ne.J_bar, ne.q_c, ne.q_e, *((ne.M_bar,) if np.any(ydds != 0) else ()))
-            flat = np.array(evaluate_float([e for mat in mats for e in mat.entries()], state))
-            parts, i = [], 0
-            for mat in mats:
-                r, c = mat.shape
-                parts.append(flat[i:i + r * c].reshape(r, c))
-                i += r * c
-            zero = np.zeros(f)
-            scale = force_scale(parts[0], parts[1][:, 0], parts[2][:, 0], zero, zero,
-                                parts[3] if len(parts) > 3 else None, ydds)
-            if np.any(np.abs(h) > NOMINAL_RTOL * scale):  # forces that cancel within a body?
-                eom = self.equations_of_motion
-                scale = scale + term_scale([*eom.k.entries(), *eom.q.entries()], state, f)
-        return _nominal_check(h, scale, _kind(self.y_s.entries(), self.yd_s.entries(),
-                                              self.ydd_s.entries()),
-                              tv, _describe_nominal(self), system, us, B)
-
-    # --- numbers -----------------------------------------------------------------------------
-    def evaluate(self, t: float = 0.0,
-                 parameters: Mapping[str, float] | None = None) -> dict[str, np.ndarray]:
-        """NumPy arrays of ``M_tilde, P, Q, h, B`` (h 1-D) at time ``t``, and of ``D, G, K, N``
-        for a time-invariant result (for a time-variant one these keys are left out).
-
-        ``parameters`` overrides default parameter values by name. One evaluation walks the
-        expression graph once in floating point (no compilation); for many evaluations use
-        :meth:`compile`.
-        """
-        from ...numeric import parameter_vector, time_value
-
-        tv = time_value(t)
-        p = parameter_vector(self.system, parameters)
-        values = {str(s): float(v) for s, v in zip(self.system.parameter_symbols, p, strict=True)}
-        values["t"] = tv
-        blocks = self._blocks()
-        flat = [e for m in blocks.values() for e in m.entries()]
-        try:
-            nums = evaluate_float(flat, values)
-        except EvaluationError:
-            raise
-        except JourdainError as exc:
-            raise EvaluationError(f"linearization of {self.system.name!r} at t = {tv}: "
-                                  f"{exc}") from None
-        out: dict[str, np.ndarray] = {}
-        i = 0
-        for name, m in blocks.items():
-            n, c = m.shape
-            out[name] = np.asarray(nums[i:i + n * c], dtype=float).reshape(n, c)
-            i += n * c
-        return self._finish(out)
-
-    def compile(self) -> CompiledLinearization:
-        """Machine code for ``M_tilde, P, Q, h, B`` as functions of t and the parameters
-        (:func:`jourdain.numeric.lambdify`), for repeated evaluation (sweeps, time-variant
-        systems)."""
-        from ...numeric import lambdify
-
-        return CompiledLinearization(self, lambdify(self.system, self._blocks()))
-
-    def _blocks(self) -> dict[str, SymMatrix]:
+    # --- numbers at checked values (the pure core; the checks and the public methods are on
+    #     the numeric floor: jourdain.numeric.linearization) --------------------------------
+    def blocks(self) -> dict[str, SymMatrix]:
+        """The matrices that have numbers: ``M_tilde, P, Q, h`` and ``B`` where the system has
+        inputs (the order of :func:`evaluate_at`'s result)."""
         out = {"M_tilde": self.M_tilde, "P": self.P, "Q": self.Q, "h": self.h}
         if self.system.inputs:
             out["B"] = self.B
-        return out
-
-    def _finish(self, out: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
-        bad = [k for k, v in out.items() if not np.all(np.isfinite(v))]
-        if bad:
-            raise EvaluationError(f"the linearization has non-finite entries in {bad} at these "
-                                  "parameter values (a singular position of the nominal motion?)")
-        out["h"] = out["h"].reshape(-1)
-        if "B" not in out:
-            out["B"] = np.zeros((self.f, 0))
-        if self.is_time_invariant:
-            P, Q = out["P"], out["Q"]
-            out["D"] = 0.5 * (P + P.T)
-            out["G"] = 0.5 * (P - P.T)
-            out["K"] = 0.5 * (Q + Q.T)
-            out["N"] = 0.5 * (Q - Q.T)
         return out
 
     def __repr__(self) -> str:
@@ -282,23 +186,99 @@ class Linearization:
                 f"inputs={self.system.input_names}, {kind})")
 
 
-@dataclass(frozen=True)
-class CompiledLinearization:
-    """Compiled ``M_tilde, P, Q, h, B`` of a :class:`Linearization`; call with ``(t,
-    parameters)`` for the same dict as :meth:`Linearization.evaluate`."""
+def values_at(lin: Linearization, t: float, p: np.ndarray) -> dict[str, float]:
+    """The values of the parameters (``p``, in the order of the system's parameters) and of
+    ``t`` by name, as :func:`evaluate_at` and :func:`check_nominal_at` read them."""
+    system = lin.system
+    values = {str(s): float(v) for s, v in zip(system.parameter_symbols, p, strict=True)}
+    values["t"] = float(t)
+    return values
 
-    linearization: Linearization
-    function: CompiledFunction
 
-    def __call__(self, t: float = 0.0,
-                 parameters: Mapping[str, float] | None = None) -> dict[str, np.ndarray]:
-        from ...numeric import parameter_vector, time_value
+def evaluate_at(lin: Linearization, values: Mapping[str, float]) -> dict[str, np.ndarray]:
+    """NumPy arrays of ``M_tilde, P, Q, h, B`` (h 1-D), and of ``D, G, K, N`` for a
+    time-invariant result, at ``values`` (every parameter and ``t`` by name, already checked:
+    :func:`values_at`). One walk over the expression graph in floating point
+    (:func:`jourdain.graph.evaluate_float`); the public form that checks its arguments is
+    ``lin.evaluate(t, parameters)`` (:mod:`jourdain.numeric.linearization`)."""
+    blocks = lin.blocks()
+    flat = [e for m in blocks.values() for e in m.entries()]
+    try:
+        nums = evaluate_float(flat, dict(values))
+    except EvaluationError:
+        raise
+    except JourdainError as exc:
+        raise EvaluationError(f"linearization of {lin.system.name!r} at t = {values['t']}: "
+                              f"{exc}") from None
+    out: dict[str, np.ndarray] = {}
+    i = 0
+    for name, m in blocks.items():
+        n, c = m.shape
+        out[name] = np.asarray(nums[i:i + n * c], dtype=float).reshape(n, c)
+        i += n * c
+    return finish(lin, out)
 
-        system = self.linearization.system
-        p = parameter_vector(system, parameters)
-        f = system.f
-        out = self.function(np.zeros(f), np.zeros(f), time_value(t), p, np.zeros(len(system.inputs)))
-        return self.linearization._finish(dict(out))
+
+def finish(lin: Linearization, out: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """The arrays of :meth:`Linearization.blocks` (by name, 2-D) completed: finite (else an
+    :class:`EvaluationError`), ``h`` 1-D, ``B`` (f×0 without inputs) and, for a
+    time-invariant result, the split ``D, G, K, N`` of §6."""
+    bad = [k for k, v in out.items() if not np.all(np.isfinite(v))]
+    if bad:
+        raise EvaluationError(f"the linearization has non-finite entries in {bad} at these "
+                              "parameter values (a singular position of the nominal motion?)")
+    out["h"] = out["h"].reshape(-1)
+    if "B" not in out:
+        out["B"] = np.zeros((lin.f, 0))
+    if lin.is_time_invariant:
+        P, Q = out["P"], out["Q"]
+        out["D"] = 0.5 * (P + P.T)
+        out["G"] = 0.5 * (P - P.T)
+        out["K"] = 0.5 * (Q + Q.T)
+        out["N"] = 0.5 * (Q - Q.T)
+    return out
+
+
+def check_nominal_at(lin: Linearization, values: Mapping[str, float]) -> NominalCheck:
+    """``h`` at ``values`` (every parameter and ``t`` by name, already checked:
+    :func:`values_at`) against the forces at work at the nominal state
+    (:class:`NominalCheck`); the public form is ``lin.check_nominal(t, parameters)``
+    (:mod:`jourdain.numeric.linearization`)."""
+    system = lin.system
+    f, m = system.f, len(system.inputs)
+    values = dict(values)
+    tv = values["t"]
+    nums = np.array(evaluate_float(
+        [*lin.y_s.entries(), *lin.yd_s.entries(), *lin.ydd_s.entries(),
+         *lin.u_s.entries(), *lin.h.entries(), *lin.B.entries()], values))
+    ys, yds, ydds, us, h = (nums[:f], nums[f:2 * f], nums[2 * f:3 * f],
+                            nums[3 * f:3 * f + m], nums[3 * f + m:4 * f + m])
+    B = nums[4 * f + m:].reshape(f, m)
+    scale = np.zeros(f)
+    if np.any(h != 0):
+        ne = lin.equations_of_motion.newton_euler
+        state = dict(values)
+        for syms, vals in ((system.y, ys), (system.yd, yds), (system.inputs, us)):
+            state.update({str(s): float(v) for s, v in zip(syms, vals, strict=True)})
+        # k = J̄ᵀq̄^c and q = J̄ᵀq̄^e add nothing to the bound (Cauchy–Schwarz); M̄ (36p²
+        # entries) only where the nominal motion accelerates
+        mats = (ne.J_bar, ne.q_c, ne.q_e, *((ne.M_bar,) if np.any(ydds != 0) else ()))
+        flat = np.array(evaluate_float([e for mat in mats for e in mat.entries()], state))
+        parts, i = [], 0
+        for mat in mats:
+            r, c = mat.shape
+            parts.append(flat[i:i + r * c].reshape(r, c))
+            i += r * c
+        zero = np.zeros(f)
+        scale = force_scale(parts[0], parts[1][:, 0], parts[2][:, 0], zero, zero,
+                            parts[3] if len(parts) > 3 else None, ydds)
+        if np.any(np.abs(h) > NOMINAL_RTOL * scale):  # forces that cancel within a body?
+            eom = lin.equations_of_motion
+            scale = scale + term_scale([*eom.k.entries(), *eom.q.entries()], state, f)
+    return _nominal_check(h, scale, _kind(lin.y_s.entries(), lin.yd_s.entries(),
+                                          lin.ydd_s.entries()),
+                          tv, _describe_nominal(lin), system, us, B)
+
 
 def _sym_part(A: SymMatrix, sign: int) -> SymMatrix:
     n = A.shape[0]
