@@ -114,12 +114,13 @@ def linearization_section(run: Run) -> str:
 def floquet_html(fl: Any, name: str, figures: Figures | None = None) -> str:
     """The Floquet analysis of a periodic nominal motion: multipliers, exponents, the
     plot against the unit circle (drawn by ``figures``, else here) and the verdict."""
-    figures = figures or Figures()
+    own = figures is None  # a page of its own: the plot put in place here
+    figures = Figures() if figures is None else figures
     rows = [(numstr(mu.real), numstr(mu.imag), f"{abs(mu):.8f}",
              numstr(lam.real) if np.isfinite(lam.real) else "−∞", numstr(lam.imag))
             for mu, lam in zip(fl.multipliers, fl.exponents, strict=True)]
     cls = "ok" if fl.is_stable else "bad"
-    return (f"<h4>Floquet analysis (periodic nominal motion, T = {numstr(fl.period)} s)</h4>"
+    html = (f"<h4>Floquet analysis (periodic nominal motion, T = {numstr(fl.period)} s)</h4>"
             "<p>Monodromy matrix Φ(t<sub>0</sub> + T, t<sub>0</sub>) of ẋ = A(t)·x over one "
             "period; its eigenvalues are the Floquet multipliers μ, the exponents ln(μ)/T.</p>"
             + html_table(rows, ["Re μ", "Im μ", "|μ|", "Re ln(μ)/T / (1/s)", "Im ln(μ)/T / (rad/s)"])
@@ -127,3 +128,4 @@ def floquet_html(fl: Any, name: str, figures: Figures | None = None) -> str:
             + f"<p>Stability (Floquet): <span class='{cls}'>{esc(fl.verdict)}</span> — "
               f"{esc(fl.reason)}</p>")
 
+    return figures.fill(html) if own else html

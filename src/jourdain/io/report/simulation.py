@@ -134,7 +134,8 @@ def wrench_section(res: Any, out: Path, info: ReportInfo,
                    figures: Figures | None = None) -> str:
     """The magnitudes of each joint's force and torque along the motion (a plot; the vectors
     in the joint and the inertial frame in ``wrench-<joint>.csv``, one table per joint); the plot drawn by ``figures``, else here."""
-    figures = figures or Figures()
+    own = figures is None  # a page of its own: the plot put in place here
+    figures = Figures() if figures is None else figures
     wrenches = res.joint_wrenches
     series: dict[str, np.ndarray] = {}
     files = []
@@ -147,9 +148,10 @@ def wrench_section(res: Any, out: Path, info: ReportInfo,
         info.files.append(fn)
         files.append(fn.name)
     keep = dict(list(series.items())[:12])
-    return (figures.add(time_plot, res.t, keep, reactions_label(res.g_names, res.units),
+    html = (figures.add(time_plot, res.t, keep, reactions_label(res.g_names, res.units),
                        "joint wrenches along the motion (on the child body at the joint point)"
                        + ("" if len(keep) == len(series) else
                           f" (first {len(keep)} of {len(series)})"))
             + "<p class='meta'>Force and torque vectors per joint, in the joint frame and in "
               f"the inertial frame: {esc(', '.join(files))}.</p>")
+    return figures.fill(html) if own else html
