@@ -15,7 +15,7 @@ import hashlib, json, sys
 import numpy as np
 import jourdain as jd
 from jourdain import models
-from jourdain.numeric import argument_names, function_source
+from jourdain.numeric.ccode import argument_names, function_source
 from jourdain.numeric.recursive import recursive_source
 from jourdain.stages.reactions import joint_directions
 

@@ -207,13 +207,13 @@ def test_report_figures_and_json_carry_the_units(tmp_path, monkeypatch):
     from jourdain.io.report import figures  # H8: the plots' SVG writer lives here
 
     labels = []
-    svg = report._svg
+    svg = figures.svg
 
     def recording(fig):  # the labels of every figure the report draws, then the SVG as before
         labels.extend((ax.get_xlabel(), ax.get_ylabel()) for ax in fig.axes)
         return svg(fig)
 
-    monkeypatch.setattr(report, "_svg", recording)
+    monkeypatch.setattr(figures, "svg", recording)
     path = tmp_path / "cart.toml"
     path.write_text(CART_MODEL)
     model = load_model(path)
