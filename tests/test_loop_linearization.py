@@ -12,7 +12,7 @@ import pytest
 
 from jourdain.io.modelfile import load_model
 from jourdain.loops.linearization import equilibrium, linearize_loop, linearize_loop_exact
-from tests.test_loops import FB, _four_bar_closed_form
+from tests.test_loops import four_bar_at_rest
 from tests.tolerance import EPS
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -22,31 +22,16 @@ def test_exact_linearization_equals_closed_form_four_bar() -> None:
     """examples/four_bar.toml (torsion spring k = 20 on the crank, rest angle 1): M from the
     kinetic energy along the manifold in closed form, K = V''(θ1) of the closed-form
     potential by a five-point difference (error h⁴·V⁽⁶⁾/90 ≈ 1e-12·K at h = 1e-3)."""
+    k_s = 20.0
     mf = load_model(EXAMPLES / "four_bar.toml")
-    k_s, g = 20.0, FB["g"]
-    a, b, c = FB["a"], FB["b"], FB["c"]
-
-    def V(th1: float) -> float:
-        phi2, th3, _, _ = _four_bar_closed_form(th1, 1.0, FB)
-        return (0.5 * k_s * (th1 - 1.0) ** 2 + FB["m1"] * g * a / 2 * math.sin(th1)
-                + FB["m2"] * g * (a * math.sin(th1) + b / 2 * math.sin(phi2))
-                + FB["m3"] * g * c / 2 * math.sin(th3))
-
-    z = equilibrium(mf.loops, [0.5, 0.8, 1.9])
+    ref = four_bar_at_rest(mf.loops, k_s)
+    z, K_ref, M_ref, hh = ref.z, ref.K, ref.M, ref.h
     th = float(z[0])
-    hh = 1e-3
-    K_ref = (-V(th - 2 * hh) + 16 * V(th - hh) - 30 * V(th) + 16 * V(th + hh)
-             - V(th + 2 * hh)) / (12 * hh * hh)
-    phi2, th3, w2, w3 = _four_bar_closed_form(th, 1.0, FB)
-    vc = a * np.array([-math.sin(th), math.cos(th)]) + b / 2 * w2 * np.array(
-        [-math.sin(phi2), math.cos(phi2)])
-    M_ref = (FB["m1"] * a * a / 3 + FB["m2"] * vc @ vc + FB["m2"] * b * b / 12 * w2 ** 2
-             + FB["m3"] * c * c / 3 * w3 ** 2)
     lin = linearize_loop_exact(mf.loops, z)
     assert lin.names == ("theta1",)
     assert abs(lin.M_tilde[0, 0] - M_ref) <= 1e3 * EPS * M_ref
     # the difference quotient's rounding, ε·|V|/h², bounds the reference's error
-    V_scale = max(abs(V(th)), k_s)
+    V_scale = max(abs(ref.V(th)), k_s)
     assert abs(lin.K[0, 0] - K_ref) <= 1e-9 * K_ref + 100 * EPS * V_scale / hh ** 2
     assert np.max(np.abs(lin.P)) == 0.0 and np.max(np.abs(lin.N)) <= 1e3 * EPS * K_ref
     w = math.sqrt(K_ref / M_ref)

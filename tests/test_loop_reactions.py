@@ -12,6 +12,7 @@ from jourdain.loops import evaluate
 from jourdain.loops.models import four_bar
 from jourdain.loops.reactions import closing_reactions
 from jourdain.loops.simulate import simulate_loop
+from tests.test_loops import slider_tree
 from tests.tolerance import solve_tol
 
 FB = {"a": 0.4, "b": 1.0, "c": 0.8, "d": 1.1, "m1": 1.0, "m2": 2.0, "m3": 1.5, "g": 9.81}
@@ -77,21 +78,6 @@ def test_simulation_results_name_the_closing_joint_wrench() -> None:
     assert "closing joint closure: max |F|" in res.summary()
 
 
-def _slider_tree():  # noqa: ANN202
-    from jourdain.model import Body, Gravity, Revolute, System, rod, symbols
-
-    phi, psi, chi = symbols("phi psi chi")
-    r, l, m1, m2, m3, g = symbols("r l m1 m2 m3 g")
-    bodies = [Body("crank", "world", Revolute("main", phi, "z"), mass=m1,
-                   com=(r / 2, 0, 0), inertia=rod(m1, r, "x")),
-              Body("rod", "crank", Revolute("pin", psi, "z", position=(r, 0, 0)), mass=m2,
-                   com=(l / 2, 0, 0), inertia=rod(m2, l, "x")),
-              Body("slider", "rod", Revolute("wrist", chi, "z", position=(l, 0, 0)),
-                   mass=m3, inertia=(0.01, 0.01, 0.01))]
-    return System([phi, psi, chi], bodies, [Gravity((0, -g, 0))],
-                  parameters={"r": 0.3, "l": 1.0, "m1": 1.0, "m2": 1.5, "m3": 2.0, "g": 9.81})
-
-
 def _loops() -> dict:
     from pathlib import Path
 
@@ -100,7 +86,7 @@ def _loops() -> dict:
 
     ex = Path(__file__).resolve().parents[1] / "examples" / "spatial_rssr.toml"
     mf = loads_model(ex.read_text(), "spatial_rssr.toml")
-    tree = _slider_tree()
+    tree = slider_tree()
     return {
         "revolute": (four_bar(), [1.1, 0.3, 1.9], [1.5, 0, 0]),
         "spherical": (mf.loops, list(mf.simulation.y0), [1.0, 0.5, 0, 0.3, 0]),

@@ -4,6 +4,8 @@ an independent Lagrange-multiplier formulation, energy, singular positions, mode
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -53,6 +55,65 @@ def _four_bar_closed_form(th1: float, th1_d: float, p: dict) -> tuple[float, flo
     w3 = a * th1_d * math.sin(th1 - phi2) / (c * math.sin(th3 - phi2))
     return phi2, th3, w2, w3
 
+
+
+def slider_tree():  # noqa: ANN201
+    """The slider-crank's open tree: crank, rod and slider hinged in a row (the slider not yet
+    guided), with gravity along −y."""
+    from jourdain.model import Body, Gravity, Revolute, System, rod, symbols
+
+    phi, psi, chi = symbols("phi psi chi")
+    r, l, m1, m2, m3, g = symbols("r l m1 m2 m3 g")
+    bodies = [Body("crank", "world", Revolute("main", phi, "z"), mass=m1,
+                   com=(r / 2, 0, 0), inertia=rod(m1, r, "x")),
+              Body("rod", "crank", Revolute("pin", psi, "z", position=(r, 0, 0)), mass=m2,
+                   com=(l / 2, 0, 0), inertia=rod(m2, l, "x")),
+              Body("slider", "rod", Revolute("wrist", chi, "z", position=(l, 0, 0)),
+                   mass=m3, inertia=(0.01, 0.01, 0.01))]
+    return System([phi, psi, chi], bodies, [Gravity((0, -g, 0))],
+                  parameters={"r": 0.3, "l": 1.0, "m1": 1.0, "m2": 1.5, "m3": 2.0, "g": 9.81})
+
+
+@dataclass(frozen=True)
+class FourBarAtRest:
+    """Closed-form references at the equilibrium of examples/four_bar.toml: z, the potential
+    V(θ1) along the manifold, its slope dV and curvature K by five-point differences of step
+    h, and the reduced mass M from the kinetic energy along the manifold."""
+
+    z: np.ndarray
+    V: Callable[[float], float]
+    h: float
+    dV: float
+    K: float
+    M: float
+
+
+def four_bar_at_rest(loop: ClosedLoopSystem, k_s: float = 20.0) -> FourBarAtRest:
+    """The four-bar of examples/four_bar.toml (torsion spring k_s on the crank, rest angle 1)
+    at its equilibrium near θ1 = 0.5."""
+    from jourdain.loops.linearization import equilibrium
+
+    g = FB["g"]
+    a, b, c = FB["a"], FB["b"], FB["c"]
+
+    def V(th1: float) -> float:
+        phi2, th3, _, _ = _four_bar_closed_form(th1, 1.0, FB)
+        return (0.5 * k_s * (th1 - 1.0) ** 2 + FB["m1"] * g * a / 2 * math.sin(th1)
+                + FB["m2"] * g * (a * math.sin(th1) + b / 2 * math.sin(phi2))
+                + FB["m3"] * g * c / 2 * math.sin(th3))
+
+    z = equilibrium(loop, [0.5, 0.8, 1.9])
+    th = float(z[0])
+    hh = 1e-3
+    dV = (V(th - 2 * hh) - 8 * V(th - hh) + 8 * V(th + hh) - V(th + 2 * hh)) / (12 * hh)
+    K = (-V(th - 2 * hh) + 16 * V(th - hh) - 30 * V(th) + 16 * V(th + hh)
+         - V(th + 2 * hh)) / (12 * hh * hh)
+    phi2, th3, w2, w3 = _four_bar_closed_form(th, 1.0, FB)
+    vc = a * np.array([-math.sin(th), math.cos(th)]) + b / 2 * w2 * np.array(
+        [-math.sin(phi2), math.cos(phi2)])
+    M = (FB["m1"] * a * a / 3 + FB["m2"] * vc @ vc + FB["m2"] * b * b / 12 * w2 ** 2
+         + FB["m3"] * c * c / 3 * w3 ** 2)
+    return FourBarAtRest(np.asarray(z), V, hh, dV, K, M)
 
 def test_four_bar_kinematics_closed_form() -> None:
     loop = four_bar()
@@ -354,30 +415,12 @@ def test_linearization_about_equilibrium_equals_closed_form_four_bar() -> None:
     mass T = ½·M·θ̇1², both in closed form from the circle intersection; the eigenvalues are
     ±i·√(K/M). Finite differences on both sides: fixed relative tolerances."""
     from jourdain.io.modelfile import load_model
-    from jourdain.loops.linearization import equilibrium, linearize_loop
+    from jourdain.loops.linearization import linearize_loop
 
     mf = load_model(EXAMPLES / "four_bar.toml")
-    k_s, g = 20.0, FB["g"]
-    a, b, c = FB["a"], FB["b"], FB["c"]
-
-    def V(th1: float) -> float:
-        phi2, th3, _, _ = _four_bar_closed_form(th1, 1.0, FB)
-        return (0.5 * k_s * (th1 - 1.0) ** 2 + FB["m1"] * g * a / 2 * math.sin(th1)
-                + FB["m2"] * g * (a * math.sin(th1) + b / 2 * math.sin(phi2))
-                + FB["m3"] * g * c / 2 * math.sin(th3))
-
-    z = equilibrium(mf.loops, [0.5, 0.8, 1.9])
-    th = float(z[0])
-    hh = 1e-3
-    dV = (V(th - 2 * hh) - 8 * V(th - hh) + 8 * V(th + hh) - V(th + 2 * hh)) / (12 * hh)
-    K_ref = (-V(th - 2 * hh) + 16 * V(th - hh) - 30 * V(th) + 16 * V(th + hh)
-             - V(th + 2 * hh)) / (12 * hh * hh)
-    assert abs(dV) <= 1e-9 * K_ref
-    phi2, th3, w2, w3 = _four_bar_closed_form(th, 1.0, FB)
-    vc = a * np.array([-math.sin(th), math.cos(th)]) + b / 2 * w2 * np.array(
-        [-math.sin(phi2), math.cos(phi2)])
-    M_ref = (FB["m1"] * a * a / 3 + FB["m2"] * vc @ vc + FB["m2"] * b * b / 12 * w2 ** 2
-             + FB["m3"] * c * c / 3 * w3 ** 2)
+    ref = four_bar_at_rest(mf.loops)
+    z, K_ref, M_ref = ref.z, ref.K, ref.M
+    assert abs(ref.dV) <= 1e-9 * K_ref
     lin = linearize_loop(mf.loops, z)
     assert lin.names == ("theta1",)
     assert abs(lin.M_tilde[0, 0] - M_ref) <= 1e-12 * M_ref * 10
@@ -440,7 +483,7 @@ def test_general_constraint_and_prismatic_closing_joint_give_the_same_motion() -
     has the M, k, q of the revolute closing joint; the slider-crank with the slider hanging
     from the rod and a prismatic closing joint to the ground has the slider's closed-form
     position."""
-    from jourdain.model import Body, Gravity, Revolute, System, rod, symbols
+    from jourdain.model import symbols
 
     fb = four_bar()
     th1, th2, th3, a, b, c, d = symbols("theta1 theta2 theta3 a b c d")
@@ -457,16 +500,7 @@ def test_general_constraint_and_prismatic_closing_joint_give_the_same_motion() -
     assert np.max(np.abs(s1["lambda"] - s2["lambda"])) <= tol * 10 * (
         1 + float(np.max(np.abs(s1["lambda"]))))
 
-    phi, psi, chi = symbols("phi psi chi")
-    r, l, m1, m2, m3, g = symbols("r l m1 m2 m3 g")
-    bodies = [Body("crank", "world", Revolute("main", phi, "z"), mass=m1,
-                   com=(r / 2, 0, 0), inertia=rod(m1, r, "x")),
-              Body("rod", "crank", Revolute("pin", psi, "z", position=(r, 0, 0)), mass=m2,
-                   com=(l / 2, 0, 0), inertia=rod(m2, l, "x")),
-              Body("slider", "rod", Revolute("wrist", chi, "z", position=(l, 0, 0)),
-                   mass=m3, inertia=(0.01, 0.01, 0.01))]
-    tree = System([phi, psi, chi], bodies, [Gravity((0, -g, 0))],
-                  parameters={"r": 0.3, "l": 1.0, "m1": 1.0, "m2": 1.5, "m3": 2.0, "g": 9.81})
+    tree = slider_tree()
     guide = ClosingJoint("guide", "prismatic", "world", "slider", axis="x")
     loop = ClosedLoopSystem(tree, [guide], ("phi",))
     assert [row for row in loop.constraints().labels] == ["guide.N2", "guide.Mz"]

@@ -51,17 +51,8 @@ from .system import (
 
 class ClosedLoopSystem(LoopModel):
     """A tree :class:`~jourdain.System` (coordinates z) closed by closing joints, with its
-    stages as methods (:class:`~jourdain.loops.system.LoopModel` holds the data).
-
-    Parameters
-    ----------
-    tree : System
-        The spanning tree; its coordinates are the redundant coordinates z.
-    closing : sequence of ClosingJoint
-    independent : sequence of coordinate names, optional
-        The independent coordinates y (else chosen by pivoting at the initial configuration).
-    name : str, optional
-    """
+    stages as methods; the parameters (tree, closing, independent, name) are those of
+    :class:`~jourdain.loops.system.LoopModel`, which holds the data."""
 
     def constraints(self) -> Constraints:
         return constraints(self)
