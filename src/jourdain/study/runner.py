@@ -180,13 +180,7 @@ def _run_local(spec: StudySpec, todo: list[tuple[int, int]], workers: int,
     method = "fork" if "fork" in mp.get_all_start_methods() else "spawn"
     with cf.ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context(method),
                                 initializer=_init_worker) as pool:
-        futures = [pool.submit(compute_block, spec, s, e, keys) for s, e in todo]
-        try:
-            for fut in cf.as_completed(futures):
-                yield _result(fut, spec)
-        finally:
-            for fut in futures:
-                fut.cancel()
+        yield from _stream(pool, spec, todo, keys)
 
 
 def _run_threads(spec: StudySpec, todo: list[tuple[int, int]], workers: int,
@@ -196,13 +190,22 @@ def _run_threads(spec: StudySpec, todo: list[tuple[int, int]], workers: int,
     import concurrent.futures as cf
 
     with cf.ThreadPoolExecutor(max_workers=workers) as pool:
-        futures = [pool.submit(compute_block, spec, s, e, keys) for s, e in todo]
-        try:
-            for fut in cf.as_completed(futures):
-                yield _result(fut, spec)
-        finally:
-            for fut in futures:
-                fut.cancel()
+        yield from _stream(pool, spec, todo, keys)
+
+
+def _stream(pool: Any, spec: StudySpec, todo: list[tuple[int, int]],
+            keys: dict[str, str]) -> Iterator[dict[str, Any]]:
+    """The blocks submitted to a local pool (processes or threads), yielded as they finish;
+    the ones not started are cancelled when the caller stops early (an error, Ctrl-C)."""
+    import concurrent.futures as cf
+
+    futures = [pool.submit(compute_block, spec, s, e, keys) for s, e in todo]
+    try:
+        for fut in cf.as_completed(futures):
+            yield _result(fut, spec)
+    finally:
+        for fut in futures:
+            fut.cancel()
 
 
 #: how local workers run: ``auto`` picks threads where the work releases the GIL
