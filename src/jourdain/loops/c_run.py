@@ -9,14 +9,9 @@ import ctypes
 
 import numpy as np
 
+from ..simulation.options import C_METHODS  # the C integrator's methods (jd_problem.method)
+from ..simulation.problem import address
 from ..simulation.simulate import _Problem, integrator_library
-
-#: the C integrator's methods (``jd_problem.method``)
-C_METHODS = {"RK45": 0, "DOP853": 1, "Radau": 2}
-
-
-def _ptr(a: np.ndarray | None) -> int | None:
-    return None if a is None else int(a.__array_interface__["data"][0])
 
 
 class Segment:
@@ -37,9 +32,9 @@ class Segment:
         # by field name: the integrator's problem struct (simulation.simulate) may grow
         self.problem = _Problem(
             f=f, nu=nu, nev=0, mkq=mkq, uexpr=None, events=None, ucb=None,
-            p=p, u_const=_ptr(self.u_const), u_kind=_ptr(self.u_kind),
-            tab_off=_ptr(self.tab_off), tab_t=None, tab_v=None, ev_dir=None, ev_term=None,
-            method=method, rtol=float(rtol), atol=_ptr(self.atol),
+            p=p, u_const=address(self.u_const), u_kind=address(self.u_kind),
+            tab_off=address(self.tab_off), tab_t=None, tab_v=None, ev_dir=None, ev_term=None,
+            method=method, rtol=float(rtol), atol=address(self.atol),
             h_max=float(max_step), h_first=0.0, accel=accel)
         self.st = np.array([t, 0.0, 0.0, 0.0])
         self.x = x.copy()
@@ -61,11 +56,11 @@ class Segment:
         lib = integrator_library()
         while True:
             code = int(lib.jd_integrate(
-                ctypes.byref(self.problem), t1, _ptr(self.st), _ptr(self.x), _ptr(self.k0),
-                _ptr(self.g_old), _ptr(self.cnt), _ptr(self.te), self.te.size,
-                _ptr(self.i_eval), _ptr(self.out_t), _ptr(self.out_x), _ptr(self.out_dx),
-                self.out_t.size, _ptr(self.n_out), _ptr(self.ev_t), _ptr(self.ev_x),
-                _ptr(self.ev_i), 1, _ptr(self.n_ev), 1 << 20, _ptr(self.fail)))
+                ctypes.byref(self.problem), t1, address(self.st), address(self.x), address(self.k0),
+                address(self.g_old), address(self.cnt), address(self.te), self.te.size,
+                address(self.i_eval), address(self.out_t), address(self.out_x), address(self.out_dx),
+                self.out_t.size, address(self.n_out), address(self.ev_t), address(self.ev_x),
+                address(self.ev_i), 1, address(self.n_ev), 1 << 20, address(self.fail)))
             if code != 1:  # JD_CONTINUE: the step budget of one call used
                 return code
 

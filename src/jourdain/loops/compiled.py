@@ -27,6 +27,7 @@ from ..errors import EvaluationError
 from ..numeric import CompiledFunction, lambdify, mkq_function
 from ..numeric.ccode import HEADER, argument_names, function_source
 from ..numeric.toolchain import build, content_key
+from ..simulation.problem import address
 from ..symbolic import SymMatrix
 from .closed_loop import ClosedLoopSystem, LoopEvaluator, Partition, constraints
 
@@ -49,9 +50,6 @@ class _Loop(ctypes.Structure):
                 ("max_newton", ctypes.c_long), ("uexpr", ctypes.c_void_p),
                 ("u_buf", ctypes.c_void_p)]
 
-
-def _ptr(a: np.ndarray) -> int:
-    return int(a.__array_interface__["data"][0])
 
 
 @lru_cache(maxsize=16)
@@ -126,11 +124,11 @@ class LoopKernel:
         self.piv = np.zeros(max(r, 1), dtype=np.int_)
         self.info[:] = 0.0
         s = self.struct
-        s.tree, s.p = self.tree.address, _ptr(self.ev.p)
+        s.tree, s.p = self.tree.address, address(self.ev.p)
         s.n, s.m, s.f, s.r = n, m, f, r
-        s.ind, s.dep, s.rows = _ptr(self.ind), _ptr(self.dep), _ptr(self.rows)
-        s.z, s.y_last, s.work = _ptr(self.z), _ptr(self.y_last), _ptr(self.work)
-        s.piv, s.info = _ptr(self.piv), _ptr(self.info)
+        s.ind, s.dep, s.rows = address(self.ind), address(self.dep), address(self.rows)
+        s.z, s.y_last, s.work = address(self.z), address(self.y_last), address(self.work)
+        s.piv, s.info = address(self.piv), address(self.info)
         s.newton_tol, s.cond_limit, s.max_newton = self.ev.newton_tol, self.cond_limit, \
             self.ev.max_newton
 
@@ -140,7 +138,7 @@ class LoopKernel:
         self.inputs_fn = fn
         self.u_buf = np.zeros(max(len(self.ev.loop.tree.inputs), 1))
         self.struct.uexpr = None if fn is None else fn.address
-        self.struct.u_buf = _ptr(self.u_buf)
+        self.struct.u_buf = address(self.u_buf)
 
     def restart(self, z: np.ndarray, y: np.ndarray) -> None:
         """Start the next solve from the configuration ``z`` with independent coordinates
@@ -183,9 +181,9 @@ class LoopKernel:
         w = 3 * n + 3 * m + 1
         out = np.full((N, w), np.nan)
         uu = self.ev.u if u is None else np.ascontiguousarray(u, dtype=float)
-        bad = int(self.lib.jd_loop_samples(self.state_address, N, _ptr(t), _ptr(x),
-                                           x.shape[1] if x.ndim == 2 else 0, _ptr(uu),
-                                           _ptr(out)))
+        bad = int(self.lib.jd_loop_samples(self.state_address, N, address(t), address(x),
+                                           x.shape[1] if x.ndim == 2 else 0, address(uu),
+                                           address(out)))
         if bad >= 0:
             out[bad:] = np.nan
         cols = {"z": (0, n), "zd": (n, 2 * n), "zdd": (2 * n, 3 * n),

@@ -17,6 +17,7 @@ import numpy as np
 
 from ..errors import EvaluationError
 from ..numeric import mkq_function
+from ..simulation.problem import address
 from ..simulation.simulate import check_t_span
 from .c_run import C_METHODS, FAILED, Segment
 from .closed_loop import ClosedLoopSystem, LoopEvaluator
@@ -152,9 +153,9 @@ def _penalty_c(ev: LoopEvaluator, t0: float, t1: float, x0: np.ndarray, tev: np.
     lib.jd_penalty_work.argtypes = [ctypes.c_long, ctypes.c_long]
     work = np.zeros(int(lib.jd_penalty_work(n, m)))
     lam = np.zeros(max(m, 1))
-    st = _Penalty(tree.address, ev.p.__array_interface__["data"][0], n, m, int(iterations),
-                  float(alpha), float(xi), float(omega), work.__array_interface__["data"][0],
-                  lam.__array_interface__["data"][0])
+    st = _Penalty(tree.address, address(ev.p), n, m, int(iterations),
+                  float(alpha), float(xi), float(omega), address(work),
+                  address(lam))
     accel = int(ctypes.cast(lib.jd_penalty_accel, ctypes.c_void_p).value or 0)
     seg = Segment(n, ev.u, tree.address, ctypes.addressof(st), accel, t0,
                   np.concatenate([x0, [0.0]]), tev, C_METHODS["DOP853"], rtol, atol, math.inf)

@@ -30,8 +30,8 @@ from .problem import (
     _ESINGULAR,
     _ESTEP,
     _EVENT,
-    _ptr,
     _Setup,
+    address,
     integrator_library,
 )
 from .results import append_incremental, open_incremental
@@ -92,19 +92,20 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
     ints = np.zeros(8 + ev_cap, dtype=np.int_)
     # cnt (5), i_eval, n_out, n_ev, ev_i (ev_cap)
     cnt, n_out, n_ev, ev_i = ints[0:5], ints[6:7], ints[7:8], ints[8:]
-    a_dbl, a_int, di = _ptr(dbl) or 0, _ptr(ints) or 0, ints.itemsize
+    a_dbl, a_int, di = address(dbl) or 0, address(ints) or 0, ints.itemsize
     p_st, p_x, p_k0, p_fail, p_g = (a_dbl + 8 * o for o in (0, 4, 4 + n, 4 + 2 * n, 5 + 3 * n))
     p_cnt, p_ieval, p_nout, p_nev, p_evi = (a_int + di * o for o in (0, 5, 6, 7, 8))
     ev_t = np.empty(ev_cap)
     ev_x = np.empty((ev_cap, n))
-    p_evt, p_evx = _ptr(ev_t), _ptr(ev_x)
+    p_evt, p_evx = address(ev_t), address(ev_x)
     if te is not None:
         cap = te.size
         out = np.empty(cap * (1 + 2 * n))
         out_t, out_x = out[:cap], out[cap:cap * (1 + n)].reshape(cap, n)
         out_dx = out[cap * (1 + n):].reshape(cap, n)
-        a_out = _ptr(out) or 0
-        p_te, n_te = _ptr(te), te.size
+        a_out = address(out) or 0
+        p_te: int | None = address(te)
+        n_te = te.size
     chunks_t: list[np.ndarray] = []
     chunks_x: list[np.ndarray] = []
     chunks_dx: list[np.ndarray] = []
@@ -160,7 +161,7 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
                 out = np.empty(cap * (1 + 2 * n))
                 out_t, out_x = out[:cap], out[cap:cap * (1 + n)].reshape(cap, n)
                 out_dx = out[cap * (1 + n):].reshape(cap, n)
-                a_out = _ptr(out) or 0
+                a_out = address(out) or 0
                 n_out[0] = 0
             id_chunk += 1
             code = lib.jd_integrate(

@@ -37,6 +37,7 @@ import numpy as np
 
 from ..numeric import mkq_function
 from ..numeric.toolchain import build, content_key
+from ..simulation.problem import address
 from ..simulation.simulate import (
     C_METHODS,
     _Problem,
@@ -205,8 +206,8 @@ class Ensemble:
         def work(k: int, lo: int, hi: int) -> None:
             status[k] = self._lib.jd_ensemble(
                 self._integrate, self._template, len(self._template), _Problem.p.offset,
-                _addr(P), P.shape[1], _addr(X0), n, self.t0, self.t1, _addr(te), ns, max_steps,
-                _addr(out_x), _addr(out_dx), _addr(code), _addr(cnt), _addr(fail), lo, hi)
+                address(P), P.shape[1], address(X0), n, self.t0, self.t1, address(te), ns, max_steps,
+                address(out_x), address(out_dx), address(code), address(cnt), address(fail), lo, hi)
 
         cuts = np.linspace(0, m, max(1, min(threads, m)) + 1).round().astype(int)
         slices = [(k, int(a), int(b)) for k, (a, b) in enumerate(zip(cuts[:-1], cuts[1:],
@@ -227,5 +228,3 @@ class Ensemble:
                            code=code, nfev=cnt[:, 0].copy(), nsteps=cnt[:, 1].copy())
 
 
-def _addr(a: np.ndarray | None) -> int | None:
-    return None if a is None else int(a.__array_interface__["data"][0])
