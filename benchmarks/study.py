@@ -103,7 +103,7 @@ def _timed(fn):
     return time.perf_counter() - t0, out
 
 
-def stability_map(n: int, loop_cases: int) -> dict:
+def stability_map(n: int, loop_cases: int, rounds: int = 9) -> dict:
     spec = loads_study(_map_spec(n))
     t_setup, ctx = _timed(lambda: context(spec))
     system, model = ctx.system, ctx.model
@@ -131,10 +131,7 @@ def stability_map(n: int, loop_cases: int) -> dict:
     t_batch, ds = _timed(lambda: run_study(spec, workers=1, quiet=True))
     ours = [VERDICTS[int(v)] for v in ds["verdict"].values.reshape(-1)[pick]]
     agree = sum(a == b for a, b in zip(ours, verdicts_loop, strict=True))
-    t_p1, _ = _timed(lambda: run_study(spec, workers=1, quiet=True))
-    t_p2, ds2 = _timed(lambda: run_study(spec, workers=2, quiet=True))
-    same_p2 = bool(np.array_equal(ds2["max_real_part"].values, ds["max_real_part"].values))
-    dask = _dask(spec, ds)
+    scaling = _scaling(spec, ctx, ds, rounds)
     N = len(cases)
     out = {
         "cases": N, "setup_s": t_setup,
@@ -148,10 +145,106 @@ def stability_map(n: int, loop_cases: int) -> dict:
         "verdicts_agree": f"{agree}/{len(pick)}",
         "compiled_loop_agrees": verdicts_cloop == verdicts_loop,
         "unstable_fraction": float(np.mean(ds["verdict"].values == 2)),
-        "1_process_s": t_p1, "2_processes_s": t_p2, "processes_speedup": t_p1 / t_p2,
-        "2_processes_identical": same_p2, **dask,
+        **scaling,
     }
     return out
+
+
+def _scaling(spec: object, ctx: object, ref: object, rounds: int) -> dict:
+    """1 against 2 workers, in ``rounds`` interleaved rounds (medians): ``run_study`` on 1
+    worker, on 2 (``pool="auto"``: threads, the work releasing the GIL), on 2 fresh processes,
+    and on warm Dask LocalClusters of 1 and 2 worker processes (both clusters up, the runs
+    interleaved); and in the same rounds what this machine gives two threads for the study's
+    own LAPACK work alone (the eigenvalues of the map's state matrices, split in two halves
+    that need no GIL; two thirds of the 1-worker study's time): the ceiling to read the
+    1 → 2 figures against on a shared machine."""
+    from jourdain.study.linear import linearization_numbers, state_matrices
+
+    nums = linearization_numbers(ctx, _parameters(ctx))
+    A, _ = state_matrices(nums["M_tilde"], nums["P"], nums["Q"])
+    halves = (A[0::2], A[1::2])
+
+    def eig(stacks: tuple) -> None:
+        for a in stacks:
+            np.linalg.eigvals(a)
+
+    def eig_two_threads() -> None:
+        import threading
+
+        th = [threading.Thread(target=eig, args=((h,),)) for h in halves]
+        for t in th:
+            t.start()
+        for t in th:
+            t.join()
+
+    local: dict = {
+        "1_worker": lambda: run_study(spec, workers=1, quiet=True),
+        "2_workers": lambda: run_study(spec, workers=2, quiet=True),
+        "lapack_1_thread": lambda: eig(halves),
+        "lapack_2_threads": eig_two_threads,
+    }
+    times: dict = {}
+    identical: dict = {}
+    _rounds(local, rounds, ref, times, identical)
+    # fresh processes apart too (forking a pool every round disturbed the threads' timings)
+    _rounds({"2_processes": lambda: run_study(spec, workers=2, pool="processes", quiet=True)},
+            rounds, ref, times, identical)
+    try:  # the Dask clusters apart: their idle workers' event loops would disturb the rest
+        import distributed
+    except ImportError:
+        distributed = None
+    if distributed is not None:
+        clusters: list = []
+        runs: dict = {}
+        try:
+            for n in (1, 2):
+                cl = distributed.LocalCluster(n_workers=n, threads_per_worker=1,
+                                              processes=True, dashboard_address=None)
+                client = distributed.Client(cl)
+                clusters.append((cl, client))
+                runs[f"dask_{n}"] = lambda client=client: run_study(spec, scheduler=client,
+                                                                    quiet=True)
+            runs["dask_lapack_1_thread"] = local["lapack_1_thread"]
+            runs["dask_lapack_2_threads"] = local["lapack_2_threads"]
+            _rounds(runs, rounds, ref, times, identical)
+        finally:
+            for cl, client in clusters:
+                client.close()
+                cl.close()
+    med = {f"{k}_s": float(np.median(v)) for k, v in times.items()}
+    out = {"rounds": rounds, **med, "identical": identical,
+           "threads_speedup": med["1_worker_s"] / med["2_workers_s"],
+           "processes_speedup": med["1_worker_s"] / med["2_processes_s"],
+           "lapack_ceiling": med["lapack_1_thread_s"] / med["lapack_2_threads_s"]}
+    if "dask_2_s" in med:
+        out["dask_speedup"] = med["dask_1_s"] / med["dask_2_s"]
+        out["dask_lapack_ceiling"] = (med["dask_lapack_1_thread_s"]
+                                      / med["dask_lapack_2_threads_s"])
+    return out
+
+
+def _rounds(runs: dict, rounds: int, ref: object, times: dict, identical: dict) -> None:
+    """Every run once (first calls: the workers build the model), then ``rounds`` rounds of
+    each in turn; the times appended to ``times[name]``; whether a study's results equal
+    ``ref`` bit for bit in ``identical[name]``."""
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=1, user_api="blas"):
+        for fn in runs.values():
+            fn()
+        for _ in range(rounds):
+            for k, fn in runs.items():
+                t, res = _timed(fn)
+                times.setdefault(k, []).append(t)
+                if hasattr(res, "data_vars"):
+                    identical[k] = bool(np.array_equal(res["max_real_part"].values,
+                                                       ref["max_real_part"].values))
+
+
+def _parameters(ctx: object) -> np.ndarray:
+    from jourdain.study.compute import case_arrays
+
+    return case_arrays(ctx, 0, len(ctx.cases))[0]
 
 
 def _dask(spec: object, ref: object, var: str = "max_real_part") -> dict:
@@ -284,17 +377,19 @@ def main() -> None:
     ap.add_argument("--mc", type=int, default=1000, help="Monte-Carlo runs")
     ap.add_argument("--quick", action="store_true", help="40 × 40 map, 200 runs")
     ap.add_argument("--repeat", type=int, default=3, help="Monte-Carlo timings: best of N")
+    ap.add_argument("--rounds", type=int, default=9,
+                    help="stability map, 1 -> 2 workers: interleaved rounds (medians)")
     ap.add_argument("--only", choices=("map", "mc"), help="run one of the two parts")
     ap.add_argument("--json", metavar="FILE", help="also write the figures as JSON")
     args = ap.parse_args()
     if args.quick:
-        args.n, args.loop_cases, args.mc = 40, 100, 200
+        args.n, args.loop_cases, args.mc, args.rounds = 40, 100, 200, 3
     with tempfile.TemporaryDirectory() as tmp:
         os.chdir(tmp)
         res = {"cpus": os.cpu_count(), "load_before": os.getloadavg(),
                "ceiling_before": machine_ceiling()}
         if args.only != "mc":
-            res["stability_map"] = stability_map(args.n, args.loop_cases)
+            res["stability_map"] = stability_map(args.n, args.loop_cases, args.rounds)
         if args.only != "map":
             res["monte_carlo"] = monte_carlo(args.mc, args.repeat)
         res.update(ceiling_after=machine_ceiling(), load_after=os.getloadavg())
@@ -317,15 +412,20 @@ def _print_map(m: dict) -> None:
     print(f"  batched (run_study, 1 process):    {m['batched_cases_per_s']:10.0f} cases/s  "
           f"{m['speedup_vs_loop']:.0f}x the loop, {m['speedup_vs_compiled_loop']:.0f}x the "
           f"compiled loop; verdicts agree {m['verdicts_agree']}")
-    print(f"  run_study 1 process {m['1_process_s']:.2f} s, 2 processes "
-          f"{m['2_processes_s']:.2f} s: {m['processes_speedup']:.2f}x "
-          f"(identical: {m['2_processes_identical']})")
+    print(f"  1 -> 2 workers, medians of {m['rounds']} interleaved rounds (identical to the serial "
+          f"run: {all(m['identical'].values())}):")
+    print(f"    run_study, 1 worker {m['1_worker_s']:.3f} s; 2 workers (threads) "
+          f"{m['2_workers_s']:.3f} s: {m['threads_speedup']:.2f}x; 2 fresh processes "
+          f"{m['2_processes_s']:.3f} s: {m['processes_speedup']:.2f}x")
+    if "dask_2_s" in m:
+        print(f"    Dask LocalCluster (warm): 1 worker {m['dask_1_s']:.3f} s, 2 workers "
+              f"{m['dask_2_s']:.3f} s: {m['dask_speedup']:.2f}x (ceiling in those rounds: "
+              f"{m['dask_lapack_ceiling']:.2f}x)")
+    print(f"    ceiling now: the map's eigenvalues alone (LAPACK, no GIL), 1 thread "
+          f"{m['lapack_1_thread_s']:.3f} s, 2 threads {m['lapack_2_threads_s']:.3f} s: "
+          f"{m['lapack_ceiling']:.2f}x")
     print(f"  loop calling System.linearize per case: {m['relinearize_loop_cases_per_s']:.1f} "
           f"cases/s (batched: {m['speedup_vs_relinearize_loop']:.0f}x)")
-    if "dask_2_workers_s" in m:
-        print(f"  Dask LocalCluster (warm): 1 worker {m['dask_1_workers_s']:.3f} s, 2 workers "
-              f"{m['dask_2_workers_s']:.3f} s: {m['dask_speedup']:.2f}x (identical: "
-              f"{m['dask_1_identical']}, {m['dask_2_identical']})")
 
 
 def _print_mc(c: dict) -> None:

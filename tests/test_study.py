@@ -266,7 +266,8 @@ def test_local_processes_and_dask_cluster_equal_the_serial_run() -> None:
     distributed = pytest.importorskip("distributed")
     spec = load_study(DATA / "map.toml")
     serial = run_study(spec, workers=1)
-    _same(run_study(spec, workers=2), serial)
+    _same(run_study(spec, workers=2, pool="processes"), serial)
+    _same(run_study(spec, workers=2, pool="threads"), serial)
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                   dashboard_address=None) as cluster, \
             distributed.Client(cluster) as client:
@@ -278,6 +279,34 @@ def test_local_processes_and_dask_cluster_equal_the_serial_run() -> None:
     _same(on_cluster, serial)
     _same(again, serial)
     _same(by_address, serial)
+
+
+def test_auto_pool_uses_threads_unless_cases_simulate_one_by_one(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """pool="auto": a linearization study (one C call and stacked LAPACK per block, the GIL
+    released) runs on threads of this process; a study simulating case by case on processes."""
+    import jourdain.study.runner as runner
+
+    used: list[str] = []
+
+    def spy(name: str, real):  # noqa: ANN001, ANN202
+        def run(*args, **kwargs):  # noqa: ANN002, ANN003, ANN202
+            used.append(name)
+            yield from real(*args, **kwargs)
+        return run
+
+    monkeypatch.setattr(runner, "_run_threads", spy("threads", runner._run_threads))
+    monkeypatch.setattr(runner, "_run_local", spy("processes", runner._run_local))
+    spec = load_study(DATA / "map.toml")
+    _same(run_study(spec, workers=2), run_study(spec, workers=1))
+    assert used == ["threads"]
+    text = (DATA / "montecarlo.toml").read_text()
+    assert "ensemble" not in text
+    per_case = loads_study(text.replace("[compute.simulate]",
+                                        "[compute.simulate]\nensemble = false"),
+                           base=DATA)
+    run_study(per_case, workers=2)
+    assert used == ["threads", "processes"]
 
 
 # --- single simulations as labelled arrays, the CLI ----------------------------------------------

@@ -28,8 +28,8 @@ def add_study_parser(subs: Any, parser_class: type) -> Any:
                    help="processes on this machine (default: one per core; 1: no processes)")
     p.add_argument("--pool", choices=("auto", "processes", "threads"), default="auto",
                    help="how the local workers run: processes, threads (for work that "
-                        "releases the GIL: simulations advanced as ensembles), or auto (the "
-                        "default: threads for a study that only simulates, else processes)")
+                        "releases the GIL), or auto (the default: threads, unless the study "
+                        "simulates case by case (ensemble = false, SciPy methods): processes)")
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help="run on this dask.distributed scheduler (tcp://host:8786)")
     p.add_argument("--plots", metavar="DIR",

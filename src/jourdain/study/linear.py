@@ -59,7 +59,8 @@ def analyse(ctx: Context, P: np.ndarray, nums: Mapping[str, np.ndarray] | None =
     A, bad = state_matrices(nums["M_tilde"], nums["P"], nums["Q"])
     for i, msg in bad.items():
         errs[i] = msg
-    good = np.array([i not in bad for i in range(n)])
+    good = np.ones(n, dtype=bool)
+    good[list(bad)] = False
     if not good.any():
         return lam, maxre, verdict, errs
     Ag = A[good]

@@ -189,8 +189,26 @@ def _run_threads(spec: StudySpec, todo: list[tuple[int, int]], workers: int,
     simulations run in C), with no worker start and no model rebuilt."""
     import concurrent.futures as cf
 
-    with cf.ThreadPoolExecutor(max_workers=workers) as pool:
+    with _one_blas_thread(), cf.ThreadPoolExecutor(max_workers=workers) as pool:
         yield from _stream(pool, spec, todo, keys)
+
+
+_BLAS: list[Any] = []  # threadpoolctl's controller, made once (it scans the loaded libraries)
+
+
+def _one_blas_thread() -> Any:
+    """BLAS/LAPACK on one thread while the study's threads run (each of them calls LAPACK for
+    its own block: more threads than cores otherwise); without threadpoolctl (the ``study``
+    extra), as configured."""
+    import contextlib
+
+    try:
+        from threadpoolctl import ThreadpoolController
+    except ImportError:
+        return contextlib.nullcontext()
+    if not _BLAS:
+        _BLAS.append(ThreadpoolController())
+    return _BLAS[0].limit(limits=1, user_api="blas")
 
 
 def _stream(pool: Any, spec: StudySpec, todo: list[tuple[int, int]],
@@ -213,9 +231,23 @@ POOLS = ("auto", "processes", "threads")
 
 
 def _releases_gil(ctx: Any) -> bool:
-    """True when a block's work is C that releases the GIL: only ``simulate``, advanced as an
-    ensemble (the linearizations and evaluations spend much of their time in Python)."""
-    return set(ctx.spec.compute) == {"simulate"} and ctx.ensemble is not None
+    """True when a block's work runs in C and LAPACK with the GIL released: the evaluations
+    and linearizations (one C call for the block, stacked solves and eigenvalues), frequency
+    responses, critical values, and simulations advanced as an ensemble; False for simulations
+    run case by case (``simulate()`` per case spends much of its time in Python)."""
+    return "simulate" not in ctx.spec.compute or ctx.ensemble is not None
+
+
+def _compute_blocks(spec: StudySpec, todo: list[tuple[int, int]], keys: dict[str, str]
+                    ) -> list[dict[str, Any]]:
+    """Several blocks in one task (a cluster's task): computed one after the other."""
+    return [compute_block(spec, s, e, keys) for s, e in todo]
+
+
+#: Dask tasks per worker thread: blocks are grouped into about this many tasks per thread,
+#: so that the scheduler's and the client's work per task (a few ms, on the same cores as
+#: the workers of a LocalCluster) stays small against the task, and the load stays balanced
+TASKS_PER_THREAD = 4
 
 
 def _run_dask(spec: StudySpec, todo: list[tuple[int, int]], scheduler: Any,
@@ -232,13 +264,17 @@ def _run_dask(spec: StudySpec, todo: list[tuple[int, int]], scheduler: Any,
         raise StudyError(f"cannot reach the Dask scheduler at {scheduler!r}: {exc}",
                          spec.filename) from None
     try:
+        threads = sum(w.get("nthreads", 1)
+                      for w in client.scheduler_info()["workers"].values()) or 1
+        size = -(-len(todo) // (TASKS_PER_THREAD * threads))
+        groups = [todo[i:i + size] for i in range(0, len(todo), size)]
         # the spec (a few kB: the study and model texts) travels with each task; a scattered
         # copy, content-keyed, raced with its release when the same study ran again
-        futures = [client.submit(compute_block, spec, s, e, keys, pure=False)
-                   for s, e in todo]
+        futures = [client.submit(_compute_blocks, spec, g, keys, pure=False) for g in groups]
         try:
-            for fut in as_completed(futures):
-                yield _result(fut, spec)
+            # results gathered as they finish, in batches: one round trip for several tasks
+            for fut, res in as_completed(futures, with_results=True, raise_errors=False):
+                yield from (_result(fut, spec) if fut.status == "error" else res)
         finally:
             client.cancel([f for f in futures if not f.done()])
     finally:
@@ -260,10 +296,11 @@ def run_study(spec: StudySpec, out: str | Path | None = None, *, workers: int | 
     workers : workers on this machine (None, the default: one per core; 1: in this
         process; a study of one block always runs in this process)
     pool : how the local workers run: ``"processes"`` (each rebuilds the model),
-        ``"threads"`` (for work that releases the GIL) or ``"auto"`` (the default: threads for
-        a study that only simulates with ensembles, processes otherwise)
+        ``"threads"`` (for work that releases the GIL) or ``"auto"`` (the default: threads,
+        BLAS on one thread each, unless the study simulates case by case: processes)
     scheduler : address of a ``dask.distributed`` scheduler (``"tcp://host:8786"``) or a
-        ``distributed.Client``: the blocks run on that cluster (``workers`` is then ignored)
+        ``distributed.Client``: the blocks run on that cluster (``workers`` is then ignored),
+        grouped into about four tasks per worker thread
     quiet : no progress bar (:class:`Progress`: on stderr, or in the notebook's cell)
     force : start afresh where ``<out>.parts/`` holds another study's parts, and replace an
         existing ``out``
