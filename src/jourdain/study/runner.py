@@ -274,7 +274,9 @@ def _run_dask(spec: StudySpec, todo: list[tuple[int, int]], scheduler: Any,
         try:
             # results gathered as they finish, in batches: one round trip for several tasks
             for fut, res in as_completed(futures, with_results=True, raise_errors=False):
-                yield from (_result(fut, spec) if fut.status == "error" else res)
+                if fut.status == "error":
+                    _result(fut, spec)  # raises the task's error as the study's
+                yield from res
         finally:
             client.cancel([f for f in futures if not f.done()])
     finally:
