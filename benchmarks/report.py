@@ -14,7 +14,8 @@ best is the least disturbed), its exit status, the ratio of the warm time to the
 and the processor time (user + system, the process and its workers) of the warm run, which
 a loaded machine inflates much less than the wall time; then the worst example of each
 state. Before the timings, one untimed run writes the
-bytecode of every module imported (a fresh checkout's first run compiles them). The floor of
+bytecode of every module imported (a fresh checkout's first run compiles them; the runs are
+made without ``PYTHONDONTWRITEBYTECODE``, which some sandboxes set). The floor of
 every run, ``python -c "import jourdain.cli"``, is timed the same way and printed first.
 
 ``--compare``: besides, for each example and the warm cache, the way reports were made before
@@ -66,6 +67,9 @@ def timed(cmd: list[str], cache: Path) -> tuple[float, int, str, float]:
     and system) of it and its children: on a machine shared with other work the wall time
     grows with the load, the processor time much less."""
     env = {**os.environ, "JOURDAIN_CACHE": str(cache), "PYTHONPATH": str(ROOT / "src")}
+    # bytecode as a user's Python writes it: a sandbox's PYTHONDONTWRITEBYTECODE=1 would make
+    # every run compile every module of jourdain from source again (0.4-0.8 s a run)
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     proc = subprocess.run(cmd, env=env, capture_output=True, text=True, check=False)

@@ -131,6 +131,37 @@ def test_cache_is_keyed_by_content_and_safe_to_delete(cache, monkeypatch):
                                   fn(y, y, 0, numeric.parameter_vector(s, None), [0.0])["M"])
 
 
+def test_threads_building_one_library_compile_it_once(cache, monkeypatch):
+    """Threads asking for the same library at once (a study's threads, a background build and
+    the simulation waiting for it): one compiles, the others wait and load that library."""
+    import threading
+
+    compiles: list[str] = []
+    real = build.compile_shared
+
+    def counted(sources, units, out, flags):  # noqa: ANN001, ANN202
+        compiles.append(out.name)
+        return real(sources, units, out, flags)
+
+    monkeypatch.setattr(build, "compile_shared", counted)
+    src = "double jd_twice(double x) { return 2.0 * x; }\n"
+    key = build.content_key("test-threads", src)
+    barrier = threading.Barrier(4)
+    libs: list[object] = []
+
+    def ask() -> None:
+        barrier.wait()
+        libs.append(build.build(key, src))
+
+    threads = [threading.Thread(target=ask) for _ in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert compiles == [f"{key}.so"] and len(libs) == 4
+    assert all(lib is libs[0] for lib in libs)
+
+
 def test_models_that_differ_in_a_sign_get_their_own_code(cache):
     """SymEngine hashes k*(x - x0) and k*(x0 - x) alike; the cache must not mix them up (a
     user flipping a sign in a model must not get the old library)."""

@@ -197,10 +197,35 @@ def test_doctype_and_names(tmp_path):
     assert model.joint("1st joint").coordinates == ("joint_1st_joint",)
 
 
-def test_missing_yourdfpy_names_the_extra(monkeypatch):
+def test_missing_yourdfpy_names_the_extra(monkeypatch, tmp_path):
+    arm = tmp_path / "arm.urdf"  # not read before: not in the cache of built models
+    arm.write_bytes(ARM.read_bytes() + b"<!-- not in the cache -->\n")
     monkeypatch.setitem(sys.modules, "yourdfpy", None)
     with pytest.raises(jd.ModelError, match=r"jourdain\[urdf\]"):
-        load_urdf(ARM)
+        load_urdf(arm)
+
+
+def test_model_read_again_comes_from_the_cache_without_yourdfpy(tmp_path):
+    """A file read before is not parsed again: a fresh process gives the same model (equal
+    System, joints, links, geometry) with yourdfpy never imported; other bytes or options are
+    another model."""
+    import subprocess
+
+    arm = tmp_path / "arm.urdf"
+    arm.write_bytes(ARM.read_bytes())
+    first = load_urdf(arm)
+    code = ("import pickle, sys; from jourdain.io.urdf import load_urdf; "
+            f"m = load_urdf({str(arm)!r}); "
+            "sys.stdout.buffer.write(pickle.dumps((m, 'yourdfpy' in sys.modules)))")
+    import pickle
+
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, check=True).stdout
+    again, imported = pickle.loads(out)
+    assert again == first and again.system == first.system and not imported
+    assert load_urdf(arm, floating_base=True).system.f == first.system.f + 6
+    arm.write_bytes(ARM.read_bytes().replace(b'name="elbow"', b'name="elbow_2"', 1))
+    renamed = load_urdf(arm)
+    assert renamed != first
 
 
 def test_cli_reads_urdf(capsys):

@@ -25,6 +25,7 @@ import stat
 import subprocess
 import sys
 import tempfile
+import threading
 import warnings
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -179,6 +180,18 @@ def build(key: str, source: str | Sequence[str], extra_flags: Sequence[str] = ()
     lib = cached_library(key)
     if lib is not None:
         return lib
+    with _BUILDING_GUARD:  # one build per key at a time (a background build, then a caller)
+        lock = _BUILDING.setdefault(key, threading.Lock())
+    with lock:
+        lib = cached_library(key)  # built meanwhile by another thread
+        return lib if lib is not None else _build(key, source, extra_flags)
+
+
+_BUILDING: dict[str, threading.Lock] = {}
+_BUILDING_GUARD = threading.Lock()
+
+
+def _build(key: str, source: str | Sequence[str], extra_flags: Sequence[str]) -> ctypes.CDLL:
     units = [source] if isinstance(source, str) else list(source)
     d = library_dir()
     so = d / f"{key}.so"

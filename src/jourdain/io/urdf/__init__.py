@@ -35,6 +35,10 @@ as references for viewers (:class:`UrdfGeometry`: mesh file names and scales, bo
 cylinders, spheres, each with its pose in the body frame; :attr:`UrdfModel.visuals` gives the
 meshes in the form of the 3-D view), never loaded.
 
+A model built from a file is kept in the compile cache under a hash of the file's bytes, the
+options and jourdain's source (:mod:`~jourdain.io.urdf.cache`): read again, it comes from there
+without importing yourdfpy.
+
 Not supported, each a :class:`UrdfError` naming the link or joint and the file: ``mimic``
 joints (unless ``mimic="independent"``, which makes them ordinary joints as Pinocchio does by
 default), closed loops (a link that is the child of two joints, ``<loop_joint>`` extensions),
@@ -50,6 +54,7 @@ from pathlib import Path
 
 from ...errors import ModelError
 from .build import _build
+from .cache import cached, keep, model_key
 from .model import (
     ROOT_COORDINATES,
     ROOT_JOINT,
@@ -102,8 +107,14 @@ def load_urdf(path: str | Path, *, floating_base: bool = False, gravity: float =
     g_value = _float(gravity, "load_urdf: gravity", name, None)
     if g_value is None:
         raise ModelError("load_urdf: gravity must be a number, got None")
-    yourdfpy = _yourdfpy()
     raw, lines = _read_xml(name)
+    key = model_key(raw, str(Path(name).resolve()),
+                    {"floating_base": bool(floating_base), "g": g_value, "mimic": mimic,
+                     "joint_damping": bool(joint_damping), "actuated": bool(actuated)})
+    model = cached(key)
+    if model is not None:  # built before from these bytes (io.urdf.cache): no yourdfpy import
+        return model
+    yourdfpy = _yourdfpy()
     try:
         urdf = yourdfpy.URDF.load(io.BytesIO(raw), build_scene_graph=False,
                                   build_collision_scene_graph=False, load_meshes=False,
@@ -112,7 +123,9 @@ def load_urdf(path: str | Path, *, floating_base: bool = False, gravity: float =
         raise UrdfError(f"yourdfpy cannot read the file: {type(exc).__name__}: {exc}",
                         name) from None
     src = _Source(name, lines)
-    return _build(urdf.robot, src, floating_base=floating_base, g=g_value,
-                  mimic=mimic, joint_damping=joint_damping, actuated=actuated)
+    model = _build(urdf.robot, src, floating_base=floating_base, g=g_value,
+                   mimic=mimic, joint_damping=joint_damping, actuated=actuated)
+    keep(key, model)
+    return model
 
 
