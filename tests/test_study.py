@@ -274,11 +274,16 @@ def test_local_processes_and_dask_cluster_equal_the_serial_run() -> None:
         on_cluster = run_study(spec, scheduler=client)
         again = run_study(spec, scheduler=client)  # the same study twice on one client
         by_address = run_study(spec, scheduler=cluster.scheduler_address)
+        # another client made later (the process's default client now): the study still
+        # waits on its own client's loop, not the default one's
+        with distributed.Client(cluster.scheduler_address):
+            beside = run_study(spec, scheduler=client)
         # both workers took part (two blocks, one each or both on one: at least ran there)
         assert len(client.scheduler_info()["workers"]) == 2
     _same(on_cluster, serial)
     _same(again, serial)
     _same(by_address, serial)
+    _same(beside, serial)
 
 
 def test_auto_pool_uses_threads_unless_cases_simulate_one_by_one(

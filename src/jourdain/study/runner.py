@@ -272,8 +272,11 @@ def _run_dask(spec: StudySpec, todo: list[tuple[int, int]], scheduler: Any,
         # copy, content-keyed, raced with its release when the same study ran again
         futures = [client.submit(_compute_blocks, spec, g, keys, pure=False) for g in groups]
         try:
-            # results gathered as they finish, in batches: one round trip for several tasks
-            for fut, res in as_completed(futures, with_results=True, raise_errors=False):
+            # results gathered as they finish, in batches: one round trip for several tasks;
+            # on this client's loop (as_completed takes the default client's otherwise, and
+            # waits forever where the process has another client, created later)
+            for fut, res in as_completed(futures, loop=client.loop, with_results=True,
+                                         raise_errors=False):
                 if fut.status == "error":
                     _result(fut, spec)  # raises the task's error as the study's
                 yield from res
