@@ -33,7 +33,9 @@ right-hand side the LDLᵀ loop of the 13×13 M 5 400 instructions, M, k, q 2 00
 (probably: its code no longer fits beside M, k, q in the instruction caches), hence used up to
 f = 10; the articulated-body recursion (numeric.dynamics_function) is 4× (n = 12) to 11×
 (n = 4) slower per run here; -march=native on the step loop is slower (AVX-512 on 27-long
-vectors). 10× PyDy at n = 12 needs about 420 ns per right-hand side against 580-600 ns now.
+vectors). GCC unrolls the LDLᵀ loop's inner loops (ldl_solve.h): 260 → 211-228 ns per solve
+alone, 7.1-7.3× → 7.6-7.7× PyDy end to end at n = 12 (2026-11-23, the two alternated). 10×
+PyDy at n = 12 needs about 450 ns per right-hand side against 520-610 ns now.
 
 PyDy's symbolic linear solver can take long for large n; it is
 skipped above ``--sympy-max-n`` (default 12: its code generation takes about 5 s at n = 12)

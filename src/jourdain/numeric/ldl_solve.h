@@ -2,6 +2,11 @@
 #ifndef JD_SOLVE_MKQ
 #define JD_SOLVE_MKQ
 /* ÿ = M⁻¹(q − k) by LDLᵀ of the projected M; 0, 1 (M not positive definite) or 2 (NaN) */
+#if defined(__GNUC__) && !defined(__clang__)
+/* GCC: its short inner loops unrolled (-O2 does not): 15 % less time per solve at f = 13, the
+   operations and their order unchanged (no reassociation), so the results are too */
+__attribute__((optimize("unroll-loops")))
+#endif
 static int jd_solve_mkq(const double *M, const double *k, const double *q, double *ydd,
                         double *L /* f×f work */) {
     double D[JD_F], Dinv[JD_F], E[JD_F], dmax = 0.0;
