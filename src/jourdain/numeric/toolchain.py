@@ -109,6 +109,26 @@ def compiler() -> str:
         "with the system's C compiler: install gcc or clang, or set CC")
 
 
+def keep_file(path: Path, data: bytes) -> None:
+    """Write ``data`` to ``path`` whole or not at all: under a private temporary name beside it,
+    then renamed into place, so that a concurrent reader (another process, another thread)
+    never sees half a file. For the cache's entries: one that cannot be written costs time,
+    not results (an OSError leaves nothing behind and is not raised)."""
+    tmp: str | None = None
+    try:
+        path.parent.mkdir(mode=0o700, parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+        os.replace(tmp, path)
+    except OSError:
+        if tmp is not None:
+            try:
+                os.unlink(tmp)
+            except OSError:
+                pass
+
+
 def content_key(*parts: str) -> str:
     """SHA-256 of the parts, the compiler flags and the Python platform."""
     h = hashlib.sha256()

@@ -16,14 +16,13 @@ from __future__ import annotations
 import datetime as _dt
 import hashlib
 import json
-import os
 import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
 from ...errors import JourdainError
-from ...numeric.toolchain import library_dir
+from ...numeric.toolchain import keep_file, library_dir
 from ...symbolic import to_sympy
 from ...workflow import eom_matrices, has_capability
 from .. import export
@@ -172,14 +171,7 @@ def cached(key: str) -> Display | None:
 def keep(key: str, display: Display) -> None:
     """Keep ``display`` under ``key`` (written whole or not at all, for a concurrent reader;
     a cache that cannot be written costs time, not results)."""
-    path = _cache_file(key)
-    try:
-        path.parent.mkdir(mode=0o700, exist_ok=True)
-        tmp = path.with_name(f".{key}.{os.getpid()}.tmp")
-        tmp.write_text(json.dumps(asdict(display)), encoding="utf-8")
-        tmp.replace(path)
-    except OSError:
-        pass
+    keep_file(_cache_file(key), json.dumps(asdict(display)).encode("utf-8"))
 
 
 def cached_display(model: ModelFile, max_ops: int) -> Display:

@@ -15,12 +15,11 @@ not results.
 from __future__ import annotations
 
 import hashlib
-import os
 import pickle
 from pathlib import Path
 from typing import Any
 
-from ...numeric.toolchain import library_dir
+from ...numeric.toolchain import keep_file, library_dir
 from .model import UrdfModel
 
 __all__ = ["cached", "keep", "model_key"]
@@ -64,11 +63,7 @@ def cached(key: str) -> UrdfModel | None:
 def keep(key: str, model: UrdfModel) -> None:
     """Keep ``model`` under ``key`` (written whole under a temporary name, then renamed)."""
     try:
-        path = _file(key)
-        path.parent.mkdir(mode=0o700, exist_ok=True)
-        tmp = path.with_name(f".{key}.{os.getpid()}.tmp")
-        with open(tmp, "wb") as fh:
-            pickle.dump(model, fh, protocol=pickle.HIGHEST_PROTOCOL)
-        tmp.replace(path)
-    except (OSError, pickle.PicklingError, TypeError, AttributeError):
-        pass
+        data = pickle.dumps(model, protocol=pickle.HIGHEST_PROTOCOL)
+    except (pickle.PicklingError, TypeError, AttributeError):
+        return
+    keep_file(_file(key), data)

@@ -13,13 +13,14 @@ are read-only, since every user of a file shares them.
 from __future__ import annotations
 
 import hashlib
+import io
 import os
 from collections import OrderedDict
 from pathlib import Path
 
 import numpy as np
 
-from ...numeric.toolchain import cache_dir
+from ...numeric.toolchain import cache_dir, keep_file
 
 #: version of the parsed form: a change to the readers changes it, and the stored meshes of
 #: older readers are not used
@@ -81,19 +82,10 @@ def store(key: str, arrays: Arrays) -> None:
     """Store the arrays under ``key`` (written under a private name and renamed into place, so
     that a concurrent reader never sees half a file); nothing when the cache is not writable."""
     vertices, faces, groups = arrays
-    path = _stored(key)
     colours = np.array([c if c is not None else (np.nan,) * 3 for _, _, c in groups],
                        dtype=float).reshape(-1, 3)
-    tmp = path.with_name(f".{key}.{os.getpid()}.npz")
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with open(tmp, "wb") as fh:
-            np.savez(fh, vertices=vertices, faces=faces,
-                     starts=np.array([g[0] for g in groups], dtype=np.int64),
-                     counts=np.array([g[1] for g in groups], dtype=np.int64), colours=colours)
-        os.replace(tmp, path)
-    except OSError:
-        try:
-            tmp.unlink()
-        except OSError:
-            pass
+    buf = io.BytesIO()
+    np.savez(buf, vertices=vertices, faces=faces,
+             starts=np.array([g[0] for g in groups], dtype=np.int64),
+             counts=np.array([g[1] for g in groups], dtype=np.int64), colours=colours)
+    keep_file(_stored(key), buf.getvalue())
