@@ -10,8 +10,10 @@
    * *batched*: :func:`jourdain.study.run_study` in this process (blocks of 512 cases: one C
      call for M̃, P, Q, h of a block, stacked solves and eigenvalues), the derivation and
      compilation not counted (timed apart as *set-up*);
-   * *1 and 2 processes*, *2 Dask workers* (a ``LocalCluster``, started beforehand): the whole
-     ``run_study`` call, worker start and model rebuild in each worker included.
+   * *1 → 2 workers*: the whole ``run_study`` call on 1 and 2 threads (``pool="auto"``), on 2
+     fresh processes (worker start and model rebuild included) and on warm Dask
+     ``LocalCluster``s of 1 and 2 workers, medians of ``--rounds`` interleaved rounds, beside
+     the ceiling of the map's own LAPACK work on two threads measured in the same rounds.
 
    The batched verdicts are compared with the loop's on the cases the loop ran.
 
@@ -160,7 +162,7 @@ def _scaling(spec: object, ctx: object, ref: object, rounds: int) -> dict:
     1 → 2 figures against on a shared machine."""
     from jourdain.study.linear import linearization_numbers, state_matrices
 
-    nums = linearization_numbers(ctx, _parameters(ctx))
+    nums = linearization_numbers(ctx, case_arrays(ctx, 0, len(ctx.cases))[0])
     A, _ = state_matrices(nums["M_tilde"], nums["P"], nums["Q"])
     halves = (A[0::2], A[1::2])
 
@@ -189,28 +191,10 @@ def _scaling(spec: object, ctx: object, ref: object, rounds: int) -> dict:
     # fresh processes apart too (forking a pool every round disturbed the threads' timings)
     _rounds({"2_processes": lambda: run_study(spec, workers=2, pool="processes", quiet=True)},
             rounds, ref, times, identical)
-    try:  # the Dask clusters apart: their idle workers' event loops would disturb the rest
-        import distributed
-    except ImportError:
-        distributed = None
-    if distributed is not None:
-        clusters: list = []
-        runs: dict = {}
-        try:
-            for n in (1, 2):
-                cl = distributed.LocalCluster(n_workers=n, threads_per_worker=1,
-                                              processes=True, dashboard_address=None)
-                client = distributed.Client(cl)
-                clusters.append((cl, client))
-                runs[f"dask_{n}"] = lambda client=client: run_study(spec, scheduler=client,
-                                                                    quiet=True)
-            runs["dask_lapack_1_thread"] = local["lapack_1_thread"]
-            runs["dask_lapack_2_threads"] = local["lapack_2_threads"]
-            _rounds(runs, rounds, ref, times, identical)
-        finally:
-            for cl, client in clusters:
-                client.close()
-                cl.close()
+    # the Dask clusters apart: their idle workers' event loops would disturb the rest
+    _dask_rounds(spec, ref, "max_real_part", rounds, times, identical,
+                 {"dask_lapack_1_thread": local["lapack_1_thread"],
+                  "dask_lapack_2_threads": local["lapack_2_threads"]})
     med = {f"{k}_s": float(np.median(v)) for k, v in times.items()}
     out = {"rounds": rounds, **med, "identical": identical,
            "threads_speedup": med["1_worker_s"] / med["2_workers_s"],
@@ -223,10 +207,11 @@ def _scaling(spec: object, ctx: object, ref: object, rounds: int) -> dict:
     return out
 
 
-def _rounds(runs: dict, rounds: int, ref: object, times: dict, identical: dict) -> None:
+def _rounds(runs: dict, rounds: int, ref: object, times: dict, identical: dict,
+            var: str = "max_real_part") -> None:
     """Every run once (first calls: the workers build the model), then ``rounds`` rounds of
-    each in turn; the times appended to ``times[name]``; whether a study's results equal
-    ``ref`` bit for bit in ``identical[name]``."""
+    each in turn; the times appended to ``times[name]``; whether a study's ``var`` equals
+    ``ref``'s bit for bit in ``identical[name]``."""
     from threadpoolctl import threadpool_limits
 
     with threadpool_limits(limits=1, user_api="blas"):
@@ -237,36 +222,35 @@ def _rounds(runs: dict, rounds: int, ref: object, times: dict, identical: dict) 
                 t, res = _timed(fn)
                 times.setdefault(k, []).append(t)
                 if hasattr(res, "data_vars"):
-                    identical[k] = bool(np.array_equal(res["max_real_part"].values,
-                                                       ref["max_real_part"].values))
+                    identical[k] = bool(np.array_equal(res[var].values, ref[var].values,
+                                                       equal_nan=True))
 
 
-def _parameters(ctx: object) -> np.ndarray:
-    from jourdain.study.compute import case_arrays
-
-    return case_arrays(ctx, 0, len(ctx.cases))[0]
-
-
-def _dask(spec: object, ref: object, var: str = "max_real_part") -> dict:
-    """The study on a LocalCluster of 1 and of 2 worker processes (one thread each), the
-    workers warm (they built the model in a first run, not counted)."""
+def _dask_rounds(spec: object, ref: object, var: str, rounds: int, times: dict,
+                 identical: dict, extra: dict | None = None) -> None:
+    """The study on warm LocalClusters of 1 and of 2 worker processes (one thread each), both
+    up, in interleaved rounds with the ``extra`` runs (:func:`_rounds`: times under
+    ``dask_1`` and ``dask_2``); nothing without dask.distributed."""
     try:
         import distributed
     except ImportError:
-        return {"dask": "not installed"}
-    out: dict = {}
-    for n in (1, 2):
-        with distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                      dashboard_address=None) as cluster, \
-                distributed.Client(cluster) as client:
-            run_study(spec, scheduler=client, quiet=True)
-            t, ds = min((_timed(lambda: run_study(spec, scheduler=client, quiet=True)) for _ in range(3)),
-                        key=lambda r: r[0])
-        out[f"dask_{n}_workers_s"] = t
-        out[f"dask_{n}_identical"] = bool(np.array_equal(ds[var].values, ref[var].values,
-                                                         equal_nan=True))
-    out["dask_speedup"] = out["dask_1_workers_s"] / out["dask_2_workers_s"]
-    return out
+        return
+    clusters: list = []
+    runs: dict = {}
+    try:
+        for n in (1, 2):
+            cl = distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                          dashboard_address=None)
+            client = distributed.Client(cl)
+            clusters.append((cl, client))
+            runs[f"dask_{n}"] = lambda client=client: run_study(spec, scheduler=client,
+                                                                quiet=True)
+        runs.update(extra or {})
+        _rounds(runs, rounds, ref, times, identical, var)
+    finally:
+        for cl, client in clusters:
+            client.close()
+            cl.close()
 
 
 def _best(fn, repeat: int):
@@ -342,7 +326,14 @@ def monte_carlo(n: int, repeat: int = 3) -> dict:
     out["ensemble_1_to_2_threads"] = out["ensemble_1_s"] / out["ensemble_2_threads_s"]
     out["ensemble_1_to_2_processes"] = out["ensemble_1_s"] / out["ensemble_2_processes_s"]
     out["c_share_of_ensemble_1"] = out["c_only_1_s"] / out["ensemble_1_s"]
-    out.update(_dask(ens, run_study(ens, workers=1, quiet=True), "max_abs_z_b"))
+    times: dict = {}
+    identical: dict = {}
+    _dask_rounds(ens, run_study(ens, workers=1, quiet=True), "max_abs_z_b", repeat, times,
+                 identical)
+    if times:
+        out.update({f"dask_{n}_workers_s": float(np.median(times[f"dask_{n}"])) for n in (1, 2)})
+        out.update({f"dask_{n}_identical": identical[f"dask_{n}"] for n in (1, 2)})
+        out["dask_speedup"] = out["dask_1_workers_s"] / out["dask_2_workers_s"]
     z = ref if ref is not None else np.zeros(1)
     out.update(failed=int(np.isnan(z).sum()), max_abs_z_b_mean_mm=float(np.nanmean(z) * 1e3),
                max_abs_z_b_std_mm=float(np.nanstd(z, ddof=1) * 1e3),
@@ -451,7 +442,8 @@ def _print_mc(c: dict) -> None:
           f"({100 * c['mkq_share_of_c']:.0f} %: what one vectorized right-hand side over the "
           f"cases could speed up; each case's step loop remains)")
     if "dask_2_workers_s" in c:
-        print(f"  ensembles on a Dask LocalCluster (warm): 1 worker {c['dask_1_workers_s']:.2f} s, "
+        print(f"  ensembles on a Dask LocalCluster (warm, medians of {c['repeat']} interleaved "
+              f"rounds): 1 worker {c['dask_1_workers_s']:.2f} s, "
               f"2 workers {c['dask_2_workers_s']:.2f} s: {c['dask_speedup']:.2f}x (identical: "
               f"{c['dask_1_identical']}, {c['dask_2_identical']})")
 
