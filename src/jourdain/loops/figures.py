@@ -30,28 +30,26 @@ def draw_figures(out: Path, d: dict[str, Any]) -> list[str]:
 
     t = d["t"]
     figs = []
-    fig, ax = plt.subplots(figsize=(7, 3.5))
-    for i, n in enumerate(d["names"]):
-        ax.plot(t, d["z"][:, i], label=n)
-    ax.set_xlabel("t / s")
-    ax.set_ylabel("tree coordinates")
-    ax.legend()
-    figs.append(("coordinates.png", fig))
-    fig, ax = plt.subplots(figsize=(7, 3.5))
+
+    def lines(fname: str, ylabel: str, series: list[tuple[str, np.ndarray]],
+              log: bool = False) -> None:
+        """One figure of labelled curves over t."""
+        fig, ax = plt.subplots(figsize=(7, 3.5))
+        for label, v in series:
+            (ax.semilogy if log else ax.plot)(t, v, label=label)
+        ax.set_xlabel("t / s")
+        ax.set_ylabel(ylabel)
+        ax.legend()
+        figs.append((fname, fig))
+
+    lines("coordinates.png", "tree coordinates",
+          [(n, d["z"][:, i]) for i, n in enumerate(d["names"])])
     tiny = 1e-300
-    ax.semilogy(t, np.max(np.abs(d["Phi"]), axis=1) + tiny, label="max |Φ|")
-    ax.semilogy(t, np.max(np.abs(d["Phi_dot"]), axis=1) + tiny, label="max |Φ̇|")
-    ax.set_xlabel("t / s")
-    ax.set_ylabel("constraint residual")
-    ax.legend()
-    figs.append(("constraint_residual.png", fig))
-    fig, ax = plt.subplots(figsize=(7, 3.5))
-    for i, r in enumerate(d["labels"]):
-        ax.plot(t, d["lam"][:, i], label=r)
-    ax.set_xlabel("t / s")
-    ax.set_ylabel("closing-joint reactions λ")
-    ax.legend()
-    figs.append(("reactions.png", fig))
+    lines("constraint_residual.png", "constraint residual",
+          [("max |Φ|", np.max(np.abs(d["Phi"]), axis=1) + tiny),
+           ("max |Φ̇|", np.max(np.abs(d["Phi_dot"]), axis=1) + tiny)], log=True)
+    lines("reactions.png", "closing-joint reactions λ",
+          [(r, d["lam"][:, i]) for i, r in enumerate(d["labels"])])
     if d["wrenches"]:  # force and torque of each closing joint in its body A's axes
         fig, axs = plt.subplots(1, 2, figsize=(9, 3.5))
         for name, w in d["wrenches"].items():
