@@ -15,6 +15,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from fractions import Fraction
+from importlib import resources
 
 import symengine as se
 
@@ -32,7 +33,8 @@ static inline double jd_powi(double x, int n) {
     return n < 0 ? 1.0 / r : r;
 }
 static inline double jd_sign(double x) { return (double)((x > 0) - (x < 0)); }
-"""
+""" + resources.files(__package__ or "jourdain.numeric").joinpath("sincos.h").read_text(
+    encoding="utf-8")  # jd_sincos_n: every sin/cos of an argument symbol, in one call
 
 _FUNCS = {
     "sin": "sin", "cos": "cos", "tan": "tan", "asin": "asin", "acos": "acos", "atan": "atan",
@@ -198,30 +200,29 @@ def _function_source(name: str, exprs: Sequence[se.Basic], names: Mapping[str, s
 
     # sin and cos of sums of coordinates (absolute angles of a chain give sin(q1 - q2), ...)
     # come from one sin/cos pair per symbol and the addition theorems: a few multiplications
-    # instead of a call to sin or cos each
-    base: dict[str, tuple[str, str]] = {}
+    # instead of a call to sin or cos each; the pairs of all symbols are computed at the top
+    # of the function by one call of jd_sincos_n (sincos.h), which the compiler vectorizes
+    symbols: dict[str, int] = {}  # symbol -> its place in jd_sincos_n's arrays
+    atoms: list[str] = []
+    if TRIG_SUMS:
+        for i in g.order:
+            if type(g.node[i]).__name__ in ("sin", "cos"):
+                for _, sym in _trig_terms(g.args[i][0], g.arg_ids[i][0]) or ():
+                    if str(sym) not in symbols:
+                        symbols[str(sym)] = len(atoms)
+                        atoms.append(_atom(sym, names))
+    n_trig = len(atoms)
+    if split:  # the pairs live in the shared array's first 2·n_trig places
+        n_tmp = 2 * n_trig
     sums: dict[int, tuple[str, str]] = {}
 
     def base_pair(sym: se.Basic) -> tuple[str, str]:
-        key = str(sym)
-        if key not in base:
-            v = _atom(sym, names)
-            base[key] = (temporary(f"sin({v})"), temporary(f"cos({v})"))
-        return base[key]
+        k = symbols[str(sym)]
+        return (f"x[{k}]", f"x[{n_trig + k}]") if split else (f"jd_s[{k}]", f"jd_c[{k}]")
 
-    def sin_cos(arg_id: int, arg: se.Basic) -> tuple[str, str] | None:
+    def sin_cos(arg_id: int, terms: list[tuple[int, se.Basic]]) -> tuple[str, str]:
         if arg_id in sums:
             return sums[arg_id]
-        terms = []
-        for term in arg.args:
-            if type(term).__name__ == "Symbol":
-                terms.append((1, term))
-            elif (type(term).__name__ == "Mul" and len(term.args) == 2
-                  and term.args[0].is_Integer and abs(int(term.args[0])) == 1
-                  and type(term.args[1]).__name__ == "Symbol"):
-                terms.append((int(term.args[0]), term.args[1]))
-            else:
-                return None
         S = C = ""
         for sign, sym in terms:
             s1, c1 = base_pair(sym)
@@ -238,13 +239,9 @@ def _function_source(name: str, exprs: Sequence[se.Basic], names: Mapping[str, s
         node, node_args, arg_ids = g.node[i], g.args[i], g.arg_ids[i]
         tn = type(node).__name__
         if tn in ("sin", "cos") and TRIG_SUMS:
-            arg = node_args[0]
-            sc = None
-            if type(arg).__name__ == "Symbol":
-                sc = base_pair(arg)
-            elif arg_ids[0] is not None and type(arg).__name__ == "Add":
-                sc = sin_cos(arg_ids[0], arg)
-            if sc is not None:
+            terms = _trig_terms(node_args[0], arg_ids[0])
+            if terms is not None:
+                sc = base_pair(terms[0][1]) if arg_ids[0] is None else sin_cos(arg_ids[0], terms)
                 code[i] = sc[0] if tn == "sin" else sc[1]
                 continue
         a = [code[c] if c is not None else _atom(x, names)
@@ -274,12 +271,16 @@ void {name}_batch(long n, long f, const double *y, const double *yd, const doubl
                out + i * {len(exprs)});
 }}
 """
+    trig = "".join(f"    jd_a[{k}] = {a};\n" for k, a in enumerate(atoms))
     if not split:
         body = "\n".join(lines)
+        if n_trig:
+            trig = (f"    double jd_a[{n_trig}], jd_s[{n_trig}], jd_c[{n_trig}];\n{trig}"
+                    f"    jd_sincos_n(jd_a, {n_trig}, jd_s, jd_c);\n")
         return f"""
 void {name}({args}) {{
     (void)y; (void)yd; (void)t; (void)p; (void)u;
-{body}
+{trig}{body}
 }}
 """ + batch
     parts = [lines[i:i + PART] for i in range(0, len(lines), PART)]
@@ -292,14 +293,39 @@ __attribute__((noinline)) static void {name}_part{j}({args}, double *x) {{
 {body}
 }}
 """)
+    trig_split = (f"    {{\n        double jd_a[{n_trig}];\n"
+                  + trig.replace("    jd_a", "        jd_a")
+                  + f"        jd_sincos_n(jd_a, {n_trig}, x, x + {n_trig});\n    }}\n"
+                  if n_trig else "")
     calls = "\n".join(f"    {name}_part{j}(y, yd, t, p, u, out, x);" for j in range(len(parts)))
     src.append(f"""
 void {name}({args}) {{
     /* temporaries on the heap: large models would strain a thread's stack */
     double *x = (double *)malloc(sizeof(double) * {max(n_tmp, 1)});
     if (!x) {{ for (long i = 0; i < {len(exprs)}; ++i) out[i] = NAN; return; }}
-{calls}
+{trig_split}{calls}
     free(x);
 }}
 """)
     return "".join(src) + batch
+
+
+def _trig_terms(arg: se.Basic, arg_id: int | None) -> list[tuple[int, se.Basic]] | None:
+    """``arg`` of a sin or cos as the signed symbols it sums (a symbol alone: one term), or
+    None where it is something else (a product, a number, ...)."""
+    tn = type(arg).__name__
+    if tn == "Symbol":
+        return [(1, arg)]
+    if arg_id is None or tn != "Add":
+        return None
+    terms = []
+    for term in arg.args:
+        if type(term).__name__ == "Symbol":
+            terms.append((1, term))
+        elif (type(term).__name__ == "Mul" and len(term.args) == 2
+              and term.args[0].is_Integer and abs(int(term.args[0])) == 1
+              and type(term.args[1]).__name__ == "Symbol"):
+            terms.append((int(term.args[0]), term.args[1]))
+        else:
+            return None
+    return terms
