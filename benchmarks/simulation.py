@@ -34,8 +34,17 @@ right-hand side the LDLᵀ loop of the 13×13 M 5 400 instructions, M, k, q 2 00
 f = 10; the articulated-body recursion (numeric.dynamics_function) is 4× (n = 12) to 11×
 (n = 4) slower per run here; -march=native on the step loop is slower (AVX-512 on 27-long
 vectors). GCC unrolls the LDLᵀ loop's inner loops (ldl_solve.h): 260 → 211-228 ns per solve
-alone, 7.1-7.3× → 7.6-7.7× PyDy end to end at n = 12 (2026-11-23, the two alternated). 10×
-PyDy at n = 12 needs about 450 ns per right-hand side against 520-610 ns now.
+alone, 7.1-7.3× → 7.6-7.7× PyDy end to end at n = 12 (2026-11-23, the two alternated). The 12
+sin/cos pairs in one vectorized call (numeric/sincos.h) instead of 12 libm sincos: M, k, q
+212 → 172 ns, jd_accel 429 → 361 ns (C microbenchmark), 7.6-7.7× → 8.4-8.6× PyDy end to end
+at n = 12 and 21× → 23× at n = 4 (two alternated rounds each), 460-468 ns per right-hand
+side. Tried and not kept, each slower in the same microbenchmark: the LDLᵀ right-looking with
+its updates vectorized (+35 ns), with L stored by columns so that the dot products become
+vectorized column updates (+90 ns at -O2, bit-identical), two rows per pass of the
+left-looking loop (±0), the solve written out at f = 13 (+90 ns); parameter-only products of
+M, k, q hoisted out of the call (133 multiplications of about 1 300: −5 ns, within noise);
+the sin/cos loop also compiled for AVX2 (−20 ns in M, k, q but not in jd_accel). 10× PyDy at
+n = 12 needs about 400 ns per right-hand side.
 
 PyDy's symbolic linear solver can take long for large n; it is
 skipped above ``--sympy-max-n`` (default 12: its code generation takes about 5 s at n = 12)

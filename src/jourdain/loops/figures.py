@@ -36,6 +36,10 @@ def draw_figures(out: Path, d: dict[str, Any]) -> list[str]:
         """One figure of labelled curves over t."""
         fig, ax = plt.subplots(figsize=(7, 3.5))
         for label, v in series:
+            if log:  # an exact zero has no logarithm: a gap in the curve, not a 1e-300 floor
+                v = np.where(v > 0.0, v, np.nan)
+                if np.all(np.isnan(v)):
+                    label += ": exactly 0 throughout"
             (ax.semilogy if log else ax.plot)(t, v, label=label)
         ax.set_xlabel("t / s")
         ax.set_ylabel(ylabel)
@@ -44,10 +48,9 @@ def draw_figures(out: Path, d: dict[str, Any]) -> list[str]:
 
     lines("coordinates.png", "tree coordinates",
           [(n, d["z"][:, i]) for i, n in enumerate(d["names"])])
-    tiny = 1e-300
     lines("constraint_residual.png", "constraint residual",
-          [("max |Φ|", np.max(np.abs(d["Phi"]), axis=1) + tiny),
-           ("max |Φ̇|", np.max(np.abs(d["Phi_dot"]), axis=1) + tiny)], log=True)
+          [("max |Φ|", np.max(np.abs(d["Phi"]), axis=1)),
+           ("max |Φ̇|", np.max(np.abs(d["Phi_dot"]), axis=1))], log=True)
     lines("reactions.png", "closing-joint reactions λ",
           [(r, d["lam"][:, i]) for i, r in enumerate(d["labels"])])
     if d["wrenches"]:  # force and torque of each closing joint in its body A's axes
@@ -71,7 +74,7 @@ def draw_figures(out: Path, d: dict[str, Any]) -> list[str]:
     ax.set_ylabel("E − E₀ / J")
     figs.append(("energy.png", fig))
     for fname, fg in figs:
-        fg.subplots_adjust(left=0.1, right=0.97, bottom=0.14, top=0.95, wspace=0.3)
+        fg.subplots_adjust(left=0.12, right=0.97, bottom=0.14, top=0.95, wspace=0.3)
         fg.savefig(out / fname, dpi=90)
         plt.close(fg)
     return [f for f, _ in figs]
