@@ -13,6 +13,7 @@ import pytest
 
 from jourdain.numeric import ccode, toolchain
 
+
 @pytest.fixture(scope="module")
 def sincos():
     source = ccode.HEADER + r"""
