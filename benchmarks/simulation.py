@@ -26,8 +26,8 @@ Usage::
     python benchmarks/simulation.py --json out.json
 
 Where a run's time went (valgrind's instruction counts of the C loop alone, before sincos.h,
-n = 12, rtol = 5e-8, 4 118 right-hand sides, 343 steps, 12.0 per step, W not limiting the steps): per
-right-hand side the LDLᵀ loop of the 13×13 M 5 400 instructions, M, k, q 2 000 plus 12 sincos
+n = 12, rtol = 5e-8, 4 118 right-hand sides, 343 steps, 12.0 per step, W not limiting the
+steps): per right-hand side the LDLᵀ loop of the 13×13 M 5 400 instructions, M, k, q 2 000 plus 12 sincos
 1 500, the step loop (stage sums, error norm, output) 1 400. The written-out LDLᵀ
 (numeric/integrator_ldl.py) halves the solve's instructions but is slower at f = 13
 (probably: its code no longer fits beside M, k, q in the instruction caches), hence used up to
