@@ -25,31 +25,29 @@ Usage::
     python benchmarks/simulation.py --quick     # n = 2, PyDy's lambdify backend (a smoke test)
     python benchmarks/simulation.py --json out.json
 
-Where a run's time went (valgrind's instruction counts of the C loop alone, before sincos.h,
-n = 12, rtol = 5e-8, 4 118 right-hand sides, 343 steps, 12.0 per step, W not limiting the
-steps): per right-hand side the LDLᵀ loop of the 13×13 M 5 400 instructions, M, k, q 2 000 plus 12 sincos
-1 500, the step loop (stage sums, error norm, output) 1 400. The written-out LDLᵀ
-(numeric/integrator_ldl.py) halves the solve's instructions but is slower at f = 13
-(probably: its code no longer fits beside M, k, q in the instruction caches), hence used up to
-f = 10; the articulated-body recursion (numeric.dynamics_function) is 4× (n = 12) to 11×
-(n = 4) slower per run here; -march=native on the step loop is slower (AVX-512 on 27-long
-vectors). GCC unrolls the LDLᵀ loop's inner loops (ldl_solve.h): 260 → 211-228 ns per solve
-alone, 7.1-7.3× → 7.6-7.7× PyDy end to end at n = 12 (2026-11-23, the two alternated). The 12
-sin/cos pairs in one vectorized call (numeric/sincos.h) instead of 12 libm sincos: M, k, q
-212 → 172 ns, jd_accel 429 → 361 ns (C microbenchmark), 7.6-7.7× → 8.4-8.6× PyDy end to end
-at n = 12 and 21× → 23× at n = 4 (two alternated rounds each), 460-468 ns per right-hand
-side. Tried and not kept, each slower in the same microbenchmark: the LDLᵀ right-looking with
-its updates vectorized (+35 ns), with L stored by columns so that the dot products become
-vectorized column updates (+90 ns at -O2, bit-identical), two rows per pass of the
-left-looking loop (±0), two partial sums per dot product (+55 ns), each column's dot products
-written out with the loop over rows kept (+55 ns, bit-identical), the solve written out at
-f = 13 (+90 ns); parameter-only products of
-M, k, q hoisted out of the call (133 multiplications of about 1 300: −5 ns, within noise);
-the sin/cos loop also compiled for AVX2 (−20 ns in M, k, q but not in jd_accel). 10× PyDy at
-n = 12 needs about 400 ns per right-hand side. Fewer right-hand sides with Verner's "most
-efficient" 7(6) pair (10 per step)? No: driven by SciPy's RungeKutta against its DOP853 on the
-same function, it needed as many for the same final error (4 812 evaluations for 7.5e-7
-against 4 742 for 6.5e-7).
+Where a run's time went (valgrind's instruction counts of the C loop alone, before sincos.h, n =
+12, rtol = 5e-8, 4 118 right-hand sides, 343 steps, 12.0 per step, W not limiting the steps):
+per right-hand side the LDLᵀ loop of the 13×13 M 5 400 instructions, M, k, q 2 000 plus 12
+sincos 1 500, the step loop (stage sums, error norm, output) 1 400. The written-out LDLᵀ
+(numeric/integrator_ldl.py) halves the solve's instructions but is slower at f = 13 (probably:
+its code no longer fits beside M, k, q in the instruction caches), hence used up to f = 10; the
+articulated-body recursion (numeric.dynamics_function) is 4× (n = 12) to 11× (n = 4) slower per
+run here; -march=native on the step loop is slower (AVX-512 on 27-long vectors). GCC unrolls the
+LDLᵀ loop's inner loops (ldl_solve.h): 260 → 211-228 ns per solve alone, 7.1-7.3× → 7.6-7.7×
+PyDy end to end at n = 12 (2026-11-23, the two alternated). The 12 sin/cos pairs in one
+vectorized call (numeric/sincos.h) instead of 12 libm sincos: M, k, q 212 → 172 ns, jd_accel 429
+→ 361 ns (C microbenchmark), 7.6-7.7× → 8.4-8.6× PyDy end to end at n = 12 and 21× → 23× at n =
+4 (two alternated rounds each), 460-468 ns per right-hand side. Tried and not kept, each slower
+in the same microbenchmark: the LDLᵀ right-looking with its updates vectorized (+35 ns), with L
+stored by columns so that the dot products become vectorized column updates (+90 ns at -O2,
+bit-identical), two rows per pass of the left-looking loop (±0), two partial sums per dot
+product (+55 ns), each column's dot products written out with the loop over rows kept (+55 ns,
+bit-identical), the solve written out at f = 13 (+90 ns); parameter-only products of M, k, q
+hoisted out of the call (133 multiplications of about 1 300: −5 ns, within noise); the sin/cos
+loop also compiled for AVX2 (−20 ns in M, k, q but not in jd_accel). 10× PyDy at n = 12 needs
+about 400 ns per right-hand side. Fewer right-hand sides with Verner's "most efficient" 7(6)
+pair (10 per step)? No: driven by SciPy's RungeKutta against its DOP853 on the same function, it
+needed as many for the same final error (4 812 evaluations for 7.5e-7 against 4 742 for 6.5e-7).
 
 PyDy's symbolic linear solver can take long for large n; it is
 skipped above ``--sympy-max-n`` (default 12: its code generation takes about 5 s at n = 12)
