@@ -10,6 +10,7 @@ import re
 import mpmath
 import numpy as np
 import pytest
+import symengine as se
 
 from jourdain.numeric import ccode, toolchain
 
@@ -76,8 +77,6 @@ def test_zero_infinity_nan_and_large_arguments(sincos):
 def test_generated_code_takes_every_pair_in_one_call():
     """sin/cos of coordinates, parameters and their sums and differences: one jd_sincos_n call
     at the top of the function, no libm call per pair."""
-    import symengine as se
-
     q1, q2, a = se.symbols("q1 q2 a")
     names = {"q1": "y[0]", "q2": "y[1]", "a": "p[0]"}
     src = ccode.function_source("jd_fn", [se.sin(q1 - q2) * se.cos(a), se.cos(q1 + q2),

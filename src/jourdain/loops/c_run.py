@@ -56,11 +56,12 @@ class Segment:
         lib = integrator_library()
         while True:
             code = int(lib.jd_integrate(
-                ctypes.byref(self.problem), t1, address(self.st), address(self.x), address(self.k0),
-                address(self.g_old), address(self.cnt), address(self.te), self.te.size,
-                address(self.i_eval), address(self.out_t), address(self.out_x), address(self.out_dx),
-                self.out_t.size, address(self.n_out), address(self.ev_t), address(self.ev_x),
-                address(self.ev_i), 1, address(self.n_ev), 1 << 20, address(self.fail)))
+                ctypes.byref(self.problem), t1, address(self.st), address(self.x),
+                address(self.k0), address(self.g_old), address(self.cnt), address(self.te),
+                self.te.size, address(self.i_eval), address(self.out_t), address(self.out_x),
+                address(self.out_dx), self.out_t.size, address(self.n_out), address(self.ev_t),
+                address(self.ev_x), address(self.ev_i), 1, address(self.n_ev), 1 << 20,
+                address(self.fail)))
             if code != 1:  # JD_CONTINUE: the step budget of one call used
                 return code
 

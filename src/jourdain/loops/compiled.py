@@ -51,7 +51,6 @@ class _Loop(ctypes.Structure):
                 ("u_buf", ctypes.c_void_p)]
 
 
-
 @lru_cache(maxsize=16)
 def loop_library(loop: ClosedLoopSystem) -> ctypes.CDLL:
     """The compiled constraint functions and loop kernel of ``loop`` (cached by content)."""

@@ -153,9 +153,8 @@ def _penalty_c(ev: LoopEvaluator, t0: float, t1: float, x0: np.ndarray, tev: np.
     lib.jd_penalty_work.argtypes = [ctypes.c_long, ctypes.c_long]
     work = np.zeros(int(lib.jd_penalty_work(n, m)))
     lam = np.zeros(max(m, 1))
-    st = _Penalty(tree.address, address(ev.p), n, m, int(iterations),
-                  float(alpha), float(xi), float(omega), address(work),
-                  address(lam))
+    st = _Penalty(tree.address, address(ev.p), n, m, int(iterations), float(alpha), float(xi),
+                  float(omega), address(work), address(lam))
     accel = int(ctypes.cast(lib.jd_penalty_accel, ctypes.c_void_p).value or 0)
     seg = Segment(n, ev.u, tree.address, ctypes.addressof(st), accel, t0,
                   np.concatenate([x0, [0.0]]), tev, C_METHODS["DOP853"], rtol, atol, math.inf)

@@ -271,12 +271,19 @@ void {name}_batch(long n, long f, const double *y, const double *yd, const doubl
                out + i * {len(exprs)});
 }}
 """
-    trig = "".join(f"    jd_a[{k}] = {a};\n" for k, a in enumerate(atoms))
+
+    def trig_block(indent: str, decl: str, s: str, c: str) -> str:
+        """The arguments of the sin/cos pairs and the one call of jd_sincos_n ("" if none)."""
+        if not n_trig:
+            return ""
+        return (f"{indent}double {decl};\n"
+                + "".join(f"{indent}jd_a[{k}] = {a};\n" for k, a in enumerate(atoms))
+                + f"{indent}jd_sincos_n(jd_a, {n_trig}, {s}, {c});\n")
+
     if not split:
         body = "\n".join(lines)
-        if n_trig:
-            trig = (f"    double jd_a[{n_trig}], jd_s[{n_trig}], jd_c[{n_trig}];\n{trig}"
-                    f"    jd_sincos_n(jd_a, {n_trig}, jd_s, jd_c);\n")
+        trig = trig_block("    ", f"jd_a[{n_trig}], jd_s[{n_trig}], jd_c[{n_trig}]",
+                          "jd_s", "jd_c")
         return f"""
 void {name}({args}) {{
     (void)y; (void)yd; (void)t; (void)p; (void)u;
@@ -293,10 +300,8 @@ __attribute__((noinline)) static void {name}_part{j}({args}, double *x) {{
 {body}
 }}
 """)
-    trig_split = (f"    {{\n        double jd_a[{n_trig}];\n"
-                  + trig.replace("    jd_a", "        jd_a")
-                  + f"        jd_sincos_n(jd_a, {n_trig}, x, x + {n_trig});\n    }}\n"
-                  if n_trig else "")
+    trig = trig_block("        ", f"jd_a[{n_trig}]", "x", f"x + {n_trig}")
+    trig_split = f"    {{\n{trig}    }}\n" if trig else ""
     calls = "\n".join(f"    {name}_part{j}(y, yd, t, p, u, out, x);" for j in range(len(parts)))
     src.append(f"""
 void {name}({args}) {{

@@ -96,9 +96,10 @@ def address(a: np.ndarray) -> int: ...
 def address(a: None) -> None: ...
 def address(a: np.ndarray | None) -> int | None:
     """The address of ``a``'s data (contiguous), for the C code's arguments and structures
-    (the step loop here, the closed loops' and the ensembles' drivers). ``ctypes.c_char.from_buffer``: 0.5 µs, against
-    2.1 µs for ``a.ctypes.data`` and 2.6 µs for ``__array_interface__`` (NumPy 2.4), and a run's
-    set-up takes about eight; read-only or empty arrays take the slow way."""
+    (the step loop here, the closed loops' and the ensembles' drivers).
+    ``ctypes.c_char.from_buffer``: 0.5 µs, against 2.1 µs for ``a.ctypes.data`` and 2.6 µs for
+    ``__array_interface__`` (NumPy 2.4), and a run's set-up takes about eight; read-only or
+    empty arrays take the slow way."""
     if a is None:
         return None
     try:

@@ -206,8 +206,9 @@ class Ensemble:
         def work(k: int, lo: int, hi: int) -> None:
             status[k] = self._lib.jd_ensemble(
                 self._integrate, self._template, len(self._template), _Problem.p.offset,
-                address(P), P.shape[1], address(X0), n, self.t0, self.t1, address(te), ns, max_steps,
-                address(out_x), address(out_dx), address(code), address(cnt), address(fail), lo, hi)
+                address(P), P.shape[1], address(X0), n, self.t0, self.t1, address(te), ns,
+                max_steps, address(out_x), address(out_dx), address(code), address(cnt),
+                address(fail), lo, hi)
 
         cuts = np.linspace(0, m, max(1, min(threads, m)) + 1).round().astype(int)
         slices = [(k, int(a), int(b)) for k, (a, b) in enumerate(zip(cuts[:-1], cuts[1:],
@@ -226,5 +227,3 @@ class Ensemble:
                            W=out_x[:, :, 2 * f],
                            ydd=None if out_dx is None else out_dx[:, :, f:2 * f],
                            code=code, nfev=cnt[:, 0].copy(), nsteps=cnt[:, 1].copy())
-
-
