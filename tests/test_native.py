@@ -1,0 +1,99 @@
+"""Code compiled for this machine (``-march=native``, numeric/toolchain.py): the same numbers,
+bit for bit, as the portable build, a cache key that names the processor, and portable code
+where the native build fails."""
+
+from __future__ import annotations
+
+import ctypes
+import math
+
+import numpy as np
+import pytest
+
+from jourdain import numeric
+from jourdain.models import n_link_pendulum_on_cart
+from jourdain.numeric import toolchain
+from jourdain.simulation import problem
+
+native = pytest.mark.skipif(toolchain.native_target() is None,
+                            reason="the compiler here does not take -march=native")
+
+
+def _run(monkeypatch, native_on: bool):
+    monkeypatch.setenv("JOURDAIN_NATIVE", "1" if native_on else "0")
+    numeric.clear_cache()
+    problem.integrator_library.cache_clear()
+    s = n_link_pendulum_on_cart(5)
+    y0 = np.concatenate([[0.0], np.linspace(math.pi + 0.3, math.pi - 0.3, 5)])
+    r = s.simulate((0.0, 2.0), y0, np.zeros(6), inputs={"F": 0.0}, rtol=1e-9, atol=1e-9)
+    y = np.random.default_rng(3).normal(size=(8, 2, 6))
+    mats = [s.evaluate(a, b, inputs={"F": 0.5}) for a, b in y]
+    return r, mats
+
+
+def _same(a, b) -> bool:
+    """Equal to the bit (NaN equal to NaN), through dicts, lists and arrays."""
+    if isinstance(a, dict):
+        return a.keys() == b.keys() and all(_same(a[k], b[k]) for k in a)
+    if isinstance(a, (list, tuple)) and not (a and isinstance(a[0], (int, float))):
+        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b, strict=True))
+    if isinstance(a, str):
+        return a == b
+    if hasattr(a, "force_inertial"):  # a JointWrench
+        return all(_same(getattr(a, k), getattr(b, k))
+                   for k in ("joint", "force", "torque", "force_inertial", "torque_inertial"))
+    x, y = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    return x.shape == y.shape and x.tobytes() == y.tobytes()
+
+
+@native
+def test_native_build_gives_the_portable_numbers_bit_for_bit(monkeypatch):
+    """The native library may use AVX-512 and FMA hardware, but with -ffp-contract=off every
+    operation is rounded as the source writes it: the same trajectory, evaluation counts and
+    matrices as the baseline build, to the last bit (the reference: the portable build)."""
+    try:
+        r_nat, m_nat = _run(monkeypatch, True)
+        r_por, m_por = _run(monkeypatch, False)
+    finally:
+        monkeypatch.delenv("JOURDAIN_NATIVE")
+        numeric.clear_cache()
+        problem.integrator_library.cache_clear()
+    assert r_nat.nfev == r_por.nfev and r_nat.n_accepted == r_por.n_accepted
+    assert np.array_equal(r_nat.t, r_por.t)
+    assert np.array_equal(r_nat.y, r_por.y) and np.array_equal(r_nat.yd, r_por.yd)
+    for a, b in zip(m_nat, m_por, strict=True):
+        assert a.keys() == b.keys() and {"M", "k", "q"} <= a.keys()
+        for name in a:
+            assert _same(a[name], b[name]), name
+
+
+@native
+def test_the_key_names_the_processor(monkeypatch):
+    """A cache shared by two machines never hands one a library built for the other: the key
+    holds what -march=native means here, and the portable build has keys of its own."""
+    k_native = toolchain.content_key("same source")
+    target = toolchain.native_target()
+    assert "-march=" in target or "target-cpu" in target
+    monkeypatch.setattr(toolchain, "_native_target", lambda cc: "-march=some-other-cpu -mavx2")
+    assert toolchain.content_key("same source") != k_native
+    monkeypatch.setenv("JOURDAIN_NATIVE", "0")
+    assert toolchain.native_target() is None and toolchain.host_flags() == ()
+    k_portable = toolchain.content_key("same source")
+    assert k_portable not in (k_native, toolchain.content_key("other source"))
+
+
+def test_a_failing_native_build_falls_back_to_portable_code(monkeypatch, tmp_path):
+    """Where the compiler knows the flag but the build fails (say, an assembler older than the
+    instruction set), the library is built portable and works; later builds skip the flag."""
+    monkeypatch.setenv("JOURDAIN_CACHE", str(tmp_path))
+    monkeypatch.setattr(toolchain, "_native_failed", set())
+    monkeypatch.setattr(toolchain, "NATIVE_FLAGS", ("-mno-such-instruction-set-xyz",))
+    monkeypatch.setattr(toolchain, "_native_target", lambda cc: "-march=fake")
+    assert toolchain.host_flags() == ("-mno-such-instruction-set-xyz",)
+    src = "double jd_twice(double x) { return 2.0 * x; }\n"
+    lib = toolchain.build(toolchain.content_key("fallback test", src), src)
+    lib.jd_twice.restype = ctypes.c_double
+    lib.jd_twice.argtypes = [ctypes.c_double]
+    assert lib.jd_twice(21.0) == 42.0
+    assert toolchain.compiler() in toolchain._native_failed
+    assert toolchain.host_flags() == ()
