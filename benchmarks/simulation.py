@@ -32,7 +32,8 @@ sincos 1 500, the step loop (stage sums, error norm, output) 1 400. The written-
 (numeric/integrator_ldl.py) halves the solve's instructions but is slower at f = 13 (probably:
 its code no longer fits beside M, k, q in the instruction caches), hence used up to f = 10; the
 articulated-body recursion (numeric.dynamics_function) is 4× (n = 12) to 11× (n = 4) slower per
-run here; -march=native on the step loop is slower (AVX-512 on 27-long vectors). GCC unrolls the
+run here. -march=native on the step loop alone is slower (2.30 against 2.10 ms), on the model
+code alone and on both faster (1.88 and 1.78 ms): hence both (numeric/toolchain.py). GCC unrolls the
 LDLᵀ loop's inner loops (ldl_solve.h): 260 → 211-228 ns per solve alone, 7.1-7.3× → 7.6-7.7×
 PyDy end to end at n = 12 (2026-11-23, the two alternated). The 12 sin/cos pairs in one
 vectorized call (numeric/sincos.h) instead of 12 libm sincos: M, k, q 212 → 172 ns, jd_accel 429
@@ -48,6 +49,14 @@ loop also compiled for AVX2 (−20 ns in M, k, q but not in jd_accel). 10× PyDy
 about 400 ns per right-hand side. Fewer right-hand sides with Verner's "most efficient" 7(6)
 pair (10 per step)? No: driven by SciPy's RungeKutta against its DOP853 on the same function, it
 needed as many for the same final error (4 812 evaluations for 7.5e-7 against 4 742 for 6.5e-7).
+Compiled for the machine (-march=native, AVX-512, -ffp-contract=off: bit-identical numbers) and
+with the stage sums in registers: 8.4-8.7× → 9.2-9.4× PyDy at n = 12, 440-470 ns per
+right-hand side (two alternated rounds on a loaded machine). Tried then and not kept: the LDLᵀ
+written out at f = 13 under AVX-512 (32 registers): 343 → 277 ns in the C microbenchmark, but
+1.72 → 1.81 ms end to end (one process, alternated, best of 45); the left-looking loop with the
+forward substitution fused into it, and a vectorized column form (L by columns, -O3, AVX-512):
+no gain and +210 ns; -O3 on the model code: +85 ns; the solve interleaved with the
+computation of k and q: no gain.
 
 PyDy's symbolic linear solver can take long for large n; it is
 skipped above ``--sympy-max-n`` (default 12: its code generation takes about 5 s at n = 12)

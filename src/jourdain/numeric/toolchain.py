@@ -11,10 +11,14 @@ extension of the processor, e.g. AVX-512) where the compiler accepts it, and the
 processor's features as the compiler reports them, so that a cache shared by different machines
 never hands one a library built for another. ``-ffp-contract=off`` keeps every operation of the
 source a separately rounded one (no fused multiply-add the source does not write), so the
-numbers are bit-for-bit those of the portable build; only the speed differs (12-link pendulum on
-a cart, ``benchmarks/simulation.py``: 503 → 429 ns per right-hand side, AMD EPYC with
-AVX-512). ``JOURDAIN_NATIVE=0`` compiles for the architecture's baseline instead. FMUs are not
-built here and stay portable (:mod:`jourdain.io.fmu.binary`).
+numbers are bit-for-bit those of the portable build (tests/test_native.py); only the speed
+differs. Measured with ``benchmarks/simulation.py`` (12-link pendulum on a cart, AMD EPYC with
+AVX-512, alternated with the portable build): M, k, q 222-227 → 179-188 ns, a right-hand side
+480-503 → 440-470 ns, 8.4-8.7× → 9.2-9.4× PyDy. Everything native or nothing: the
+integrator library alone compiled native made the runs slower, not faster (2.30 against 2.10
+ms; probably its AVX code beside the model's SSE code). ``JOURDAIN_NATIVE=0`` compiles for the architecture's
+baseline instead (valgrind, for one, does not know AVX-512). FMUs are not built here and stay
+portable (:mod:`jourdain.io.fmu.binary`).
 
 Loading a library runs its code, so a library is loaded only from a directory that belongs to
 the user and that no one else may write to, and only if the file itself belongs to the user and
