@@ -35,7 +35,7 @@ def _same(a, b) -> bool:
     """Equal to the bit (NaN equal to NaN), through dicts, lists and arrays."""
     if isinstance(a, dict):
         return a.keys() == b.keys() and all(_same(a[k], b[k]) for k in a)
-    if isinstance(a, (list, tuple)) and not (a and isinstance(a[0], (int, float))):
+    if isinstance(a, (list, tuple)):
         return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b, strict=True))
     if isinstance(a, str):
         return a == b
@@ -97,3 +97,17 @@ def test_a_failing_native_build_falls_back_to_portable_code(monkeypatch, tmp_pat
     assert lib.jd_twice(21.0) == 42.0
     assert toolchain.compiler() in toolchain._native_failed
     assert toolchain.host_flags() == ()
+
+
+def test_a_source_that_does_not_compile_leaves_native_code_on(monkeypatch, tmp_path):
+    """The retry without the flag tells a flag at fault from a source at fault: where the
+    portable build fails too, the compiler's error is raised and native code stays on."""
+    monkeypatch.setenv("JOURDAIN_CACHE", str(tmp_path))
+    monkeypatch.setattr(toolchain, "_native_failed", set())
+    monkeypatch.setattr(toolchain, "NATIVE_FLAGS", ("-O2",))
+    monkeypatch.setattr(toolchain, "_native_target", lambda cc: "-march=fake")
+    src = "double jd_broken(double x) { return 2.0 * ; }\n"
+    with pytest.raises(toolchain.CompilerError, match="jd_broken|expected expression"):
+        toolchain.build(toolchain.content_key("broken source", src), src)
+    assert toolchain._native_failed == set()
+    assert toolchain.host_flags() == ("-O2",)

@@ -16,9 +16,9 @@ differs. Measured with ``benchmarks/simulation.py`` (12-link pendulum on a cart,
 AVX-512, alternated with the portable build): M, k, q 222-227 → 179-188 ns, a right-hand side
 480-503 → 440-470 ns, 8.4-8.7× → 9.2-9.4× PyDy. Everything native or nothing: the
 integrator library alone compiled native made the runs slower, not faster (2.30 against 2.10
-ms; probably its AVX code beside the model's SSE code). ``JOURDAIN_NATIVE=0`` compiles for the architecture's
-baseline instead (valgrind, for one, does not know AVX-512). FMUs are not built here and stay
-portable (:mod:`jourdain.io.fmu.binary`).
+ms; probably its AVX code beside the model's SSE code). ``JOURDAIN_NATIVE=0`` compiles for the
+architecture's baseline instead (valgrind, for one, does not know AVX-512). FMUs are not built
+here and stay portable (:mod:`jourdain.io.fmu.binary`).
 
 Loading a library runs its code, so a library is loaded only from a directory that belongs to
 the user and that no one else may write to, and only if the file itself belongs to the user and
@@ -116,15 +116,24 @@ def library_dir() -> Path:
 
 
 def compiler() -> str:
-    """The C compiler: ``$CC``, else ``cc``, ``gcc`` or ``clang`` on the PATH."""
+    """The C compiler: ``$CC``, else ``cc``, ``gcc`` or ``clang`` on the PATH (looked up once
+    per value of ``$CC`` and ``$PATH``: every cache key asks, see :func:`native_target`)."""
     cand = [os.environ["CC"]] if os.environ.get("CC") else ["cc", "gcc", "clang"]
+    where = (*cand, os.environ.get("PATH"))
+    if where in _found:
+        return _found[where]
     for c in cand:
         path = shutil.which(c)
         if path:
+            _found[where] = path  # only what was found: a compiler installed later is seen
             return path
     raise CompilerError(
         "no C compiler found (tried " + ", ".join(cand) + "); jourdain compiles its numeric code "
         "with the system's C compiler: install gcc or clang, or set CC")
+
+
+#: compiler() by ($CC or the default names, $PATH)
+_found: dict[tuple[str | None, ...], str] = {}
 
 
 def keep_file(path: Path, data: bytes) -> None:
@@ -292,10 +301,11 @@ def _build(key: str, source: str | Sequence[str], extra_flags: Sequence[str]) ->
             if not native:
                 raise
             # e.g. an assembler older than the compiler's instruction sets: portable code,
-            # for this process (the key stays: the library is correct on this machine)
-            _native_failed.add(compiler())
+            # for this process (the key stays: the library is correct on this machine); where
+            # the portable build fails too, the source is at fault, not the flag
             compile_shared(dict(zip(names, units, strict=True)), names, so,
                            (*CFLAGS, *extra_flags))
+            _native_failed.add(compiler())
     except CompilerError as exc:
         raise CompilerError(f"compiling {src} failed:\n{str(exc)[-4000:]}") from None
     lib = ctypes.CDLL(str(so))
