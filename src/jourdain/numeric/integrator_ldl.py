@@ -46,9 +46,11 @@ def ldl_source(f: int) -> str:
            "double *ydd, double *L) {",
            "    (void)L;",
            "    double dmax = 0.0;"]
-    # a{i}_{j}, i >= j: the lower triangle of M, overwritten by d_j·l_ij during the elimination
+    # a{i}_{j}, i >= j: the lower triangle of M, read from the upper one (M_ij = M_ji: the
+    # generated jd_fn_upper leaves the lower one unwritten), overwritten by d_j·l_ij during
+    # the elimination
     for i in range(f):
-        out.append("    double " + ", ".join(f"a{i}_{j} = M[{i * f + j}]" for j in range(i + 1))
+        out.append("    double " + ", ".join(f"a{i}_{j} = M[{j * f + i}]" for j in range(i + 1))
                    + ";")
     for i in range(f):  # written as a comparison: fmax is a library call at -O2
         out.append(f"    {{ double t_ = fabs(a{i}_{i}); dmax = t_ > dmax ? t_ : dmax; }}")

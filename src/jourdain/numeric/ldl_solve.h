@@ -1,7 +1,9 @@
 
 #ifndef JD_SOLVE_MKQ
 #define JD_SOLVE_MKQ
-/* ÿ = M⁻¹(q − k) by LDLᵀ of the projected M; 0, 1 (M not positive definite) or 2 (NaN) */
+/* ÿ = M⁻¹(q − k) by LDLᵀ of the projected M, read from its diagonal and upper triangle
+   (the generated jd_fn_upper leaves the lower one unwritten); 0, 1 (M not positive
+   definite) or 2 (NaN) */
 #if defined(__GNUC__) && !defined(__clang__)
 /* GCC: its short inner loops unrolled (-O2 does not): 15 % less time per solve at f = 13, the
    operations and their order unchanged (no reassociation), so the results are too */
@@ -17,7 +19,7 @@ static int jd_solve_mkq(const double *M, const double *k, const double *q, doubl
         if (!(d > 1e-13 * dmax)) return isfinite(d) ? 1 : 2;
         D[j] = d; Dinv[j] = 1.0 / d;
         for (int i = j + 1; i < JD_F; ++i) {
-            double s = M[i * JD_F + j];
+            double s = M[j * JD_F + i];  /* the upper triangle: M_ji = M_ij */
             for (int m = 0; m < j; ++m) s -= L[i * JD_F + m] * E[m];
             L[i * JD_F + j] = s * Dinv[j];
         }
