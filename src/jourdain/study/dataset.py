@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import json
 from collections.abc import Sequence
+from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
@@ -36,9 +37,11 @@ def xarray() -> Any:
     return xr
 
 
+@lru_cache(maxsize=1)
 def _version() -> str:
     """The installed jourdain's version (from its distribution: this module sits below the
-    package's ``__init__``, which holds the same number)."""
+    package's ``__init__``, which holds the same number); read once per process (the
+    distribution's metadata: 1.3 ms, 2 % of a 10 000-case stability map)."""
     from importlib.metadata import PackageNotFoundError, version
 
     try:
