@@ -253,10 +253,18 @@ def _function_source(name: str, exprs: Sequence[se.Basic], names: Mapping[str, s
     code: dict[int, str] = {}
 
     def emit(i: int) -> str:
-        """The C of node ``i`` (its arguments emitted before; a smaller sum that it builds on
-        is emitted here, where it comes later in the graph's order)."""
+        """The C of node ``i`` (its arguments emitted before). The smaller sums that it builds
+        on and that come later in the graph's order are emitted first, innermost first (a
+        loop, not a recursion: a chain of nested sums may be long)."""
         if i in code:
             return code[i]
+        chain = []
+        b = subset.get(i)
+        while b is not None and b not in code:
+            chain.append(b)
+            b = subset.get(b)
+        for b in reversed(chain):
+            emit(b)
         node, node_args, arg_ids = g.node[i], g.args[i], g.arg_ids[i]
         tn = type(node).__name__
         if tn in ("sin", "cos") and TRIG_SUMS:
@@ -271,7 +279,7 @@ def _function_source(name: str, exprs: Sequence[se.Basic], names: Mapping[str, s
             b = subset[i]
             inner = set(term_keys(g, b))
             rest = [x for x, k in zip(a, term_keys(g, i), strict=True) if k not in inner]
-            c = "(" + " + ".join([emit(b), *rest]) + ")"
+            c = "(" + " + ".join([code[b], *rest]) + ")"
         else:
             c = _node(node, a, node_args)
         # a node used more than once becomes a temporary; -x of an atom is not worth one
