@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import JourdainError
+from ..simulation.problem import build_integrator_soon
 from ..simulation.simulate import DEFAULT_ATOL, DEFAULT_RTOL
 from .cli import linearization_document, linearize_near
 from .closed_loop import ClosedLoopSystem, constraints
@@ -104,6 +105,7 @@ def run_report(model: Any, out: Path, parameters: Mapping[str, float] | None = N
     # Matplotlib imported and the figures drawn in a process forked now, while this one
     # simulates and linearizes (where there are two cores)
     painter = Painter()
+    build_integrator_soon()  # compiled while the loop's equations are derived
     try:
         return _report(model, out, parameters, t_end, painter)
     finally:

@@ -10,38 +10,6 @@
  * Events go to ev_t/ev_x/ev_i (capacity ev_cap). cnt: nfev, nstep, naccept, nreject, have_k0.
  * On an error, fail[0] = t and fail[1..n] = the state at which it happened.
  */
-/* out = x + h·Σ_j a[j]·K_j over the stages j < s with a[j] ≠ 0 (the zeros of the tables
-   skipped; x NULL: 0 + h·Σ ...): each component's sum kept in a register over the stages, four
-   components at a time, instead of out[] read and written once per stage, the terms added in
-   the order of j as before, so the results are bit-identical to that form; 1.5-7 % less time
-   per run of the n-link pendulum on a cart (n = 12 and 4) */
-static void stage_sum(long n, int s, double h, const double *a, const double *x,
-                      const double *K, double *out) {
-    double w[16];
-    const double *Kp[16];
-    int q = 0;
-    for (int j = 0; j < s; ++j) {
-        double aj = h * a[j];
-        if (aj == 0.0) continue;
-        w[q] = aj; Kp[q] = K + j * n; ++q;
-    }
-    long i = 0;
-    for (; i + 4 <= n; i += 4) {
-        double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
-        if (x) { s0 = x[i]; s1 = x[i + 1]; s2 = x[i + 2]; s3 = x[i + 3]; }
-        for (int t = 0; t < q; ++t) {
-            const double *kt = Kp[t] + i, wt = w[t];
-            s0 += wt * kt[0]; s1 += wt * kt[1]; s2 += wt * kt[2]; s3 += wt * kt[3];
-        }
-        out[i] = s0; out[i + 1] = s1; out[i + 2] = s2; out[i + 3] = s3;
-    }
-    for (; i < n; ++i) {
-        double s0 = x ? x[i] : 0.0;
-        for (int t = 0; t < q; ++t) s0 += w[t] * Kp[t][i];
-        out[i] = s0;
-    }
-}
-
 int jd_integrate(const jd_problem *P, double t_end, double *st, double *x, double *k0,
                  double *g_old, long *cnt, const double *t_eval, long n_eval, long *i_eval,
                  double *out_t, double *out_x, double *out_dx, long cap, long *n_out,
@@ -140,26 +108,16 @@ int jd_integrate(const jd_problem *P, double t_end, double *st, double *x, doubl
             continue;
         }
         /* error estimate */
-        for (long i = 0; i < n; ++i) {  /* both finite here: a comparison, not fmax's call */
-            double a = fabs(x[i]), b = fabs(x_new[i]);
-            sc[i] = P->atol[i] + P->rtol * (a > b ? a : b);
-        }
+        error_scales(n, P->atol, P->rtol, x, x_new, sc);
         double en;
         if (P->method == 1) {
             double e5 = 0.0, e3 = 0.0, *a3v = xe;
             stage_sum(n, S + 1, 1.0, RK8_E5, NULL, K, err);
             stage_sum(n, S + 1, 1.0, RK8_E3, NULL, K, a3v);
-            for (long i = 0; i < n; ++i) {
-                double a5 = err[i] / sc[i], a3 = a3v[i] / sc[i];
-                e5 += a5 * a5; e3 += a3 * a3;
-            }
+            error_sums8(n, err, a3v, sc, &e5, &e3);
             en = (e5 == 0.0 && e3 == 0.0) ? 0.0 : h * e5 / sqrt((e5 + 0.01 * e3) * (double)n);
         } else {
-            for (long i = 0; i < n; ++i) {
-                double a = 0.0;
-                for (int j = 0; j <= S; ++j) a += RK5_E[j] * K[j * n + i];
-                err[i] = h * a;
-            }
+            error_rk5(n, S + 1, h, RK5_E, K, err);
             en = rms_scaled(n, err, sc);
         }
         if (!(en <= 1.0)) {

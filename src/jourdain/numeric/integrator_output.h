@@ -9,12 +9,6 @@ typedef struct {
     double pi_alpha, pi_beta;  /* PI control of accepted steps: 0.7/k and 0.4/k */
 } jd_method;
 
-static double rms_scaled(long n, const double *v, const double *sc) {
-    double s = 0.0;
-    for (long i = 0; i < n; ++i) { double r = v[i] / sc[i]; s += r * r; }
-    return sqrt(s / (double)n);
-}
-
 typedef struct {
     jd_ctx *c;
     const jd_method *m;

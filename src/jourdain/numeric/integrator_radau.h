@@ -1,87 +1,6 @@
 /* jourdain's integrator library, part 3 of 4: Radau IIA of order 5 (Hairer & Wanner II, IV.8):
- * real and complex LU, the forward-difference Jacobian, the simplified Newton iteration and the
- * step loop. */
-/* ---- dense linear algebra for Radau IIA ---- */
-static int lu_real(long n, double *A, long *piv) {
-    for (long k = 0; k < n; ++k) {
-        long p = k;
-        double best = fabs(A[k * n + k]);
-        for (long i = k + 1; i < n; ++i) if (fabs(A[i * n + k]) > best) { best = fabs(A[i * n + k]); p = i; }
-        piv[k] = p;
-        if (best == 0.0 || !isfinite(best)) return 1;
-        if (p != k) for (long j = 0; j < n; ++j) { double tmp = A[k * n + j]; A[k * n + j] = A[p * n + j]; A[p * n + j] = tmp; }
-        for (long i = k + 1; i < n; ++i) {
-            double l = A[i * n + k] / A[k * n + k];
-            A[i * n + k] = l;
-            for (long j = k + 1; j < n; ++j) A[i * n + j] -= l * A[k * n + j];
-        }
-    }
-    return 0;
-}
-
-static void lu_solve_real(long n, const double *A, const long *piv, double *b) {
-    for (long k = 0; k < n; ++k) { long p = piv[k]; if (p != k) { double tmp = b[k]; b[k] = b[p]; b[p] = tmp; } }
-    for (long i = 0; i < n; ++i) { double s = b[i]; for (long j = 0; j < i; ++j) s -= A[i * n + j] * b[j]; b[i] = s; }
-    for (long i = n - 1; i >= 0; --i) { double s = b[i]; for (long j = i + 1; j < n; ++j) s -= A[i * n + j] * b[j]; b[i] = s / A[i * n + i]; }
-}
-
-/* complex matrices as separate real and imaginary parts (no C99 complex needed) */
-static int lu_cplx(long n, double *Ar, double *Ai, long *piv) {
-    for (long k = 0; k < n; ++k) {
-        long p = k;
-        double best = hypot(Ar[k * n + k], Ai[k * n + k]);
-        for (long i = k + 1; i < n; ++i) {
-            double a = hypot(Ar[i * n + k], Ai[i * n + k]);
-            if (a > best) { best = a; p = i; }
-        }
-        piv[k] = p;
-        if (best == 0.0 || !isfinite(best)) return 1;
-        if (p != k) for (long j = 0; j < n; ++j) {
-            double tr = Ar[k * n + j], ti = Ai[k * n + j];
-            Ar[k * n + j] = Ar[p * n + j]; Ai[k * n + j] = Ai[p * n + j];
-            Ar[p * n + j] = tr; Ai[p * n + j] = ti;
-        }
-        double dr = Ar[k * n + k], di = Ai[k * n + k], dd = dr * dr + di * di;
-        for (long i = k + 1; i < n; ++i) {
-            double ar = Ar[i * n + k], ai = Ai[i * n + k];
-            double lr = (ar * dr + ai * di) / dd, li = (ai * dr - ar * di) / dd;
-            Ar[i * n + k] = lr; Ai[i * n + k] = li;
-            for (long j = k + 1; j < n; ++j) {
-                double br = Ar[k * n + j], bi = Ai[k * n + j];
-                Ar[i * n + j] -= lr * br - li * bi;
-                Ai[i * n + j] -= lr * bi + li * br;
-            }
-        }
-    }
-    return 0;
-}
-
-static void lu_solve_cplx(long n, const double *Ar, const double *Ai, const long *piv,
-                          double *br, double *bi) {
-    for (long k = 0; k < n; ++k) {
-        long p = piv[k];
-        if (p != k) { double t = br[k]; br[k] = br[p]; br[p] = t; t = bi[k]; bi[k] = bi[p]; bi[p] = t; }
-    }
-    for (long i = 0; i < n; ++i) {
-        double sr = br[i], si = bi[i];
-        for (long j = 0; j < i; ++j) {
-            sr -= Ar[i * n + j] * br[j] - Ai[i * n + j] * bi[j];
-            si -= Ar[i * n + j] * bi[j] + Ai[i * n + j] * br[j];
-        }
-        br[i] = sr; bi[i] = si;
-    }
-    for (long i = n - 1; i >= 0; --i) {
-        double sr = br[i], si = bi[i];
-        for (long j = i + 1; j < n; ++j) {
-            sr -= Ar[i * n + j] * br[j] - Ai[i * n + j] * bi[j];
-            si -= Ar[i * n + j] * bi[j] + Ai[i * n + j] * br[j];
-        }
-        double dr = Ar[i * n + i], di = Ai[i * n + i], dd = dr * dr + di * di;
-        br[i] = (sr * dr + si * di) / dd;
-        bi[i] = (si * dr - sr * di) / dd;
-    }
-}
-
+ * the forward-difference Jacobian, the simplified Newton iteration and the step loop (its LU
+ * factorizations and loops over the state vector are in integrator_kernels.h). */
 /* forward-difference Jacobian J[i*n + j] = d f_i / d x_j; the work W (last component) does not
    enter the right-hand side, so its column is zero */
 static int jacobian(jd_ctx *c, double t, const double *x, const double *f0, double *J,
@@ -113,51 +32,27 @@ static int collocation(jd_ctx *c, jd_radau_ws *w, double t, const double *x, dou
     long n = c->n;
     double mr = RADAU_MU_REAL / h;
     double mcr = RADAU_MU_CPLX[0] / h, mci = RADAU_MU_CPLX[1] / h;
-    for (int k = 0; k < 3; ++k)
-        for (long i = 0; i < n; ++i) {
-            double a = 0.0;
-            for (int j = 0; j < 3; ++j) a += RADAU_TI[k * 3 + j] * w->Z0[j * n + i];
-            w->W[k * n + i] = a;
-        }
+    radau_transform(n, RADAU_TI, w->Z0, w->W);
     memcpy(w->Z, w->Z0, 3 * n * sizeof(double));
     double dw_old = -1.0, rate = -1.0;
     int converged = 0, k;
     for (k = 0; k < 6; ++k) {
         for (int st = 0; st < 3; ++st) {
-            for (long i = 0; i < n; ++i) w->xs[i] = x[i] + w->Z[st * n + i];
+            vector_sum(n, x, w->Z + st * n, w->xs);
             int r = rhs(c, t + RADAU_C[st] * h, w->xs, w->F + st * n);
             if (r == JD_ECALLBACK || r == JD_ENOMEM) return r;
             if (r) { *n_iter = k + 1; *rate_out = rate; return 0; }
         }
-        for (long i = 0; i < n; ++i) {
-            double a = 0.0, b = 0.0, e = 0.0;
-            for (int st = 0; st < 3; ++st) {
-                a += w->F[st * n + i] * RADAU_TI[0 * 3 + st];
-                b += w->F[st * n + i] * RADAU_TI[1 * 3 + st];
-                e += w->F[st * n + i] * RADAU_TI[2 * 3 + st];
-            }
-            w->fr[i] = a - mr * w->W[i];
-            /* (b + i e) - (mcr + i mci) (W1 + i W2) */
-            w->dW[n + i] = b - (mcr * w->W[n + i] - mci * w->W[2 * n + i]);
-            w->dW[2 * n + i] = e - (mcr * w->W[2 * n + i] + mci * w->W[n + i]);
-        }
+        radau_residual(n, RADAU_TI, w->F, w->W, mr, mcr, mci, w->fr, w->dW);
         lu_solve_real(n, w->LUr, w->pr, w->fr);
         lu_solve_cplx(n, w->LCr, w->LCi, w->pc, w->dW + n, w->dW + 2 * n);
         memcpy(w->dW, w->fr, n * sizeof(double));
-        double s = 0.0;
-        for (int q = 0; q < 3; ++q)
-            for (long i = 0; i < n; ++i) { double v = w->dW[q * n + i] / w->sc[i]; s += v * v; }
-        double dw = sqrt(s / (3.0 * (double)n));
+        double dw = sqrt(radau_sum_squares(n, w->dW, w->sc) / (3.0 * (double)n));
         if (!isfinite(dw)) break;
         if (dw_old >= 0.0) rate = dw / dw_old;
         if (rate >= 0.0 && (rate >= 1.0 || pow(rate, 6 - k) / (1.0 - rate) * dw > tol)) break;
-        for (long i = 0; i < 3 * n; ++i) w->W[i] += w->dW[i];
-        for (int q = 0; q < 3; ++q)
-            for (long i = 0; i < n; ++i) {
-                double a = 0.0;
-                for (int j = 0; j < 3; ++j) a += RADAU_T[q * 3 + j] * w->W[j * n + i];
-                w->Z[q * n + i] = a;
-            }
+        vector_sum(3 * n, w->W, w->dW, w->W);
+        radau_transform(n, RADAU_T, w->W, w->Z);
         if (dw == 0.0 || (rate >= 0.0 && rate / (1.0 - rate) * dw < tol)) { converged = 1; break; }
         dw_old = dw;
     }
@@ -168,16 +63,7 @@ static int collocation(jd_ctx *c, jd_radau_ws *w, double t, const double *x, dou
 
 static int radau_lu(jd_radau_ws *w, long n, double h) {
     double mr = RADAU_MU_REAL / h, mcr = RADAU_MU_CPLX[0] / h, mci = RADAU_MU_CPLX[1] / h;
-    for (long i = 0; i < n * n; ++i) {
-        w->LUr[i] = -w->J[i];
-        w->LCr[i] = -w->J[i];
-        w->LCi[i] = 0.0;
-    }
-    for (long i = 0; i < n; ++i) {
-        w->LUr[i * n + i] += mr;
-        w->LCr[i * n + i] += mcr;
-        w->LCi[i * n + i] += mci;
-    }
+    radau_matrices(n, w->J, mr, mcr, mci, w->LUr, w->LCr, w->LCi);
     return lu_real(n, w->LUr, w->pr) || lu_cplx(n, w->LCr, w->LCi, w->pc);
 }
 

@@ -1,4 +1,5 @@
-/* jourdain's integrator library, part 1 of 4 (numeric/integrator_c.py joins them): the problem
+/* jourdain's integrator library, part 1 of 4 (numeric/integrator_c.py joins them, with the
+ * declarations of integrator_kernels.h after this one): the problem
  * a run integrates, its inputs, and the right-hand side dx = [yd, M^-1 (q - k), yd.q]. */
 #include <math.h>
 #include <stdlib.h>

@@ -225,13 +225,15 @@ def cached_library(key: str) -> ctypes.CDLL | None:
 
 
 def compile_shared(sources: Mapping[str, str | bytes], units: Sequence[str], out: Path,
-                   flags: Sequence[str]) -> None:
+                   flags: Sequence[str],
+                   unit_flags: Sequence[Sequence[str]] | None = None) -> None:
     """Compile the translation ``units`` (names in ``sources``, which may also hold the headers
     they include) into the shared library ``out``: each unit by its own compiler process, in
     parallel, then linked. The sources are written into a private folder beside ``out`` (the
     include path), removed afterwards; ``out`` is written under a private name and renamed into
     place, so a concurrent reader never sees half a library. ``flags`` are for compiling
-    (``-shared`` is for the link alone and dropped there). CompilerError names the unit."""
+    (``-shared`` is for the link alone and dropped there); ``unit_flags``, one per unit, follow
+    them for that unit alone (``-O3`` overrides ``-O2``). CompilerError names the unit."""
     cc = compiler()
     compile_flags = [f for f in flags if f != "-shared"]
     work = Path(tempfile.mkdtemp(prefix=".build-", dir=out.parent))
@@ -239,10 +241,11 @@ def compile_shared(sources: Mapping[str, str | bytes], units: Sequence[str], out
         for name, text in sources.items():
             (work / name).write_bytes(text if isinstance(text, bytes) else text.encode())
         objects = [work / f"{Path(u).stem}.o" for u in units]
-        procs = [subprocess.Popen([cc, *compile_flags, f"-I{work}", "-c", "-o", str(o),
+        own = list(unit_flags) if unit_flags is not None else [()] * len(units)
+        procs = [subprocess.Popen([cc, *compile_flags, *fl, f"-I{work}", "-c", "-o", str(o),
                                    str(work / u)],
                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-                 for u, o in zip(units, objects, strict=True)]
+                 for u, o, fl in zip(units, objects, own, strict=True)]
         errors = [p.communicate()[1] for p in procs]
         for p, e, u in zip(procs, errors, units, strict=True):
             if p.returncode != 0:
@@ -258,13 +261,15 @@ def compile_shared(sources: Mapping[str, str | bytes], units: Sequence[str], out
         shutil.rmtree(work, ignore_errors=True)
 
 
-def build(key: str, source: str | Sequence[str], extra_flags: Sequence[str] = ()) -> ctypes.CDLL:
+def build(key: str, source: str | Sequence[str], extra_flags: Sequence[str] = (),
+          unit_flags: Sequence[Sequence[str]] | None = None) -> ctypes.CDLL:
     """Compile ``source`` to ``<cache>/<key>.so`` (unless there) and load it.
 
     ``source`` may be several translation units: they are compiled in parallel (one compiler
     process each, :func:`compile_shared`) and linked into one library; ``<key>.c`` keeps them
-    one after the other. ``extra_flags`` follow :data:`CFLAGS` (``-O3`` overrides ``-O2``); the
-    caller puts them in ``key`` (:func:`content_key`).
+    one after the other. ``extra_flags`` follow :data:`CFLAGS` (``-O3`` overrides ``-O2``), and
+    ``unit_flags`` (one per unit) follow those for one unit; the caller puts them in ``key``
+    (:func:`content_key`).
     """
     lib = cached_library(key)
     if lib is not None:
@@ -273,14 +278,15 @@ def build(key: str, source: str | Sequence[str], extra_flags: Sequence[str] = ()
         lock = _BUILDING.setdefault(key, threading.Lock())
     with lock:
         lib = cached_library(key)  # built meanwhile by another thread
-        return lib if lib is not None else _build(key, source, extra_flags)
+        return lib if lib is not None else _build(key, source, extra_flags, unit_flags)
 
 
 _BUILDING: dict[str, threading.Lock] = {}
 _BUILDING_GUARD = threading.Lock()
 
 
-def _build(key: str, source: str | Sequence[str], extra_flags: Sequence[str]) -> ctypes.CDLL:
+def _build(key: str, source: str | Sequence[str], extra_flags: Sequence[str],
+           unit_flags: Sequence[Sequence[str]] | None) -> ctypes.CDLL:
     units = [source] if isinstance(source, str) else list(source)
     d = library_dir()
     so = d / f"{key}.so"
@@ -296,7 +302,7 @@ def _build(key: str, source: str | Sequence[str], extra_flags: Sequence[str]) ->
     try:
         try:
             compile_shared(dict(zip(names, units, strict=True)), names, so,
-                           (*CFLAGS, *native, *extra_flags))
+                           (*CFLAGS, *native, *extra_flags), unit_flags)
         except CompilerError:
             if not native:
                 raise
@@ -304,7 +310,7 @@ def _build(key: str, source: str | Sequence[str], extra_flags: Sequence[str]) ->
             # for this process (the key stays: the library is correct on this machine); where
             # the portable build fails too, the source is at fault, not the flag
             compile_shared(dict(zip(names, units, strict=True)), names, so,
-                           (*CFLAGS, *extra_flags))
+                           (*CFLAGS, *extra_flags), unit_flags)
             _native_failed.add(compiler())
     except CompilerError as exc:
         raise CompilerError(f"compiling {src} failed:\n{str(exc)[-4000:]}") from None

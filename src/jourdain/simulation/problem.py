@@ -9,6 +9,7 @@ import ctypes
 import inspect
 import math
 import numbers
+import threading
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from functools import lru_cache
@@ -20,7 +21,7 @@ import symengine as se
 from ..errors import EvaluationError, JourdainError
 from ..model.expressions import as_expr
 from ..numeric import CompiledFunction, lambdify
-from ..numeric.integrator_c import source as integrator_source
+from ..numeric.integrator_c import units as integrator_units
 from ..numeric.toolchain import build, content_key
 from ..symbolic import SymMatrix
 
@@ -70,17 +71,16 @@ _CALLBACK = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, ctypes.POINTER(ctype
                              ctypes.POINTER(ctypes.c_double), ctypes.POINTER(ctypes.c_double))
 
 
-#: compiler flags of the integrator library, after toolchain.CFLAGS
-INTEGRATOR_FLAGS = ("-O3",)
-
-
 @lru_cache(maxsize=1)
 def integrator_library() -> ctypes.CDLL:
-    """The compiled integrator (built once, cached on disk like the model code)."""
-    src = integrator_source()
-    # -O3: the stage sums and the error norm over the state vector are vectorized; 10 % less
-    # time per right-hand side at 2f + 1 = 27 states (12-link pendulum on a cart), 3 % at 11
-    lib = build(content_key("integrator", src, *INTEGRATOR_FLAGS), src, INTEGRATOR_FLAGS)
+    """The compiled integrator (built once, cached on disk like the model code): two
+    translation units, the step loops at -O2 and the kernels at -O3
+    (:data:`jourdain.numeric.integrator_c.UNITS`)."""
+    units = integrator_units()
+    texts = [text for text, _ in units]
+    flags = [fl for _, fl in units]
+    lib = build(content_key("integrator", *texts, *(" ".join(f) for f in flags)), texts,
+                unit_flags=flags)
     vp, lg, db = ctypes.c_void_p, ctypes.c_long, ctypes.c_double
     lib.jd_integrate.restype = ctypes.c_int
     lib.jd_integrate.argtypes = [vp, db, vp, vp, vp, vp, vp, vp, lg, vp, vp, vp, vp, lg, vp, vp,
@@ -88,6 +88,28 @@ def integrator_library() -> ctypes.CDLL:
     lib.jd_rhs.restype = ctypes.c_int
     lib.jd_rhs.argtypes = [vp, db, vp, vp, vp]
     return lib
+
+
+def build_integrator_soon() -> None:
+    """Start compiling the integrator library in a thread and return at once (the compiler
+    runs in a process of its own, on another core): for a caller that will simulate after
+    other work, such as ``jourdain run``, which derives, compiles and evaluates the model
+    meanwhile. Where the library is built or cached already, nothing is done. A later
+    :func:`integrator_library` waits for the build (:func:`build` holds one lock per library),
+    or builds it itself where this one failed, and raises its error then. Call it after any
+    ``fork`` of this process: a forked child would hold a copy of the build's lock."""
+    if integrator_library.cache_info().currsize:
+        return
+    # not a daemon: an exit waits for the compiler (Ctrl-C stops the compiler with it), so
+    # that no half-built library is left in the cache
+    threading.Thread(target=_build_quietly, name="jourdain-integrator-build").start()
+
+
+def _build_quietly() -> None:
+    try:
+        integrator_library()
+    except Exception:  # noqa: BLE001 - the caller's own integrator_library() reports it
+        pass
 
 
 @overload

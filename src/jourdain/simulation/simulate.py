@@ -75,7 +75,6 @@ from .options import (  # noqa: F401 - the import paths of the options stay thos
     steps_per_call,
 )
 from .problem import (  # noqa: F401 - re-exported: the ensemble driver builds on them
-    INTEGRATOR_FLAGS,
     Event,
     _Problem,
     _Setup,
@@ -88,7 +87,7 @@ if TYPE_CHECKING:
     from ..model.system import System
 
 __all__ = ["ATOL_MAX", "C_METHODS", "DEFAULT_ATOL", "DEFAULT_METHOD", "DEFAULT_RTOL",
-           "DEFAULT_SAMPLES", "DEFAULT_T_END", "INTEGRATOR_FLAGS", "MAX_OUTPUT_BYTES",
+           "DEFAULT_SAMPLES", "DEFAULT_T_END", "MAX_OUTPUT_BYTES",
            "MAX_SAMPLES", "MAX_STEPS", "MAX_TIME", "MIN_SAMPLES", "OUTPUT_SUFFIXES", "RTOL_MIN",
            "SCIPY_METHODS", "Event", "IntegrationError", "accelerations", "check_atol",
            "check_max_step", "check_method", "check_rtol", "check_samples", "check_t_end",

@@ -12,8 +12,9 @@ from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 from typing import Any
 
+from ...simulation.problem import build_integrator_soon
 from ...version import __version__
-from ...workflow import summary
+from ...workflow import has_capability, summary
 from .. import export
 from ..modelfile import ModelFile
 from .equations import (
@@ -100,6 +101,8 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
         set_pending(model, max_ops)
         pool = fork_workers(prepare_worker)
         set_pending(None, max_ops)  # the worker has its copy
+    if has_capability("simulate"):  # compiled while the equations and numbers are computed
+        build_integrator_soon()
     try:
         summ = summary(model)  # the symbolic equations and reactions
         display: Future[Display] | None = None
