@@ -168,3 +168,28 @@ def test_figures_of_a_lost_worker_are_drawn_here():
         assert lost.fill(page) == expected
     finally:
         pool.shutdown()
+
+
+def test_the_numbers_never_import_sympy(tmp_path):
+    """``jourdain run``'s own process computes the numbers (matrices, numeric linearization,
+    simulation) with SymEngine alone; SymPy (0.3 s to import) is for the display, in the
+    worker. A comparison of None with a SymEngine number had imported it. Checked in a fresh
+    process on the robot arm (its Pow nodes go through the numeric jet's base test)."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys, numpy as np\n"
+        "from jourdain.io import load_model\n"
+        "from jourdain.workflow.evaluation import evaluate_all\n"
+        f"m = load_model({str(ROOT / 'examples' / 'robot_arm.toml')!r})\n"
+        "s = m.system\n"
+        "v, extra, missing = evaluate_all(m, np.array(m.simulation.y0, float),\n"
+        "    np.array(m.simulation.yd0, float), 0.0, {}, {})\n"
+        "assert 'A' in v or 'M' in v, sorted(v)\n"
+        "r = s.simulate((0.0, 0.1), m.simulation.y0, m.simulation.yd0)\n"
+        "print('sympy' in sys.modules, sorted(v)[:3])\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         env={**__import__("os").environ, "JOURDAIN_CACHE": str(tmp_path)})
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.startswith("False"), out.stdout

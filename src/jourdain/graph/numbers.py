@@ -68,7 +68,10 @@ def _float_values(g: Graph, values: Mapping[str, float]) -> dict[int, float]:
         elif name == "Pow":
             b, e = args
             try:
-                v = math.exp(e) if g.atoms.get(children[k][0]) == se.E else b**e
+                base = g.atoms.get(children[k][0])
+                # `is not None` first: comparing None with a SymEngine number imports SymPy
+                # (0.3 s) to convert it
+                v = math.exp(e) if base is not None and base == se.E else b**e
             except (ZeroDivisionError, OverflowError):
                 raise JourdainError(f"{b}**{e}: division by zero or overflow") from None
             if isinstance(v, complex):
