@@ -96,7 +96,7 @@ def _layout(system: System) -> tuple[tuple[Any, ...], list[Any], dict[str, SymMa
 
 @lru_cache(maxsize=32)
 def _compiled(system: System) -> Any:
-    return lambdify(system, _layout(system)[2])
+    return lambdify(system, _layout(system)[2], lean=True)
 
 
 def _assemble(joints: Sequence[Any], g: np.ndarray, nums: Mapping[str, np.ndarray]

@@ -34,7 +34,7 @@ def pose_function(system: System) -> Any:
     for i, jm in enumerate(joint_motions(system)):
         mats[f"A{i}"] = SymMatrix.from_rows([list(row) for row in jm.A])
         mats[f"d{i}"] = SymMatrix.column(list(jm.d))
-    return lambdify(system, mats)
+    return lambdify(system, mats, lean=True)
 
 
 def quaternions(S: np.ndarray) -> np.ndarray:

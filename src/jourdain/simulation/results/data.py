@@ -32,7 +32,7 @@ def _positions_function(system: System) -> Any:
     for bk in kin.bodies:
         mats[f"{bk.name}.r_O"] = bk.r_O
         mats[f"{bk.name}.r"] = bk.r
-    return lambdify(system, mats)
+    return lambdify(system, mats, lean=True)
 
 
 

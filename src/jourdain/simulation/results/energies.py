@@ -33,7 +33,8 @@ def _energy_function(system: System) -> tuple[Any, bool, tuple[str, ...], bool]:
     from ...symbolic import SymMatrix
 
     e = energy(kinematics(system))
-    fn = lambdify(system, {"T": SymMatrix.column([e.T]), "V": SymMatrix.column([e.V])})
+    fn = lambdify(system, {"T": SymMatrix.column([e.T]), "V": SymMatrix.column([e.V])},
+                  lean=True)
     return fn, e.conservative, e.nonconservative, e.rheonomic
 
 
@@ -48,7 +49,7 @@ def _potential_rate_function(system: System) -> Any:
     rate = se.diff(energy(kinematics(system)).V, system.t)
     if rate.is_Number and rate == 0:
         return None
-    return lambdify(system, {"dVdt": SymMatrix.column([rate])})
+    return lambdify(system, {"dVdt": SymMatrix.column([rate])}, lean=True)
 
 
 @lru_cache(maxsize=32)
@@ -78,7 +79,8 @@ def _drive_power_function(system: System) -> Any:
                   if Mv[r] != zero and ne.J_bar[r, j] != zero)) for j in range(system.f)]
     b = se.Add(*(v[r] * ne.q_c[r] for r in range(n6) if v[r] != zero),
                se.diff(energy(kin).V, system.t))
-    return lambdify(system, {"a": SymMatrix.column(a), "b": SymMatrix.column([b])})
+    return lambdify(system, {"a": SymMatrix.column(a), "b": SymMatrix.column([b])},
+                    lean=True)
 
 
 
