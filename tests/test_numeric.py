@@ -139,9 +139,9 @@ def test_threads_building_one_library_compile_it_once(cache, monkeypatch):
     compiles: list[str] = []
     real = build.compile_shared
 
-    def counted(sources, units, out, flags):  # noqa: ANN001, ANN202
+    def counted(sources, units, out, flags, unit_flags=None):  # noqa: ANN001, ANN202
         compiles.append(out.name)
-        return real(sources, units, out, flags)
+        return real(sources, units, out, flags, unit_flags)
 
     monkeypatch.setattr(build, "compile_shared", counted)
     src = "double jd_twice(double x) { return 2.0 * x; }\n"
