@@ -107,7 +107,7 @@ def test_period_is_checked(mathieu):
         floquet(mathieu, -np.pi)
 
 
-def _mathieu_multipliers(a, q):
+def _mathieu_monodromy(a, q):
     """An independent integration of the Mathieu equation over τ = 0 … π (SciPy only)."""
     def rhs(t, z):
         Z = z.reshape(2, 2)
@@ -115,7 +115,11 @@ def _mathieu_multipliers(a, q):
 
     sol = solve_ivp(rhs, (0, np.pi), np.eye(2).ravel(), method="DOP853", rtol=1e-12,
                     atol=1e-14)
-    return np.linalg.eigvals(sol.y[:, -1].reshape(2, 2))
+    return sol.y[:, -1].reshape(2, 2)
+
+
+def _mathieu_multipliers(a, q):
+    return np.linalg.eigvals(_mathieu_monodromy(a, q))
 
 
 @pytest.fixture(scope="module")
@@ -213,3 +217,128 @@ def test_example_energy_balance(pendulum):
         res = capabilities.simulate(pendulum, parameters=params, t_end=0.5)
         assert res.energy_balance_error <= 1e-7
         assert np.abs(res.work_nonconservative).max() <= 1e-7 * np.abs(res.work_drive).max()
+
+
+SHAKEN_DOUBLE = """
+[model]
+name = "shaken double pendulum with a spinning disc"
+[coordinates]
+phi1 = {}
+phi2 = {}
+psi = {}
+[parameters]
+m1 = { value = 1.0 }
+m2 = { value = 0.6 }
+l1 = { value = 0.8 }
+l2 = { value = 0.5 }
+J = { value = 0.02 }
+A = { value = 0.04 }
+w = { value = 9.0 }
+d = { value = 0.05 }
+g = { value = 9.81 }
+[bodies.mount]
+parent = "world"
+mass = 1.0
+inertia = "point"
+joint = { type = "general", name = "shaker", steps = [{ trans = "y", distance = "A*cos(w*t)" }] }
+[bodies.rod1]
+parent = "mount"
+mass = "m1"
+com = [0, "-l1/2", 0]
+inertia = { rod = { length = "l1", axis = "y" } }
+joint = { type = "revolute", name = "hinge1", coordinate = "phi1", axis = "z" }
+[bodies.rod2]
+parent = "rod1"
+mass = "m2"
+com = [0, "-l2/2", 0]
+inertia = { rod = { length = "l2", axis = "y" } }
+joint = { type = "revolute", name = "hinge2", coordinate = "phi2", axis = "z", position = [0, "-l1", 0] }
+[bodies.disc]
+parent = "rod2"
+mass = 0.3
+inertia = [0.01, 0.01, "J"]
+joint = { type = "revolute", name = "spin", coordinate = "psi", axis = "z", position = [0, "-l2", 0] }
+[forces.gravity]
+type = "gravity"
+vector = [0, "-g", 0]
+[forces.knee]
+type = "rotational_spring_damper"
+coordinate = "phi2"
+damping = "d"
+[nominal.hanging]
+y = { phi1 = 0, phi2 = 0, psi = 0 }
+period = "2*pi/w"
+"""
+
+
+@pytest.fixture(scope="module")
+def shaken():
+    from jourdain.io.modelfile.loader import loads_model
+    return loads_model(SHAKEN_DOUBLE, "shaken.toml")
+
+
+def test_compiled_monodromy_against_scipy_and_simulation(shaken, monkeypatch):
+    """Three coordinates, M̃ full (the disc's spin couples all three rates), P from a damper,
+    the spin angle cyclic (Routh: 5 of the 6 states): the monodromy matrix of the compiled
+    DOP853 (all six columns as one problem, the accelerations from jd_monodromy_accel) equals
+    SciPy's DOP853 on A(t) (the path without a compiler) to the tolerance of either, and each
+    of its columns equals the nonlinear simulation from the nominal plus ε over one period."""
+    import jourdain.analysis.floquet as fq
+
+    res = capabilities.linear_analysis(shaken, "hanging")
+    fl = res["floquet"]
+    assert fl.cyclic == ("psi",)
+    assert fl.state_names == ("phi1", "phi2", "phi1_d", "phi2_d", "psi_d")
+    lin = res["linearization"].compile()
+    assert fq._monodromy_accel(lin.function) is not None
+    monkeypatch.setattr(fq, "_monodromy_accel", lambda fn: None)
+    ref = fq.floquet(lin, fl.period, cyclic=("psi",))
+    assert np.abs(fl.monodromy - ref.monodromy).max() <= fl.tolerance + ref.tolerance
+    # damped: inside the unit circle but for the spin rate's multiplier 1 (its momentum is
+    # conserved); det Φ = exp(∫ tr A dt) < 1
+    assert 0 < np.linalg.det(fl.monodromy) < 1
+    system = shaken.system
+    T, eps = fl.period, 1e-6
+    names = system.coordinate_names
+    for j, state in enumerate(fl.state_names):
+        y0, yd0 = np.zeros(3), np.zeros(3)
+        if state.endswith("_d"):
+            yd0[names.index(state[:-2])] = eps
+        else:
+            y0[names.index(state)] = eps
+        sim = system.simulate((0.0, T), y0, yd0, rtol=1e-12, atol=1e-16, t_eval=[0.0, T])
+        full = np.concatenate([sim.y[-1], sim.yd[-1]]) / eps
+        col = full[[0, 1, 3, 4, 5]]
+        scale = np.abs(fl.monodromy[:, j]).max()
+        # Φ's own tolerance, the nonlinearity and the simulation's error; measured 1e-11
+        assert np.abs(col - fl.monodromy[:, j]).max() <= fl.tolerance + 1e-9 * scale, state
+
+
+def test_compiled_monodromy_of_many_coordinates_and_its_errors():
+    """34 uncoupled Mathieu equations (the accelerations' scratch on the heap beyond 32 kB):
+    each equation's 2×2 block of Φ equals SciPy's integration of that equation alone, and
+    the blocks between equations are zero; a stiffness whose value turns NaN within the
+    period stops the integration with the time."""
+    n = 34
+    xs = jd.symbols(" ".join(f"x{i}" for i in range(n)))
+    a_vals = np.linspace(-0.3, 3.3, n)
+    bodies = [jd.Body(f"m{i}", "world", jd.Prismatic(f"s{i}", x, "x"), mass=1.0,
+                      inertia=jd.point_mass()) for i, x in enumerate(xs)]
+    forces = [jd.GeneralizedForce(f"k{i}", x, -(float(a) - 2 * 0.4 * jd.cos(2 * jd.t)) * x)
+              for i, (x, a) in enumerate(zip(xs, a_vals, strict=True))]
+    lin = jd.System(list(xs), bodies, forces).linearize({str(x): 0 for x in xs}).compile()
+    fl = floquet(lin, np.pi, cyclic=())
+    assert fl.monodromy.shape == (2 * n, 2 * n)
+    coupled = np.ones((2 * n, 2 * n), dtype=bool)
+    for i, a in enumerate(a_vals):  # measured 1.3e-12 against a tolerance of 5e-8
+        block = np.ix_([i, n + i], [i, n + i])
+        coupled[block] = False
+        assert np.abs(fl.monodromy[block] - _mathieu_monodromy(a, 0.4)).max() <= fl.tolerance
+    assert not fl.monodromy[coupled].any()
+    x = jd.symbols("x")
+    body = jd.Body("m", "world", jd.Prismatic("s", x, "x"), mass=1.0, inertia=jd.point_mass())
+    bad = jd.System([x], [body], [jd.GeneralizedForce(
+        "k", x, -(1 + jd.sqrt(jd.cos(jd.t) + 0.9)) * x)]).linearize({"x": 0}).compile()
+    with pytest.raises(EvaluationError, match=r"integration over one period failed: NaN .* "
+                                              r"at t = 2\.6"):
+        floquet(bad, 2 * np.pi, cyclic=())

@@ -22,11 +22,14 @@ int jd_integrate(const jd_problem *P, double t_end, double *st, double *x, doubl
     const jd_method *m = P->method == 1 ? &m8 : P->method == 2 ? &mr : &m5;
     int S = m->stages;
     long nu = P->nu > 0 ? P->nu : 1;
+    /* M and its factor: none where the problem brings its own accel (the monodromy matrix's
+       columns of analysis/floquet.py are 2f² coordinates, an f⁴ matrix never formed) */
+    long ff = P->accel ? 0 : f * f;
     double *mem = (double *)malloc(sizeof(double) *
-        (2 * nu + f * f + 2 * f + f * f + n * (16 + 7 + 5) + 3 * (nev + 1)));
+        (2 * nu + ff + 2 * f + ff + n * (16 + 7 + 5) + 3 * (nev + 1)));
     if (!mem) return JD_ENOMEM;
-    jd_ctx c = {P, n, mem, mem + nu, mem + 2 * nu, mem + 2 * nu + f * f + 2 * f, 0, 0.0, fail + 1};
-    double *K = c.L + f * f, *F = K + 16 * n, *x_new = F + 7 * n, *xs = x_new + n,
+    jd_ctx c = {P, n, mem, mem + nu, mem + 2 * nu, mem + 2 * nu + ff + 2 * f, 0, 0.0, fail + 1};
+    double *K = c.L + ff, *F = K + 16 * n, *x_new = F + 7 * n, *xs = x_new + n,
            *sc = xs + n, *err = sc + n, *xe = err + n, *g_new = xe + n, *g_tmp = g_new + nev + 1,
            *roots = g_tmp + nev + 1;
     jd_step s = {&c, m, P->method, n, 0.0, 0.0, x, x_new, K, F, xs, NULL, 0};

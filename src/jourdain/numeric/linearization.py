@@ -84,8 +84,82 @@ class CompiledLinearization:
 def compile_linearization(lin: _result.Linearization) -> CompiledLinearization:
     """Machine code for ``M_tilde, P, Q, h, B`` as functions of t and the parameters
     (:func:`jourdain.numeric.lambdify`), for repeated evaluation (sweeps, time-variant
-    systems)."""
-    return CompiledLinearization(lin, lambdify(lin.system, lin.blocks()))
+    systems), with :func:`monodromy_accel_source` for the Floquet analysis."""
+    blocks = lin.blocks()
+    return CompiledLinearization(lin, lambdify(lin.system, blocks,
+                                               extra_source=monodromy_accel_source(blocks)))
+
+
+def monodromy_accel_source(blocks: Mapping[str, Any]) -> str:
+    """C of ``jd_monodromy_accel``: Φ̇ = A(t)·Φ (:mod:`jourdain.analysis.floquet`) as a
+    problem of the compiled integrator, whose state is ``[y, ẏ, W]`` with ``ÿ`` from an
+    ``accel`` function. The 2f columns of Φ = [H; Ḣ] are the "coordinates" ``y`` = H (f×2f,
+    column after column) and ``ẏ`` = Ḣ; ``ÿ = −M̃⁻¹·(Q·H + P·Ḣ)`` with one Cholesky factor of
+    ½(M̃ + M̃ᵀ) per evaluation for all columns (``jd_fn`` gives M̃, P, Q at t; its y and ẏ are
+    not read: the matrices are those at the nominal motion). Returns 1 where M̃ is not positive
+    definite, 2 where a number is not finite (the integrator's codes)."""
+    names = list(blocks)
+    offsets, at = {}, 0
+    for n in names:
+        rows, cols = blocks[n].shape
+        offsets[n] = at
+        at += rows * cols
+    f = blocks["M_tilde"].shape[0]
+    # scratch on the stack up to 32 kB, else on the heap
+    heap = 8 * (at + f * f + f) > 32768
+    decl = ("double *out = malloc(sizeof(double) * (JD_MO_SIZE + F * F + F));\n"
+            "    if (!out) return 2;\n    double *L = out + JD_MO_SIZE, *z = L + F * F;\n"
+            if heap else
+            "double out[JD_MO_SIZE], L[F * F], z[F];\n")
+    free = "free(out); " if heap else ""
+    return f"""
+/* the monodromy matrix's columns for the integrator (numeric/linearization.py) */
+#define JD_MO_SIZE {at}
+int jd_monodromy_accel(const double *y, const double *yd, double t, const double *p,
+                       const double *u, double *ydd, double *power) {{
+    enum {{ F = {f}, N = 2 * {f} }};
+    {decl}    for (int i = 0; i < F; ++i) z[i] = 0.0;
+    jd_fn(z, z, t, p, u, out);
+    const double *M = out + {offsets["M_tilde"]}, *P = out + {offsets["P"]}, *Q = out + {offsets["Q"]};
+    double dmax = 0.0, fin = 0.0;
+    for (int i = 0; i < F * F; ++i) fin += (M[i] + P[i] + Q[i]) * 0.0;
+    if (fin != 0.0) {{ {free}return 2; }}
+    for (int i = 0; i < F; ++i) if (fabs(M[i * F + i]) > dmax) dmax = fabs(M[i * F + i]);
+    for (int j = 0; j < F; ++j) {{  /* L·Lᵀ = ½(M̃ + M̃ᵀ); L's diagonal holds 1/l_jj */
+        double d = M[j * F + j];
+        for (int m = 0; m < j; ++m) d -= L[j * F + m] * L[j * F + m];
+        if (!(d > 1e-13 * dmax)) {{ {free}return 1; }}
+        double inv = 1.0 / sqrt(d);
+        L[j * F + j] = inv;
+        for (int i = j + 1; i < F; ++i) {{
+            double s = 0.5 * (M[i * F + j] + M[j * F + i]);
+            for (int m = 0; m < j; ++m) s -= L[i * F + m] * L[j * F + m];
+            L[i * F + j] = s * inv;
+        }}
+    }}
+    for (int c = 0; c < N; ++c) {{
+        const double *h = y + c * F, *hd = yd + c * F;
+        double *b = ydd + c * F;
+        for (int i = 0; i < F; ++i) {{
+            double s = 0.0;
+            for (int k = 0; k < F; ++k) s -= Q[i * F + k] * h[k] + P[i * F + k] * hd[k];
+            b[i] = s;
+        }}
+        for (int i = 0; i < F; ++i) {{
+            double s = b[i];
+            for (int k = 0; k < i; ++k) s -= L[i * F + k] * b[k];
+            b[i] = s * L[i * F + i];
+        }}
+        for (int i = F - 1; i >= 0; --i) {{
+            double s = b[i];
+            for (int k = i + 1; k < F; ++k) s -= L[k * F + i] * b[k];
+            b[i] = s * L[i * F + i];
+        }}
+    }}
+    *power = 0.0;
+    {free}return 0;
+}}
+"""
 
 
 def evaluate_general_linearization(glin: _general.GeneralLinearization, y: Any, yd: Any,

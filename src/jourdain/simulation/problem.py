@@ -112,6 +112,50 @@ def _build_quietly() -> None:
         pass
 
 
+def integrate_accel(accel: int, f: int, p: np.ndarray, n_inputs: int, x0: np.ndarray,
+                    t_span: tuple[float, float], rtol: float, atol: float) -> np.ndarray:
+    """The state at ``t_span[1]`` of ``ẍ = accel(x, ẋ, t)`` from ``x0 = [x, ẋ, W]`` (2f + 1
+    numbers) by the compiled DOP853: a problem that is not a model's, whose ``accel``
+    (the address of a C function with ``jd_accel``'s signature) is given with its parameters
+    ``p``, inputs held at zero (the monodromy matrix of :mod:`jourdain.analysis.floquet`).
+    Raises EvaluationError with the integrator's reason and the time where it stopped."""
+    lib = integrator_library()
+    n = 2 * f + 1
+    pv = np.ascontiguousarray(p, dtype=float).reshape(-1)
+    nu = max(n_inputs, 1)
+    zeros, kinds = np.zeros(nu), np.zeros(nu, dtype=np.intc)
+    offsets = np.zeros(n_inputs + 1, dtype=np.int_)
+    atols = np.full(n, float(atol))
+    problem = _Problem(f, n_inputs, 0, None, None, None, None, address(pv), address(zeros),
+                       address(kinds), address(offsets), address(zeros), address(zeros), None,
+                       None, 1, float(rtol), address(atols), math.inf, 0.0, accel)
+    st = np.zeros(4)
+    st[0] = t_span[0]
+    x = np.ascontiguousarray(x0, dtype=float).copy()
+    k0, g, fail = np.zeros(n), np.zeros(1), np.zeros(n + 1)
+    te = np.array([float(t_span[1])])
+    out_t, out_x, out_dx = np.zeros(1), np.zeros(n), np.zeros(n)
+    ints = np.zeros(9, dtype=np.int_)  # cnt (5), i_eval, n_out, n_ev, ev_i (no events)
+    ev = np.zeros(n + 1)
+    di = ints.itemsize
+    a_int = address(ints)
+    while True:
+        code = lib.jd_integrate(
+            ctypes.byref(problem), te[0], address(st), address(x), address(k0), address(g),
+            a_int, address(te), 1, a_int + 5 * di, address(out_t), address(out_x),
+            address(out_dx), 1, a_int + 6 * di, address(ev), address(ev) + 8, a_int + 8 * di,
+            1, a_int + 7 * di, 1_000_000, address(fail))
+        if code != _CONTINUE:
+            break
+    if code != _DONE or ints[6] != 1:
+        reason = {_ESINGULAR: "the mass matrix is not positive definite",
+                  _ENAN: "NaN or inf in the state or its derivative",
+                  _ESTEP: "the step size fell below the round-off limit"}.get(
+                      code, f"the integrator failed with code {code}")
+        raise EvaluationError(f"{reason} at t = {fail[0]:.9g}")
+    return out_x.copy()
+
+
 @overload
 def address(a: np.ndarray) -> int: ...
 @overload
