@@ -5,12 +5,15 @@ from __future__ import annotations
 
 import argparse
 import sys
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 from ..errors import JourdainError
 from ..io import capabilities as integration
 from ..io.fmu import export_fmu
 from ..io.report import write_report
+from ..io.report.figures import prepare_worker
+from ..io.report.workers import fork_workers
 from ..simulation.simulate import OUTPUT_SUFFIXES
 from ..workflow import require
 from .arguments import UsageError, load, overrides, sim_options, tree_only
@@ -70,6 +73,18 @@ def cmd_simulate(args: argparse.Namespace) -> int:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
+    # the figures' worker, forked before the model is read: it imports Matplotlib on a core
+    # that would otherwise wait while this process reads and derives the model (a URDF robot:
+    # yourdfpy and trimesh, 0.4 s); the report shuts it down
+    pool = fork_workers(prepare_worker)
+    try:
+        return _run(args, pool)
+    finally:
+        if pool is not None:  # the report's, done already; else what failed before it
+            pool.shutdown(cancel_futures=True)
+
+
+def _run(args: argparse.Namespace, pool: ProcessPoolExecutor | None) -> int:
     model = load(args.model)
     params = overrides(model.system, args.set)
     opts = sim_options(model, args)
@@ -78,7 +93,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         # jourdain.loops brings SciPy's linear algebra (0.2 s): imported for loop models only
         from ..loops.report import run_report
 
-        for line in run_report(model, out, params, opts.get("t_end")):
+        for line in run_report(model, out, params, opts.get("t_end"), pool=pool):
             print(line)
         print(f"report: {out / 'index.html'}")
         return EXIT_OK
@@ -91,7 +106,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     try:
         info = write_report(model, out, parameters=params, t_end=opts.get("t_end"),
                             max_ops=args.max_ops, progress=progress or False,
-                            parallel=True, study=study)
+                            parallel=True, study=study, figure_pool=pool)
     finally:
         if progress:
             progress.done()

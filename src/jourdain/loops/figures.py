@@ -84,9 +84,13 @@ class Painter:
     """A one-process pool forked at construction (Matplotlib imported there at once), or
     nothing where that cannot help; :meth:`draw` draws there or here."""
 
-    def __init__(self) -> None:
-        self.pool: ProcessPoolExecutor | None = None
+    def __init__(self, pool: ProcessPoolExecutor | None = None) -> None:
+        """``pool``: a worker forked earlier (``jourdain run`` forks it before it reads the
+        model, so that Matplotlib is imported meanwhile), used instead of a new one."""
+        self.pool: ProcessPoolExecutor | None = pool
         self.ready: Future[bool] | None = None
+        if pool is not None:
+            return
         try:
             cores = len(os.sched_getaffinity(0))
         except AttributeError:  # not on Linux

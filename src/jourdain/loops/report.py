@@ -13,6 +13,7 @@ from __future__ import annotations
 import html
 import json
 from collections.abc import Mapping
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 from typing import Any
 
@@ -99,12 +100,14 @@ def check_lines(s: Mapping[str, Any]) -> list[str]:
 
 
 def run_report(model: Any, out: Path, parameters: Mapping[str, float] | None = None,
-               t_end: float | None = None) -> list[str]:
+               t_end: float | None = None,
+               pool: ProcessPoolExecutor | None = None) -> list[str]:
     """Simulate and linearize a loop model, write ``index.html``, plots and ``motion.csv``
-    into ``out``; returns summary lines."""
-    # Matplotlib imported and the figures drawn in a process forked now, while this one
-    # simulates and linearizes (where there are two cores)
-    painter = Painter()
+    into ``out``; returns summary lines. ``pool``: a one-process worker for the figures,
+    forked earlier (it is shut down here)."""
+    # Matplotlib imported and the figures drawn in a process forked now (or before the model
+    # was read), while this one simulates and linearizes (where there are two cores)
+    painter = Painter(pool)
     build_integrator_soon()  # compiled while the loop's equations are derived
     try:
         return _report(model, out, parameters, t_end, painter)

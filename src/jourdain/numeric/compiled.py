@@ -6,6 +6,7 @@ its ``jd_accel``, memoized per system (:func:`clear_cache`).
 from __future__ import annotations
 
 import ctypes
+import pickle
 import shutil
 import warnings
 from collections.abc import Mapping
@@ -24,13 +25,22 @@ from ..symbolic import SymMatrix
 from .ccode import HEADER, argument_names, function_source
 from .integrator_ldl import ldl_source  # the solve written out per f (H1)
 from .recursive import LDL_SOLVE, recursive_units
-from .toolchain import CompilerError, build, cache_dir, compiler, content_key
+from .toolchain import (
+    CompilerError,
+    build,
+    cache_dir,
+    compiler,
+    content_key,
+    keep_file,
+    library_dir,
+    not_private,
+)
 
 if TYPE_CHECKING:
     from ..model.system import System
     from ..stages.projection import EquationsOfMotion
 
-from .functions import CompiledFunction, InterpretedFunction
+from .functions import CompiledFunction, InterpretedFunction, JitFunction
 
 _GENERATOR_VERSION = "c3"
 
@@ -54,9 +64,12 @@ def lambdify(system: System, matrices: Mapping[str, SymMatrix],
     the copies into its lower triangle (:func:`jourdain.numeric.ccode.function_source`).
     ``lean``: compiled for a short compile rather than the fastest code, for a function
     evaluated once per sample of a motion (energies, positions, poses, joint wrenches: a
-    report builds several after its simulation): its sines and cosines are not vectorized
-    (``JD_LEAN`` in sincos.h), 45-50 instead of 75 ms of compiling a small function, with the
-    same numbers to the bit.
+    report builds four to six after its simulation). Up to :data:`JIT_MAX_NODES` nodes it is
+    compiled in this process by SymEngine's LLVM backend (:func:`_jit`: 1-20 ms for the
+    examples' functions, against 45-75 ms of a compiler process; at most a few ms over 800
+    samples) and kept on disk; else, and without LLVM, as C whose sines and cosines are not
+    vectorized (``JD_LEAN`` in sincos.h: 45-50 instead of 75 ms for a small function, the
+    same numbers to the bit).
 
     The cache key is a hash of the generated source itself: SymEngine's own hashes cannot serve,
     since they do not tell ``k*(x - x0)`` from ``k*(x0 - x)``.
@@ -75,9 +88,49 @@ def lambdify(system: System, matrices: Mapping[str, SymMatrix],
         return _interpreted(system, names, shapes, exprs)
     cnames = argument_names(system.y, system.yd, system.t, system.parameter_symbols,
                             system.inputs)
-    source = (("#define JD_LEAN 1\n" if lean else "") + HEADER
-              + function_source("jd_fn", exprs, cnames, whole, symmetric) + extra_source)
+    body = function_source("jd_fn", exprs, cnames, whole, symmetric) + extra_source
+    if lean and not extra_source and count_nodes(exprs, JIT_MAX_NODES + 1) <= JIT_MAX_NODES:
+        jit = _jit(system, names, shapes, exprs, body)
+        if jit is not None:
+            return jit
+    source = ("#define JD_LEAN 1\n" if lean else "") + HEADER + body
     return _load(system, names, shapes, source)  # the cached library when there is one
+
+
+#: the largest lean function (nodes of its expression graph) compiled by LLVM in-process:
+#: the energies of an 8-link spatial chain (3 500 nodes) take 47 ms, about what the compiler
+#: process takes; beyond, the JIT's time grows faster than the compiler's
+JIT_MAX_NODES = 4000
+
+
+def _jit(system: System, names: tuple[str, ...], shapes: tuple[tuple[int, int], ...],
+         exprs: list[se.Basic], source: str) -> JitFunction | None:
+    """``exprs`` compiled by SymEngine's LLVM backend (``opt_level=0``: the shortest compile;
+    a lean function is evaluated once per sample), kept in ``<cache>/<key>.llvm`` under the
+    hash of the generated C ``source`` (private files only, as for the libraries); None where
+    this SymEngine has no LLVM backend or it cannot compile the expressions."""
+    args = arguments(system)  # the C reads what it uses; the LLVM function takes all
+    key = content_key("llvm", _GENERATOR_VERSION, se.__version__, source,
+                      " ".join(map(str, args)))
+    path = library_dir() / f"{key}.llvm"
+    fn = None
+    if path.exists() and not not_private(path):
+        try:
+            fn = pickle.loads(path.read_bytes())  # noqa: S301 - this user's own private cache
+        except Exception:  # noqa: BLE001 - an unreadable entry is rebuilt
+            fn = None
+    if fn is None:
+        try:
+            fn = se.Lambdify(list(args), exprs, backend="llvm", cse=True, real=True,
+                             opt_level=0)
+        except (RuntimeError, ValueError, TypeError, NotImplementedError):
+            return None
+        try:
+            keep_file(path, pickle.dumps(fn))
+        except (OSError, TypeError, pickle.PicklingError):  # a cache that cannot be written
+            pass
+    return JitFunction(names, shapes, args, key, system.f, len(system.parameters),
+                       len(system.inputs), fn)
 
 
 def _load(system: System, names: tuple[str, ...], shapes: tuple[tuple[int, int], ...],

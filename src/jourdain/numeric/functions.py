@@ -201,6 +201,26 @@ class InterpretedFunction(CompiledFunction):
         return None
 
 
+class JitFunction(InterpretedFunction):
+    """A small function evaluated once per sample of a motion (``lambdify(lean=True)``),
+    compiled in this process by SymEngine's LLVM backend (no compiler process) and kept on
+    disk like a library (``<cache_dir>/<key>.llvm``); a batch is one call over all states."""
+
+    def _batch(self, n: int, Y: np.ndarray, YD: np.ndarray, T: np.ndarray, P: np.ndarray,
+               ps: int, U: np.ndarray, us: int, out: np.ndarray) -> None:
+        Pn = np.broadcast_to(P[:self.n_p] if ps == 0 else P.reshape(n, self.n_p),
+                             (n, self.n_p))
+        Un = np.broadcast_to(U[:self.n_u] if us == 0 else U.reshape(n, self.n_u),
+                             (n, self.n_u))
+        X = np.concatenate([Y, YD, T[:, None], Pn, Un], axis=1)
+        out[:] = np.asarray(self.lib(X), dtype=float).reshape(n, self.size)
+
+    @property
+    def address(self) -> int:
+        raise CompilerError("this function was compiled by LLVM in this process (lambdify's "
+                            "lean): it has no C address; compile it with lean=False")
+
+
 def _contig(x: Any, n: int, what: str) -> np.ndarray:
     v = np.ascontiguousarray(x, dtype=float).reshape(-1)
     if v.size != n:

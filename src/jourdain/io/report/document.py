@@ -32,7 +32,7 @@ from .linearization import linearization_section, nominal_placeholder
 from .sections import model_section, numbers_section
 from .simulation import simulation_section
 from .state import RUN_FORMAT, ReportInfo, Run
-from .workers import fork_workers
+from .workers import fork_workers, ignore_interrupt
 
 #: the number of computed sections (the list of files is the sixth)
 SECTIONS = 5
@@ -62,7 +62,8 @@ def compute_sections(run: Run, sections: list[str], display: Future[Display] | N
 def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | None = None,
                  t_end: float | None = None, max_ops: int = export.MAX_DISPLAY_OPS,
                  progress: Any = False, parallel: bool = False,
-                 study: Any = None) -> ReportInfo:  # study: a parameter study's section (H3)
+                 study: Any = None,  # study: a parameter study's section (H3)
+                 figure_pool: ProcessPoolExecutor | None = None) -> ReportInfo:
     """Compute everything for ``model`` and write ``out/report.html`` with the data files.
 
     Files: ``report.html``, ``model.toml`` (a copy of the input; ``model.urdf`` for a URDF
@@ -81,6 +82,12 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
     cache: 0.5 s here + 0.8 s in one worker against 0.5 s + 1.2–1.7 s in two; in-process
     1.1–1.4 s), which a shared machine pays in wall time.
 
+    ``figure_pool``: with ``parallel``, the figures' worker forked earlier
+    (``fork_workers(prepare_worker)``; ``jourdain run`` forks it before it reads the model,
+    so that Matplotlib is imported while the model is read and derived, on a core that would
+    otherwise wait). The display, where the cache lacks it, is then computed in a second
+    worker forked here (it imports SymPy, not Matplotlib). Both are shut down here.
+
     ``study``: a parameter study (a study file or :class:`jourdain.study.StudySpec`) run on
     this model; its section (stability map, Campbell diagram, histograms, the outputs' table)
     follows the simulation, its files (``study.nc``, ``study-*.svg``/``.png``) join the report's
@@ -96,22 +103,26 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
     out.mkdir(parents=True, exist_ok=True)
     system = model.system
     info = ReportInfo(out / "report.html")
-    pool: ProcessPoolExecutor | None = None
-    if parallel:  # the worker imports Matplotlib while this process works
-        set_pending(model, max_ops)
-        pool = fork_workers(prepare_worker)
-        set_pending(None, max_ops)  # the worker has its copy
-    if has_capability("simulate"):  # compiled while the equations and numbers are computed
-        build_integrator_soon()
+    pool: ProcessPoolExecutor | None = figure_pool  # the figures' worker
+    display_pool: ProcessPoolExecutor | None = None
+    display: Future[Display] | None = None
+    known: Display | None = None
     try:
-        summ = summary(model)  # the symbolic equations and reactions
-        display: Future[Display] | None = None
-        known: Display | None = None
-        if pool is not None:  # the display from the cache, else from the worker
-            key = display_key(model, max_ops)
+        if parallel:  # the display from the cache, else from a worker
+            key = display_key(model, max_ops)  # derives the equations (the workers' copies)
             known = cached(key)
-            if known is None:
-                display = pool.submit(display_in_worker, key)
+            if known is None or pool is None:
+                set_pending(model, max_ops)
+                if pool is None:  # one worker: Matplotlib imported there while this works
+                    display_pool = pool = fork_workers(prepare_worker)
+                else:  # the figures' worker has it: the display alone
+                    display_pool = fork_workers(ignore_interrupt)
+                set_pending(None, max_ops)  # the worker has its copy
+            if known is None and display_pool is not None:
+                display = display_pool.submit(display_in_worker, key)
+        if has_capability("simulate"):  # compiled while the equations and numbers are computed
+            build_integrator_soon()  # after the forks (a child would copy the build's lock)
+        summ = summary(model)  # the symbolic equations and reactions
         values = system.parameter_values
         values.update(parameters or {})
         run = Run(model, out, dict(parameters or {}), t_end, max_ops, progress, info, summ,
@@ -136,8 +147,9 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
             sections = [html if s == _EQUATIONS else s for s in sections]
         page = _page(run, sections, t_start)
     finally:
-        if pool is not None:
-            pool.shutdown(cancel_futures=True)
+        for worker in (pool, None if display_pool is pool else display_pool):
+            if worker is not None:
+                worker.shutdown(cancel_futures=True)
     info.html.write_text(page, encoding="utf-8")
     manifest = {"format": RUN_FORMAT, "model": system.name, "file": model.path,
                 "status": info.status, "message": info.message,

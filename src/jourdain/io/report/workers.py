@@ -6,12 +6,19 @@ from __future__ import annotations
 
 import multiprocessing
 import os
+import signal
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor
 
 
 def _ready() -> bool:
     return True
+
+
+def ignore_interrupt() -> None:
+    """A worker's initializer: Ctrl-C is the parent's to handle (it waits for the work of the
+    sections it finished)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def cores() -> int:
