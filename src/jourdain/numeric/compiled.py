@@ -65,8 +65,8 @@ def lambdify(system: System, matrices: Mapping[str, SymMatrix],
     ``lean``: compiled for a short compile rather than the fastest code, for a function
     evaluated once per sample of a motion (energies, positions, poses, joint wrenches: a
     report builds four to six after its simulation). Up to :data:`JIT_MAX_NODES` nodes it is
-    compiled in this process by SymEngine's LLVM backend (:func:`_jit`: 1-20 ms for the
-    examples' functions, against 45-75 ms of a compiler process; at most a few ms over 800
+    compiled in this process by SymEngine's LLVM backend (:func:`_jit`: 1-8 ms for the
+    robot arm's functions, against 45-75 ms of a compiler process; at most a few ms over 800
     samples) and kept on disk; else, and without LLVM, as C whose sines and cosines are not
     vectorized (``JD_LEAN`` in sincos.h: 45-50 instead of 75 ms for a small function, the
     same numbers to the bit).
@@ -98,8 +98,8 @@ def lambdify(system: System, matrices: Mapping[str, SymMatrix],
 
 
 #: the largest lean function (nodes of its expression graph) compiled by LLVM in-process:
-#: the energies of an 8-link spatial chain (3 500 nodes) take 47 ms, about what the compiler
-#: process takes; beyond, the JIT's time grows faster than the compiler's
+#: the energies of an 8-link spatial chain (3 500 nodes) take 47 ms at opt_level 0; larger
+#: ones were not measured against the compiler, and stay C
 JIT_MAX_NODES = 4000
 
 
