@@ -88,6 +88,8 @@ def test_lean_function_by_llvm_equals_c_and_the_interpreter(cache):
     assert "llvm" not in calls
     for name in exprs:
         assert np.array_equal(again.batch(Y, YD, t, p)[name], a[name])
+    # no states: an empty batch (a motion that failed at its start)
+    assert again.batch(Y[:0], YD[:0], t[:0], p)["M"].shape == (0, system.f, system.f)
     # a single state through __call__ equals the batch's row
     one = lean(Y[7], YD[7], t[7], p, np.zeros(0))
     for name in exprs:

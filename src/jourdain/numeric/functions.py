@@ -208,6 +208,8 @@ class JitFunction(InterpretedFunction):
 
     def _batch(self, n: int, Y: np.ndarray, YD: np.ndarray, T: np.ndarray, P: np.ndarray,
                ps: int, U: np.ndarray, us: int, out: np.ndarray) -> None:
+        if n == 0:  # a motion without samples (a run that failed at its start)
+            return
         Pn = np.broadcast_to(P[:self.n_p] if ps == 0 else P.reshape(n, self.n_p),
                              (n, self.n_p))
         Un = np.broadcast_to(U[:self.n_u] if us == 0 else U.reshape(n, self.n_u),
