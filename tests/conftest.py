@@ -20,5 +20,19 @@ def pytest_unconfigure(config: pytest.Config) -> None:
 
 
 @pytest.fixture
+def cache(tmp_path, monkeypatch):
+    """An empty compile cache of the test's own (the memoized functions and loaded libraries
+    forgotten before and after)."""
+    from jourdain import numeric
+    from jourdain.numeric import toolchain
+
+    monkeypatch.setenv("JOURDAIN_CACHE", str(tmp_path / "cache"))
+    numeric.clear_cache()
+    toolchain._loaded.clear()
+    yield tmp_path / "cache"
+    numeric.clear_cache()
+
+
+@pytest.fixture
 def rng() -> np.random.Generator:
     return np.random.default_rng(12345)

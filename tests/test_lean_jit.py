@@ -12,22 +12,12 @@ import jourdain as jd
 from jourdain import numeric
 from jourdain.models import spatial_chain
 from jourdain.numeric import compiled as comp
-from jourdain.numeric import toolchain as build
 from jourdain.numeric.functions import CompiledFunction, JitFunction
 from jourdain.symbolic import SymMatrix
 
 pytestmark = pytest.mark.skipif(
     comp._jit(spatial_chain(1), ("a",), ((1, 1),), [se.Integer(1)], "probe") is None,
     reason="this SymEngine has no LLVM backend")
-
-
-@pytest.fixture
-def cache(tmp_path, monkeypatch):
-    monkeypatch.setenv("JOURDAIN_CACHE", str(tmp_path / "cache"))
-    numeric.clear_cache()
-    build._loaded.clear()
-    yield tmp_path / "cache"
-    numeric.clear_cache()
 
 
 def _states(system, n, seed):

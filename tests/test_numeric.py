@@ -13,15 +13,6 @@ from jourdain.numeric import toolchain as build
 from jourdain.symbolic import SymMatrix
 
 
-@pytest.fixture
-def cache(tmp_path, monkeypatch):
-    monkeypatch.setenv("JOURDAIN_CACHE", str(tmp_path / "cache"))
-    numeric.clear_cache()
-    build._loaded.clear()
-    yield tmp_path / "cache"
-    numeric.clear_cache()
-
-
 def _reference(system, exprs, y, yd, t, p, u):
     """SymEngine's own (non-compiled) evaluator on the same expressions."""
     args = list(numeric.arguments(system))
