@@ -193,3 +193,34 @@ def test_the_numbers_never_import_sympy(tmp_path):
                          env={**__import__("os").environ, "JOURDAIN_CACHE": str(tmp_path)})
     assert out.returncode == 0, out.stderr[-2000:]
     assert out.stdout.startswith("False"), out.stdout
+
+
+def _sleep_long() -> None:
+    import time as _time
+    _time.sleep(60)
+
+
+def test_stop_workers_does_not_wait_for_a_worker_still_starting(tmp_path):
+    """``jourdain run`` forks its figures' worker before it reads the model; where the model
+    is malformed, the message must not wait for the worker's imports: stop_workers ends a
+    worker whose initializer would take a minute in well under that, and the command exits 1
+    naming the line."""
+    import subprocess
+    import sys
+    import time as _time
+
+    from jourdain.io.report.workers import fork_workers, stop_workers
+
+    pool = fork_workers(_sleep_long)
+    if pool is None:
+        pytest.skip("one core: no worker is forked")
+    start = _time.perf_counter()
+    stop_workers(pool)
+    assert _time.perf_counter() - start < 20
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[model]\nname = 3 = 4\n")
+    proc = subprocess.run([sys.executable, "-m", "jourdain.cli", "run", str(bad), "--out",
+                           str(tmp_path / "out")], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 1
+    assert "bad.toml:2: TOML syntax error" in proc.stderr
+    assert "Traceback" not in proc.stderr

@@ -13,7 +13,7 @@ from ..io import capabilities as integration
 from ..io.fmu import export_fmu
 from ..io.report import write_report
 from ..io.report.figures import prepare_worker
-from ..io.report.workers import fork_workers
+from ..io.report.workers import fork_workers, stop_workers
 from ..simulation.simulate import OUTPUT_SUFFIXES
 from ..workflow import require
 from .arguments import UsageError, load, overrides, sim_options, tree_only
@@ -78,10 +78,14 @@ def cmd_run(args: argparse.Namespace) -> int:
     # yourdfpy and trimesh, 0.4 s); the report shuts it down
     pool = fork_workers(prepare_worker)
     try:
-        return _run(args, pool)
-    finally:
-        if pool is not None:  # the report's, done already; else what failed before it
-            pool.shutdown(cancel_futures=True)
+        code = _run(args, pool)
+    except BaseException:  # the message at once, not after the worker's imports
+        if pool is not None:
+            stop_workers(pool)
+        raise
+    if pool is not None:  # the report's, done already
+        pool.shutdown(cancel_futures=True)
+    return code
 
 
 def _run(args: argparse.Namespace, pool: ProcessPoolExecutor | None) -> int:
