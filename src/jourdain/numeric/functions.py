@@ -186,10 +186,16 @@ class InterpretedFunction(CompiledFunction):
 
     def _batch(self, n: int, Y: np.ndarray, YD: np.ndarray, T: np.ndarray, P: np.ndarray,
                ps: int, U: np.ndarray, us: int, out: np.ndarray) -> None:
-        Pn = np.broadcast_to(P[:self.n_p] if ps == 0 else P, (n, self.n_p))
-        Un = np.broadcast_to(U[:self.n_u] if us == 0 else U, (n, self.n_u))
-        for i in range(n):  # one state at a time: no compiled loop without a compiler
-            out[i] = self.raw(Y[i], YD[i], T[i], Pn[i], Un[i])
+        if n == 0:  # no states (a motion that failed at its start): Lambdify refuses them
+            return
+        Pn = np.broadcast_to(P[:self.n_p] if ps == 0 else P.reshape(n, self.n_p),
+                             (n, self.n_p))
+        Un = np.broadcast_to(U[:self.n_u] if us == 0 else U.reshape(n, self.n_u),
+                             (n, self.n_u))
+        # all states in one call: Lambdify loops over the rows itself, with the same numbers
+        # as one state at a time
+        X = np.concatenate([Y, YD, T[:, None], Pn, Un], axis=1)
+        out[:] = np.asarray(self.lib(X), dtype=float).reshape(n, self.size)
 
     @property
     def address(self) -> int:
@@ -205,17 +211,6 @@ class JitFunction(InterpretedFunction):
     """A small function evaluated once per sample of a motion (``lambdify(lean=True)``),
     compiled in this process by SymEngine's LLVM backend (no compiler process) and kept on
     disk like a library (``<cache_dir>/<key>.llvm``); a batch is one call over all states."""
-
-    def _batch(self, n: int, Y: np.ndarray, YD: np.ndarray, T: np.ndarray, P: np.ndarray,
-               ps: int, U: np.ndarray, us: int, out: np.ndarray) -> None:
-        if n == 0:  # a motion without samples (a run that failed at its start)
-            return
-        Pn = np.broadcast_to(P[:self.n_p] if ps == 0 else P.reshape(n, self.n_p),
-                             (n, self.n_p))
-        Un = np.broadcast_to(U[:self.n_u] if us == 0 else U.reshape(n, self.n_u),
-                             (n, self.n_u))
-        X = np.concatenate([Y, YD, T[:, None], Pn, Un], axis=1)
-        out[:] = np.asarray(self.lib(X), dtype=float).reshape(n, self.size)
 
     @property
     def address(self) -> int:
