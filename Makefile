@@ -19,11 +19,11 @@ $(BIN)/python:
 
 # the main job needs jourdain only; the test tools (Pinocchio, PyDy, Cython: most of a 1 GB
 # environment) are installed by the test target
-$(BIN)/.installed-run: pyproject.toml | $(BIN)/python
+$(BIN)/.installed-run: pyproject.toml setup.py | $(BIN)/python
 	$(BIN)/python -m pip install --quiet -e .
 	touch $@
 
-$(BIN)/.installed: pyproject.toml | $(BIN)/python
+$(BIN)/.installed: pyproject.toml setup.py | $(BIN)/python
 	$(BIN)/python -m pip install --quiet -e ".[test]"
 	touch $@ $(BIN)/.installed-run
 
@@ -59,7 +59,7 @@ test: lint browser
 # the documentation site (mkdocs.yml): tutorials executed and every example run for the gallery
 # at each build, so a change of the code that breaks either fails here; compiled libraries in a
 # cache of the project (removed by make clean); MkDocs' own notices about its future silenced
-$(BIN)/.installed-docs: pyproject.toml | $(BIN)/python
+$(BIN)/.installed-docs: pyproject.toml setup.py | $(BIN)/python
 	$(BIN)/python -m pip install --quiet -e ".[docs]"
 	touch $@ $(BIN)/.installed-run
 
@@ -84,4 +84,5 @@ viewer-assets:
 	tools/build_viewer.sh
 
 clean:
-	rm -rf $(VENV) .pytest_cache .ruff_cache .jourdain-test-cache .jourdain-docs-cache site
+	rm -rf $(VENV) .pytest_cache .ruff_cache .jourdain-test-cache .jourdain-docs-cache site \
+	  src/jourdain/numeric/prebuilt

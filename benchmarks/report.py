@@ -5,11 +5,14 @@ Each example of ``examples/`` (every ``.toml`` and ``.urdf``; none excluded) is 
 the process to its exit (imports included), in three states of the compile cache:
 
 - **empty**: a new, empty ``JOURDAIN_CACHE`` for each repetition (C code generated and
-  compiled, the report's symbolic display computed);
-- **new model**: a cache holding only the integrator library, which no model changes (what a
-  user sees after every change to the model, on a machine where jourdain ran before);
-- **warm**: the same cache after a first run (what a user sees the second time; the compiled
-  libraries and the display are read from the cache).
+  compiled, the report's symbolic display computed), the integrator library as the install
+  compiled it (``setup.py``: a machine's first run after ``pip install``; the script says
+  whether the install did) — also what a user sees after every change to the model;
+- **nothing prebuilt**: the same, with ``JOURDAIN_PREBUILT`` empty: the integrator library
+  compiled by the run too (an install that had no compiler; a checkout whose integrator source
+  changed since it was installed);
+- **warm**: the first state's cache after that run (what a user sees the second time; the
+  compiled libraries and the display are read from the cache).
 
 Reported per example: the best of ``--repeat`` runs in each state (the machine is shared: the
 best is the least disturbed), its exit status, the ratio of the warm time to the 2 s target
@@ -52,9 +55,9 @@ EXAMPLES = ROOT / "examples"
 TARGET_SECONDS = 2.0
 
 
-#: the "new model" state: a cache holding only what no model changes, the integrator library
-PREPARE_NEW = ("from jourdain.simulation.problem import integrator_library; "
-               "integrator_library()")
+#: where the integrator library of a run with an empty cache comes from (printed first)
+WHERE_INTEGRATOR = ("from jourdain.simulation.problem import integrator_library; "
+                    "print(integrator_library()._name)")
 
 
 def examples(only: list[str] | None) -> list[Path]:
@@ -68,12 +71,15 @@ def examples(only: list[str] | None) -> list[Path]:
     return found
 
 
-def timed(cmd: list[str], cache: Path) -> tuple[float, int, str, float]:
+def timed(cmd: list[str], cache: Path, prebuilt: bool = True) -> tuple[float, int, str, float]:
     """Seconds from the start of ``cmd`` to its exit, its exit status, its last line of
-    error output (the process's own compile cache ``cache``) and the processor seconds (user
-    and system) of it and its children: on a machine shared with other work the wall time
-    grows with the load, the processor time much less."""
+    error output (the process's own compile cache ``cache``; ``prebuilt``: False, the
+    libraries compiled at install time not used) and the processor seconds (user and system)
+    of it and its children: on a machine shared with other work the wall time grows with the
+    load, the processor time much less."""
     env = {**os.environ, "JOURDAIN_CACHE": str(cache), "PYTHONPATH": str(ROOT / "src")}
+    if not prebuilt:
+        env["JOURDAIN_PREBUILT"] = ""
     # bytecode as a user's Python writes it: a sandbox's PYTHONDONTWRITEBYTECODE=1 would make
     # every run compile every module of jourdain from source again (0.4-0.8 s a run)
     env.pop("PYTHONDONTWRITEBYTECODE", None)
@@ -142,19 +148,26 @@ def main() -> int:
         print(f"python {sys.version.split()[0]}, {os.cpu_count()} cores; best of "
               f"{args.repeat}; target {TARGET_SECONDS:g} s per example")
         print(f"floor: python -c 'import jourdain.cli': {floor[0]:.2f} s "
-              f"(processor {floor[1]:.2f} s)\n")
-        print(f"{'example':<28} {'empty cache':>12} {'new model':>12} {'warm cache':>11} "
+              f"(processor {floor[1]:.2f} s)")
+        where = subprocess.run([sys.executable, "-c", WHERE_INTEGRATOR], capture_output=True,
+                               text=True, env={**os.environ, "PYTHONPATH": str(ROOT / "src"),
+                                               "JOURDAIN_CACHE": str(base / "where")})
+        so = where.stdout.strip()
+        print("integrator library with an empty cache: "
+              + (f"compiled at install, {so}" if not so.startswith(str(base))
+                 else "not compiled at install (setup.py): the empty-cache runs compile it")
+              + "\n")
+        print(f"{'example':<28} {'empty cache':>12} {'no prebuilt':>12} {'warm cache':>11} "
               f"{'warm/target':>12} "
               f"{'warm, processor':>16}")
         for k, model in enumerate(models):
             out = base / f"out{k}"
-            empty, new, warm, warm_cpu = [], [], [], []
+            empty, bare, warm, warm_cpu = [], [], [], []
             status: list[tuple[int, str]] = []
             for r in range(args.repeat):
-                cache = base / f"new{k}-{r}"  # the integrator library alone, untimed
-                timed([sys.executable, "-c", PREPARE_NEW], cache)
-                wall, rc, err, _ = timed(run_cmd(model, out), cache)
-                new.append(wall)
+                wall, rc, err, _ = timed(run_cmd(model, out), base / f"bare{k}-{r}",
+                                         prebuilt=False)
+                bare.append(wall)
                 status.append((rc, err))
                 cache = base / f"cache{k}-{r}"
                 wall, rc, err, _ = timed(run_cmd(model, out), cache)  # empty cache
@@ -166,13 +179,13 @@ def main() -> int:
                 status.append((rc, err))
             bad = [(rc, err) for rc, err in status if rc != 0]
             row: dict[str, Any] = {
-                "example": model.name, "empty_s": min(empty), "new_model_s": min(new),
+                "example": model.name, "empty_s": min(empty), "no_prebuilt_s": min(bare),
                 "warm_s": min(warm),
                 "warm_cpu_s": min(warm_cpu),
                 "exit": bad[0][0] if bad else 0, "error": bad[0][1] if bad else ""}
             rows.append(row)
             flag = "" if not bad else f"   exit {bad[0][0]}: {bad[0][1][:60]}"
-            print(f"{model.name:<28} {row['empty_s']:>10.2f} s {row['new_model_s']:>10.2f} s "
+            print(f"{model.name:<28} {row['empty_s']:>10.2f} s {row['no_prebuilt_s']:>10.2f} s "
                   f"{row['warm_s']:>9.2f} s "
                   f"{row['warm_s'] / TARGET_SECONDS:>11.2f}× {row['warm_cpu_s']:>14.2f} s{flag}",
                   flush=True)
@@ -184,11 +197,11 @@ def main() -> int:
                       + (f" (a run exited {rc}: not comparable)" if rc else ""), flush=True)
     worst_empty = max(rows, key=lambda r: r["empty_s"])
     worst_warm = max(rows, key=lambda r: r["warm_s"])
-    worst_new = max(rows, key=lambda r: r["new_model_s"])
+    worst_bare = max(rows, key=lambda r: r["no_prebuilt_s"])
     print(f"\nworst, empty cache: {worst_empty['example']} {worst_empty['empty_s']:.2f} s "
           f"({worst_empty['empty_s'] / TARGET_SECONDS:.2f}× the target)")
-    print(f"worst, new model:   {worst_new['example']} {worst_new['new_model_s']:.2f} s "
-          f"({worst_new['new_model_s'] / TARGET_SECONDS:.2f}× the target)")
+    print(f"worst, no prebuilt: {worst_bare['example']} {worst_bare['no_prebuilt_s']:.2f} s "
+          f"({worst_bare['no_prebuilt_s'] / TARGET_SECONDS:.2f}× the target)")
     print(f"worst, warm cache:  {worst_warm['example']} {worst_warm['warm_s']:.2f} s "
           f"({worst_warm['warm_s'] / TARGET_SECONDS:.2f}× the target)")
     if args.json:

@@ -1,6 +1,8 @@
 """Shared fixtures. The compiled libraries of the tests go to a temporary cache (or to
 ``$JOURDAIN_TEST_CACHE``, as ``make test`` sets it), never to the user's ~/.cache/jourdain; child
-processes started by the tests inherit it."""
+processes started by the tests inherit it. The libraries compiled at install time
+(``setup.py``: the integrator) are not used (``JOURDAIN_PREBUILT`` empty), so that every test
+compiles what it uses, whether the install compiled or not; tests/test_prebuilt.py checks them."""
 
 import os
 import shutil
@@ -12,6 +14,7 @@ import pytest
 _given = os.environ.get("JOURDAIN_TEST_CACHE")
 _temporary = None if _given else tempfile.mkdtemp(prefix="jourdain-test-cache-")
 os.environ["JOURDAIN_CACHE"] = _given or _temporary
+os.environ["JOURDAIN_PREBUILT"] = ""
 
 
 def pytest_unconfigure(config: pytest.Config) -> None:

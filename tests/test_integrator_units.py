@@ -67,8 +67,7 @@ def test_two_units_give_the_numbers_of_one_unit_bit_for_bit(fresh_cache, monkeyp
     bit for the explicit methods and Radau IIA: vectorizing reorders no sum."""
     two = _runs()
     (main, _), _ = integrator_c.units()
-    monkeypatch.setattr(problem, "integrator_units",
-                        lambda: (("#define JD_KERNELS 1\n" + main, ()),))
+    monkeypatch.setattr(integrator_c, "units", lambda: (("#define JD_KERNELS 1\n" + main, ()),))
     problem.integrator_library.cache_clear()
     one = _runs()
     for (y2, yd2, n2), (y1, yd1, n1) in zip(two, one, strict=True):
@@ -109,7 +108,7 @@ def test_a_build_started_ahead_is_the_one_the_simulation_uses(fresh_cache, monke
 def test_a_failing_build_ahead_leaves_the_error_to_the_caller(fresh_cache, monkeypatch):
     """The thread swallows the compiler's failure; the caller's own integrator_library()
     builds again and raises the error, naming the source."""
-    monkeypatch.setattr(problem, "integrator_units", lambda: (("this is not C\n", ()),))
+    monkeypatch.setattr(integrator_c, "units", lambda: (("this is not C\n", ()),))
     problem.build_integrator_soon()
     for t in threading.enumerate():
         if t.name == "jourdain-integrator-build":

@@ -45,8 +45,13 @@ from __future__ import annotations
 import re
 from fractions import Fraction
 from importlib import resources
+from pathlib import Path
+from typing import TYPE_CHECKING
 
-import numpy as np
+from . import toolchain
+
+if TYPE_CHECKING:  # imported where used: setup.py builds the library without NumPy
+    import numpy as np
 
 #: the translation units of the library: the line that opens each (the kernels' unit defines
 #: JD_KERNELS: their definitions; elsewhere their declarations), its files in order, and its
@@ -86,6 +91,8 @@ def _number(entry: str) -> float:
 
 def table_values(text: str | None = None) -> dict[str, np.ndarray]:
     """The arrays of :func:`tables` by name, as doubles."""
+    import numpy as np
+
     return {k: np.array([_number(v) for v in vals]) for k, vals in _entries(text).items()}
 
 
@@ -111,3 +118,19 @@ def units() -> tuple[tuple[str, tuple[str, ...]], ...]:
     """The C source of the integrator library: each translation unit's text and flags."""
     return tuple((head + "\n".join(_read(n) for n in files), flags)
                  for head, files, flags in UNITS)
+
+
+def library_source() -> tuple[str, list[str], list[tuple[str, ...]]]:
+    """The library's content key (:func:`jourdain.numeric.toolchain.content_key`: the units'
+    text and flags, the compiler's flags and target), its units' text and their flags."""
+    texts = [text for text, _ in units()]
+    flags = [fl for _, fl in units()]
+    return toolchain.content_key("integrator", *texts, *(" ".join(f) for f in flags)), texts, flags
+
+
+def prebuild(dest: Path) -> Path:
+    """Compile the library into ``dest`` at install time (``setup.py``): found there by
+    :func:`jourdain.simulation.problem.integrator_library` on a machine's first run, as long as
+    its key matches (:func:`jourdain.numeric.toolchain.prebuild`)."""
+    key, texts, flags = library_source()
+    return toolchain.prebuild(dest, key, texts, flags)

@@ -26,6 +26,14 @@ is not writable by others (as Python's own caches are trusted only when private)
 another user could have put or changed there is never loaded. A library file that fails the
 check is rebuilt; a cache directory that fails it is not used at all: jourdain says so once
 and compiles into a private temporary directory instead (removed at exit).
+
+Libraries no model changes (the integrator, :mod:`jourdain.numeric.integrator_c`) are compiled
+when jourdain is installed from source, into ``prebuilt/`` beside this module (``setup.py``,
+:func:`prebuild`), so that a machine's first run does not wait for them: a library is looked up
+in the cache, then there (``$JOURDAIN_PREBUILT`` names another directory; empty: none), under
+the same key and the same checks. One built for another machine, compiler or source has
+another key and is not found; without a compiler at install time nothing is prebuilt and the
+library is compiled at its first use, as any other.
 """
 
 from __future__ import annotations
@@ -207,21 +215,34 @@ def content_key(*parts: str) -> str:
     return h.hexdigest()[:32]
 
 
+def prebuilt_dir() -> Path | None:
+    """The directory of the libraries compiled at install time (:func:`prebuild`):
+    ``$JOURDAIN_PREBUILT`` where set (empty: none), else ``prebuilt/`` beside this module."""
+    env = os.environ.get("JOURDAIN_PREBUILT")
+    if env is not None:
+        return Path(env).expanduser() if env.strip() else None
+    return Path(__file__).with_name("prebuilt")
+
+
 def cached_library(key: str) -> ctypes.CDLL | None:
-    """The library cached under ``key``, or None if it was never built (or was deleted)."""
+    """The library cached under ``key`` (in :func:`library_dir`, else in :func:`prebuilt_dir`),
+    or None if it was never built (or was deleted)."""
     if key in _loaded:
         return _loaded[key]
-    so = library_dir() / f"{key}.so"
-    if not so.exists():
-        return None
-    if not_private(so):  # someone else's or writable by others: rebuilt, never loaded
-        return None
-    try:
-        lib = ctypes.CDLL(str(so))
-    except OSError:  # a truncated or foreign file: rebuild
-        return None
-    _loaded[key] = lib
-    return lib
+    pre = prebuilt_dir()
+    for d in (library_dir(), *([pre] if pre is not None else [])):
+        so = d / f"{key}.so"
+        # missing, someone else's or writable by others (then never loaded: rebuilt), or a
+        # truncated or foreign file: the next place, then a build
+        if not so.exists() or not_private(so):
+            continue
+        try:
+            lib = ctypes.CDLL(str(so))
+        except OSError:
+            continue
+        _loaded[key] = lib
+        return lib
+    return None
 
 
 def compile_shared(sources: Mapping[str, str | bytes], units: Sequence[str], out: Path,
@@ -287,8 +308,32 @@ _BUILDING_GUARD = threading.Lock()
 
 def _build(key: str, source: str | Sequence[str], extra_flags: Sequence[str],
            unit_flags: Sequence[Sequence[str]] | None) -> ctypes.CDLL:
+    so = _compile(library_dir(), key, source, extra_flags, unit_flags)
+    lib = ctypes.CDLL(str(so))
+    _loaded[key] = lib
+    return lib
+
+
+def prebuild(dest: Path, key: str, source: str | Sequence[str],
+             unit_flags: Sequence[Sequence[str]] | None = None) -> Path:
+    """Compile a library that no model changes into ``dest`` at install time (``setup.py``;
+    :func:`cached_library` looks there after the cache): ``<key>.so`` and its source, as
+    :func:`build` would compile it into the cache, with the same flags; the files of other keys
+    in ``dest`` (an earlier version's) are removed. Returns the library's path; raises
+    CompilerError (no compiler, a failed compile), which an install reports and goes on."""
+    dest.mkdir(parents=True, exist_ok=True)
+    so = _compile(dest, key, source, (), unit_flags)
+    for old in dest.iterdir():
+        if old.suffix in (".so", ".c") and old.stem != key:
+            old.unlink(missing_ok=True)
+    return so
+
+
+def _compile(d: Path, key: str, source: str | Sequence[str], extra_flags: Sequence[str],
+             unit_flags: Sequence[Sequence[str]] | None) -> Path:
+    """``<d>/<key>.so`` from ``source`` (and ``<d>/<key>.c``): native code where the compiler
+    takes it, else portable code for this process."""
     units = [source] if isinstance(source, str) else list(source)
-    d = library_dir()
     so = d / f"{key}.so"
     src = d / f"{key}.c"
     # the source is kept for reading, also when the compiler fails; written under a private
@@ -314,6 +359,4 @@ def _build(key: str, source: str | Sequence[str], extra_flags: Sequence[str],
             _native_failed.add(compiler())
     except CompilerError as exc:
         raise CompilerError(f"compiling {src} failed:\n{str(exc)[-4000:]}") from None
-    lib = ctypes.CDLL(str(so))
-    _loaded[key] = lib
-    return lib
+    return so

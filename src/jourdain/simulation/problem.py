@@ -21,8 +21,8 @@ import symengine as se
 from ..errors import EvaluationError, JourdainError
 from ..model.expressions import as_expr
 from ..numeric import CompiledFunction, lambdify
-from ..numeric.integrator_c import units as integrator_units
-from ..numeric.toolchain import build, content_key
+from ..numeric.integrator_c import library_source as integrator_source
+from ..numeric.toolchain import build
 from ..symbolic import SymMatrix
 
 if TYPE_CHECKING:
@@ -76,11 +76,8 @@ def integrator_library() -> ctypes.CDLL:
     """The compiled integrator (built once, cached on disk like the model code): two
     translation units, the step loops at -O2 and the kernels at -O3
     (:data:`jourdain.numeric.integrator_c.UNITS`)."""
-    units = integrator_units()
-    texts = [text for text, _ in units]
-    flags = [fl for _, fl in units]
-    lib = build(content_key("integrator", *texts, *(" ".join(f) for f in flags)), texts,
-                unit_flags=flags)
+    key, texts, flags = integrator_source()
+    lib = build(key, texts, unit_flags=flags)
     vp, lg, db = ctypes.c_void_p, ctypes.c_long, ctypes.c_double
     lib.jd_integrate.restype = ctypes.c_int
     lib.jd_integrate.argtypes = [vp, db, vp, vp, vp, vp, vp, vp, lg, vp, vp, vp, vp, lg, vp, vp,
