@@ -115,3 +115,20 @@ def test_a_failing_build_ahead_leaves_the_error_to_the_caller(fresh_cache, monke
             t.join()
     with pytest.raises(toolchain.CompilerError, match="compiling"):
         problem.integrator_library()
+
+
+def _build_in_child(key: str, source: str) -> int:
+    return int(toolchain.build(key, source).jd_seven())
+
+
+def test_a_child_forked_during_a_build_builds_for_itself(fresh_cache):
+    """A build's lock held by a thread of the parent (build_soon) at a fork: the child has no
+    such thread, so it must not wait for that lock (it would forever); it builds itself."""
+    import multiprocessing
+
+    source = "int jd_seven(void) { return 7; }\n"
+    key = toolchain.content_key("fork test", source)
+    with toolchain._BUILDING_GUARD:
+        lock = toolchain._BUILDING.setdefault(key, threading.Lock())
+    with lock, multiprocessing.get_context("fork").Pool(1) as pool:  # as if mid-build
+        assert pool.apply_async(_build_in_child, (key, source)).get(timeout=120) == 7

@@ -65,6 +65,11 @@ def test_run_report_has_the_closing_joint_wrench(tmp_path: Path) -> None:
     assert [h for h in header if h.startswith("closure.")] == [
         "closure.Fx", "closure.Fy", "closure.Fz", "closure.Tx", "closure.Ty", "closure.Tz"]
     assert (out / "closing_joint_wrenches.png").stat().st_size > 0
+    # the motion's figures and the wrenches' are drawn apart; the page shows them in order
+    page = (out / "index.html").read_text()
+    assert [f.split('"')[0] for f in page.split('<img src="')[1:]] == [
+        "coordinates.png", "constraint_residual.png", "reactions.png",
+        "closing_joint_wrenches.png", "energy.png"]
 
 
 def test_run_report_files_like_the_tree_report(tmp_path: Path) -> None:

@@ -184,3 +184,34 @@ def test_penalty_form_in_c_equals_its_scipy_run() -> None:
     # both within their tolerance of the same motion (and of the exact one)
     assert np.max(np.abs(c.z - s.z)) <= 1e4 * 1e-10
     assert np.max(np.abs(c.coordinate("th0") - reference(n, c.t))) <= 1e-5
+
+
+def test_the_loop_library_is_compiled_ahead_once(cache, monkeypatch) -> None:
+    """simulate_loop starts the loop kernel's build in a thread (build_soon) while the tree's
+    M, k, q and the constraints compile: the kernel is compiled once, by that thread (the
+    simulation's own call waits for it instead of generating and compiling it again), and
+    the motion is the same as with the kernel built beforehand."""
+    import threading
+
+    from jourdain import numeric
+    from jourdain.loops import compiled
+    from jourdain.numeric import toolchain
+
+    reference = simulate_loop(four_bar(), (0.0, 0.5), [0.5, 0.8, 1.9], [1.0, 0.0, 0.0],
+                              samples=11)
+    monkeypatch.setattr(toolchain, "_loaded", {})
+    monkeypatch.setenv("JOURDAIN_CACHE", str(cache / "second"))
+    compiled._loop_library.cache_clear()
+    numeric.clear_cache()
+    kernels: list[str] = []  # the threads that compiled a loop kernel
+    real = toolchain.compile_shared
+
+    def counted(sources, units, out, flags, unit_flags=None):
+        if any("jd_loop_samples" in str(v) for v in sources.values()):
+            kernels.append(threading.current_thread().name)
+        real(sources, units, out, flags, unit_flags)
+
+    monkeypatch.setattr(toolchain, "compile_shared", counted)
+    res = simulate_loop(four_bar(), (0.0, 0.5), [0.5, 0.8, 1.9], [1.0, 0.0, 0.0], samples=11)
+    assert kernels == ["jourdain-loop-build"]
+    assert res.z.tobytes() == reference.z.tobytes()

@@ -23,8 +23,16 @@ def _import_matplotlib() -> bool:
     return True
 
 
+#: the report's figures in the order the page shows them
+FIGURES = ("coordinates.png", "constraint_residual.png", "reactions.png",
+           "closing_joint_wrenches.png", "energy.png")
+
+
 def draw_figures(out: Path, d: dict[str, Any]) -> list[str]:
-    """Write the report's PNG figures into ``out`` from the arrays ``d``; their file names."""
+    """Write PNG figures into ``out`` from the arrays ``d``; their file names. ``d`` holds
+    ``t`` and the motion (``z``, ``names``, ``Phi``, ``Phi_dot``, ``lam``, ``labels``,
+    ``E``: the coordinates, residuals, reactions and energy), or the closing joints'
+    ``wrenches``, or both: what it holds is drawn."""
     _import_matplotlib()
     import matplotlib.pyplot as plt  # noqa: PLC0415
 
@@ -46,14 +54,21 @@ def draw_figures(out: Path, d: dict[str, Any]) -> list[str]:
         ax.legend()
         figs.append((fname, fig))
 
-    lines("coordinates.png", "tree coordinates",
-          [(n, d["z"][:, i]) for i, n in enumerate(d["names"])])
-    lines("constraint_residual.png", "constraint residual",
-          [("max |Φ|", np.max(np.abs(d["Phi"]), axis=1)),
-           ("max |Φ̇|", np.max(np.abs(d["Phi_dot"]), axis=1))], log=True)
-    lines("reactions.png", "closing-joint reactions λ",
-          [(r, d["lam"][:, i]) for i, r in enumerate(d["labels"])])
-    if d["wrenches"]:  # force and torque of each closing joint in its body A's axes
+    if "z" in d:
+        lines("coordinates.png", "tree coordinates",
+              [(n, d["z"][:, i]) for i, n in enumerate(d["names"])])
+        lines("constraint_residual.png", "constraint residual",
+              [("max |Φ|", np.max(np.abs(d["Phi"]), axis=1)),
+               ("max |Φ̇|", np.max(np.abs(d["Phi_dot"]), axis=1))], log=True)
+        lines("reactions.png", "closing-joint reactions λ",
+              [(r, d["lam"][:, i]) for i, r in enumerate(d["labels"])])
+        fig, ax = plt.subplots(figsize=(7, 3.5))
+        E = d["E"]
+        ax.plot(t, E - E[0])
+        ax.set_xlabel("t / s")
+        ax.set_ylabel("E − E₀ / J")
+        figs.append(("energy.png", fig))
+    if d.get("wrenches"):  # force and torque of each closing joint in its body A's axes
         fig, axs = plt.subplots(1, 2, figsize=(9, 3.5))
         for name, w in d["wrenches"].items():
             for j, c in enumerate("xyz"):
@@ -67,12 +82,6 @@ def draw_figures(out: Path, d: dict[str, Any]) -> list[str]:
             if a.get_legend_handles_labels()[0]:
                 a.legend()
         figs.append(("closing_joint_wrenches.png", fig))
-    fig, ax = plt.subplots(figsize=(7, 3.5))
-    E = d["E"]
-    ax.plot(t, E - E[0])
-    ax.set_xlabel("t / s")
-    ax.set_ylabel("E − E₀ / J")
-    figs.append(("energy.png", fig))
     for fname, fg in figs:
         fg.subplots_adjust(left=0.12, right=0.97, bottom=0.14, top=0.95, wspace=0.3)
         fg.savefig(out / fname, dpi=90)
@@ -104,10 +113,13 @@ class Painter:
         self.pool = ProcessPoolExecutor(1, mp_context=context)
         self.ready = self.pool.submit(_import_matplotlib)
 
-    def draw(self, out: Path, d: dict[str, Any]) -> list[str]:
+    def draw(self, out: Path, d: dict[str, Any]) -> Future[list[str]]:
+        """:func:`draw_figures` started in the worker (done here where there is none)."""
         if self.pool is None:
-            return draw_figures(out, d)
-        return self.pool.submit(draw_figures, out, d).result()
+            done: Future[list[str]] = Future()
+            done.set_result(draw_figures(out, d))
+            return done
+        return self.pool.submit(draw_figures, out, d)
 
     def close(self) -> None:
         """Let the worker go (after its last drawing)."""
@@ -116,4 +128,4 @@ class Painter:
             self.pool = None
 
 
-__all__ = ["Painter", "draw_figures"]
+__all__ = ["FIGURES", "Painter", "draw_figures"]

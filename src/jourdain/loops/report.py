@@ -24,7 +24,7 @@ from ..simulation.problem import build_integrator_soon
 from ..simulation.simulate import DEFAULT_ATOL, DEFAULT_RTOL
 from .cli import linearization_document, linearize_near
 from .closed_loop import ClosedLoopSystem, constraints
-from .figures import Painter
+from .figures import FIGURES, Painter
 from .simulate import SOLVERS, simulate_loop
 
 
@@ -131,6 +131,10 @@ def _report(model: Any, out: Path, parameters: Mapping[str, float] | None,
                         parameters=parameters, rtol=rtol, atol=atol, method=method,
                         inputs=dict(sim.inputs) if sim.inputs else None)
     names = loop.coordinate_names
+    # the motion's figures drawn in the worker while this process linearizes
+    motion_figs = painter.draw(out, {
+        "t": res.t, "z": res.z, "names": list(names), "Phi": res.Phi, "Phi_dot": res.Phi_dot,
+        "lam": res.lam, "labels": list(res.labels), "E": res.total_energy})
     lines = res.summary().splitlines()
     # linearization about the equilibrium nearest the initial configuration
     lin = None
@@ -162,10 +166,9 @@ def _report(model: Any, out: Path, parameters: Mapping[str, float] | None,
                    np.column_stack([res.t, w["F"], w["T"], w["F_inertial"], w["T_inertial"]]),
                    delimiter=",", header=",".join(head), comments="")
         files.append(f"wrench-{name}.csv")
-    figs = painter.draw(out, {
-        "t": res.t, "z": res.z, "names": list(names), "Phi": res.Phi, "Phi_dot": res.Phi_dot,
-        "lam": res.lam, "labels": list(res.labels), "E": res.total_energy,
-        "wrenches": {n: {"F": w["F"], "T": w["T"]} for n, w in wrenches.items()}})
+    drawn = painter.draw(out, {"t": res.t, "wrenches": {n: {"F": w["F"], "T": w["T"]}
+                                                       for n, w in wrenches.items()}})
+    figs = sorted([*motion_figs.result(), *drawn.result()], key=FIGURES.index)
     info = {"name": loop.name, "status": res.status, "message": res.message,
             "max_Phi": res.max_Phi, "max_Phi_dot": res.max_Phi_dot,
             "energy_drift": res.energy_drift,

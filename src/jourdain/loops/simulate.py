@@ -60,7 +60,7 @@ from .closed_loop import (
     SingularConfiguration,
     constraint_function,
 )
-from .compiled import REASONS, LoopKernel, input_function
+from .compiled import REASONS, LoopKernel, build_loop_library_soon, input_function
 from .redundant import simulate_penalty, simulate_redundant
 from .results import LoopResults
 from .scipy_run import SOLVERS, run_scipy
@@ -95,6 +95,9 @@ def simulate_loop(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: Any,
         raise EvaluationError(f"method must be one of {', '.join(SOLVERS)}, got {method!r}")
     if engine not in ("c", "scipy"):
         raise EvaluationError(f'engine must be "c" or "scipy", got {engine!r}')
+    c_engine = engine == "c" and method in C_METHODS and not callable(inputs)
+    if c_engine:  # the loop kernel compiled while the tree's functions are
+        build_loop_library_soon(loop)
     fn_u = input_function(loop, inputs) if isinstance(inputs, Mapping) else None
     u_of = _input_values(loop, inputs, fn_u, parameters)
     ev = LoopEvaluator(loop, z0, t0, parameters, u_of(t0))
@@ -106,7 +109,7 @@ def simulate_loop(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: Any,
     started = time.perf_counter()
     ind = list(ev.part.independent)
     x = np.concatenate([asm.z[ind], asm.zd[ind]])
-    if engine == "c" and method in C_METHODS and not callable(inputs):
+    if c_engine:
         run = _run_c(ev, t0, t1, x, tev, method, rtol, atol, max_step, repartition, cond_limit,
                      fn_u)
         run_method = method

@@ -49,7 +49,7 @@ import sys
 import tempfile
 import threading
 import warnings
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from functools import lru_cache
 from pathlib import Path
 
@@ -304,6 +304,36 @@ def build(key: str, source: str | Sequence[str], extra_flags: Sequence[str] = ()
 
 _BUILDING: dict[str, threading.Lock] = {}
 _BUILDING_GUARD = threading.Lock()
+
+
+def _forget_builds() -> None:
+    """In a child forked while a thread built: the build's locks are the parent's (none of
+    its threads runs here to release them); fresh ones."""
+    global _BUILDING_GUARD
+    _BUILDING.clear()
+    _BUILDING_GUARD = threading.Lock()
+
+
+os.register_at_fork(after_in_child=_forget_builds)
+
+
+def build_soon(fn: Callable[..., object], *args: object, name: str = "jourdain-build") -> None:
+    """Start ``fn(*args)``, a function that builds a library (through :func:`build`), in a
+    thread and return at once: the compiler runs in a process of its own, on another core,
+    while the caller goes on (other code to generate and compile). The caller's own later call
+    of ``fn`` waits for that build (:func:`build` holds one lock per library), or builds where
+    this one failed and raises its error then: the thread's errors are dropped. A child
+    forked meanwhile builds for itself."""
+
+    def quietly() -> None:
+        try:
+            fn(*args)
+        except Exception:  # noqa: BLE001 - the caller's own call reports it
+            pass
+
+    # not a daemon: an exit waits for the compiler (Ctrl-C stops the compiler with it), so
+    # that no half-built library is left in the cache
+    threading.Thread(target=quietly, name=name).start()
 
 
 def _build(key: str, source: str | Sequence[str], extra_flags: Sequence[str],

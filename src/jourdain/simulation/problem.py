@@ -9,7 +9,6 @@ import ctypes
 import inspect
 import math
 import numbers
-import threading
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from functools import lru_cache
@@ -22,7 +21,7 @@ from ..errors import EvaluationError, JourdainError
 from ..model.expressions import as_expr
 from ..numeric import CompiledFunction, lambdify
 from ..numeric.integrator_c import library_source as integrator_source
-from ..numeric.toolchain import build
+from ..numeric.toolchain import build, build_soon
 from ..symbolic import SymMatrix
 
 if TYPE_CHECKING:
@@ -88,25 +87,15 @@ def integrator_library() -> ctypes.CDLL:
 
 
 def build_integrator_soon() -> None:
-    """Start compiling the integrator library in a thread and return at once (the compiler
-    runs in a process of its own, on another core): for a caller that will simulate after
+    """Start compiling the integrator library in a thread and return at once
+    (:func:`jourdain.numeric.toolchain.build_soon`): for a caller that will simulate after
     other work, such as ``jourdain run``, which derives, compiles and evaluates the model
-    meanwhile. Where the library is built or cached already, nothing is done. A later
-    :func:`integrator_library` waits for the build (:func:`build` holds one lock per library),
-    or builds it itself where this one failed, and raises its error then. Call it after any
-    ``fork`` of this process: a forked child would hold a copy of the build's lock."""
-    if integrator_library.cache_info().currsize:
-        return
-    # not a daemon: an exit waits for the compiler (Ctrl-C stops the compiler with it), so
-    # that no half-built library is left in the cache
-    threading.Thread(target=_build_quietly, name="jourdain-integrator-build").start()
-
-
-def _build_quietly() -> None:
-    try:
-        integrator_library()
-    except Exception:  # noqa: BLE001 - the caller's own integrator_library() reports it
-        pass
+    meanwhile (the thread loads a library cached or prebuilt). Where this process has loaded
+    it, nothing is done. A later :func:`integrator_library` waits for the build, or builds it
+    itself where this one failed, and raises its error then. Call it after any ``fork`` of
+    this process (a child forked meanwhile would compile it again)."""
+    if not integrator_library.cache_info().currsize:
+        build_soon(integrator_library, name="jourdain-integrator-build")
 
 
 def integrate_accel(accel: int, f: int, p: np.ndarray, n_inputs: int, x0: np.ndarray,
