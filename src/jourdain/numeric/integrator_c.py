@@ -123,8 +123,8 @@ def units() -> tuple[tuple[str, tuple[str, ...]], ...]:
 def library_source() -> tuple[str, list[str], list[tuple[str, ...]]]:
     """The library's content key (:func:`jourdain.numeric.toolchain.content_key`: the units'
     text and flags, the compiler's flags and target), its units' text and their flags."""
-    texts = [text for text, _ in units()]
-    flags = [fl for _, fl in units()]
+    us = units()
+    texts, flags = [text for text, _ in us], [fl for _, fl in us]
     return toolchain.content_key("integrator", *texts, *(" ".join(f) for f in flags)), texts, flags
 
 
