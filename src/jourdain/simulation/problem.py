@@ -23,6 +23,7 @@ from ..numeric import CompiledFunction, lambdify
 from ..numeric.integrator_c import library_source as integrator_source
 from ..numeric.toolchain import build, build_soon
 from ..symbolic import SymMatrix
+from .options import C_METHODS
 
 if TYPE_CHECKING:
     from ..model.system import System
@@ -105,41 +106,73 @@ def integrate_accel(accel: int, f: int, p: np.ndarray, n_inputs: int, x0: np.nda
     (the address of a C function with ``jd_accel``'s signature) is given with its parameters
     ``p``, inputs held at zero (the monodromy matrix of :mod:`jourdain.analysis.floquet`).
     Raises EvaluationError with the integrator's reason and the time where it stopped."""
-    lib = integrator_library()
-    n = 2 * f + 1
-    pv = np.ascontiguousarray(p, dtype=float).reshape(-1)
-    nu = max(n_inputs, 1)
-    zeros, kinds = np.zeros(nu), np.zeros(nu, dtype=np.intc)
-    offsets = np.zeros(n_inputs + 1, dtype=np.int_)
-    atols = np.full(n, float(atol))
-    problem = _Problem(f, n_inputs, 0, None, None, None, None, address(pv), address(zeros),
-                       address(kinds), address(offsets), address(zeros), address(zeros), None,
-                       None, 1, float(rtol), address(atols), math.inf, 0.0, accel)
-    st = np.zeros(4)
-    st[0] = t_span[0]
-    x = np.ascontiguousarray(x0, dtype=float).copy()
-    k0, g, fail = np.zeros(n), np.zeros(1), np.zeros(n + 1)
-    te = np.array([float(t_span[1])])
-    out_t, out_x, out_dx = np.zeros(1), np.zeros(n), np.zeros(n)
-    ints = np.zeros(9, dtype=np.int_)  # cnt (5), i_eval, n_out, n_ev, ev_i (no events)
-    ev = np.zeros(n + 1)
-    di = ints.itemsize
-    a_int = address(ints)
-    while True:
-        code = lib.jd_integrate(
-            ctypes.byref(problem), te[0], address(st), address(x), address(k0), address(g),
-            a_int, address(te), 1, a_int + 5 * di, address(out_t), address(out_x),
-            address(out_dx), 1, a_int + 6 * di, address(ev), address(ev) + 8, a_int + 8 * di,
-            1, a_int + 7 * di, 1_000_000, address(fail))
-        if code != _CONTINUE:
-            break
-    if code != _DONE or ints[6] != 1:
+    pv = np.ascontiguousarray(p, dtype=float).reshape(-1)  # alive while the run reads it
+    t1 = float(t_span[1])
+    seg = Segment(f, np.zeros(n_inputs), None, address(pv), accel, float(t_span[0]),
+                  np.ascontiguousarray(x0, dtype=float), np.array([t1]), C_METHODS["DOP853"],
+                  rtol, atol, math.inf)
+    code = seg.run(t1)
+    if code != _DONE or seg.n_out[0] != 1:
         reason = {_ESINGULAR: "the mass matrix is not positive definite",
                   _ENAN: "NaN or inf in the state or its derivative",
                   _ESTEP: "the step size fell below the round-off limit"}.get(
                       code, f"the integrator failed with code {code}")
-        raise EvaluationError(f"{reason} at t = {fail[0]:.9g}")
-    return out_x.copy()
+        raise EvaluationError(f"{reason} at t = {seg.fail[0]:.9g}")
+    return seg.out_x[0].copy()
+
+
+class Segment:
+    """One run of the C integrator (``jd_integrate``) from ``t`` with the state ``x = [y, ẏ,
+    W]`` (f coordinates), the right-hand side ``accel`` (a ``jd_accel`` hook) with ``p`` its
+    state, constant inputs ``u``, output at ``te``; :meth:`run` to ``t1``. For problems that
+    are not a model's: the closed loops' drivers (:mod:`jourdain.loops.c_run`) and the
+    monodromy matrix (:func:`integrate_accel`)."""
+
+    def __init__(self, f: int, u: np.ndarray, mkq: int | None, p: int, accel: int, t: float,
+                 x: np.ndarray, te: np.ndarray, method: int, rtol: float, atol: float,
+                 max_step: float) -> None:
+        n = 2 * f + 1
+        nu = len(u)
+        self.u_const = np.zeros(max(nu, 1))
+        self.u_const[:nu] = u
+        self.u_kind = np.zeros(max(nu, 1), dtype=np.intc)
+        self.tab_off = np.zeros(nu + 1, dtype=np.int_)
+        self.atol = np.full(n, float(atol))
+        # by field name: the integrator's problem struct (simulation.simulate) may grow
+        self.problem = _Problem(
+            f=f, nu=nu, nev=0, mkq=mkq, uexpr=None, events=None, ucb=None,
+            p=p, u_const=address(self.u_const), u_kind=address(self.u_kind),
+            tab_off=address(self.tab_off), tab_t=None, tab_v=None, ev_dir=None, ev_term=None,
+            method=method, rtol=float(rtol), atol=address(self.atol),
+            h_max=float(max_step), h_first=0.0, accel=accel)
+        self.st = np.array([t, 0.0, 0.0, 0.0])
+        self.x = x.copy()
+        self.k0 = np.zeros(n)
+        self.g_old = np.zeros(1)
+        self.cnt = np.zeros(5, dtype=np.int_)
+        self.te = np.ascontiguousarray(te, dtype=float)
+        self.i_eval = np.zeros(1, dtype=np.int_)
+        cap = max(self.te.size, 1)
+        self.out_t = np.empty(cap)
+        self.out_x = np.empty((cap, n))
+        self.out_dx = np.empty((cap, n))
+        self.n_out = np.zeros(1, dtype=np.int_)
+        self.ev_t, self.ev_x = np.empty(1), np.empty((1, n))
+        self.ev_i, self.n_ev = np.empty(1, dtype=np.int_), np.zeros(1, dtype=np.int_)
+        self.fail = np.zeros(n + 1)
+
+    def run(self, t1: float) -> int:
+        lib = integrator_library()
+        while True:
+            code = int(lib.jd_integrate(
+                ctypes.byref(self.problem), t1, address(self.st), address(self.x),
+                address(self.k0), address(self.g_old), address(self.cnt), address(self.te),
+                self.te.size, address(self.i_eval), address(self.out_t), address(self.out_x),
+                address(self.out_dx), self.out_t.size, address(self.n_out), address(self.ev_t),
+                address(self.ev_x), address(self.ev_i), 1, address(self.n_ev), 1 << 20,
+                address(self.fail)))
+            if code != _CONTINUE:  # else the step budget of one call used
+                return code
 
 
 @overload
