@@ -128,7 +128,6 @@ def test_a_child_forked_during_a_build_builds_for_itself(fresh_cache):
 
     source = "int jd_seven(void) { return 7; }\n"
     key = toolchain.content_key("fork test", source)
-    with toolchain._BUILDING_GUARD:
-        lock = toolchain._BUILDING.setdefault(key, threading.Lock())
-    with lock, multiprocessing.get_context("fork").Pool(1) as pool:  # as if mid-build
+    with toolchain.build_lock(key), multiprocessing.get_context("fork").Pool(1) as pool:
+        # as if mid-build
         assert pool.apply_async(_build_in_child, (key, source)).get(timeout=120) == 7

@@ -15,8 +15,6 @@ jourdain's C integrator with them: one C call per step loop, no Python per right
 from __future__ import annotations
 
 import ctypes
-import os
-import threading
 from collections.abc import Mapping
 from functools import lru_cache
 from importlib import resources
@@ -28,7 +26,7 @@ import symengine as se
 from ..errors import EvaluationError
 from ..numeric import CompiledFunction, lambdify, mkq_function
 from ..numeric.ccode import HEADER, argument_names, function_source
-from ..numeric.toolchain import build, build_soon, content_key
+from ..numeric.toolchain import build, build_lock, build_soon, content_key
 from ..simulation.problem import address
 from ..symbolic import SymMatrix
 from .closed_loop import ClosedLoopSystem, LoopEvaluator, Partition, constraints
@@ -58,19 +56,8 @@ def loop_library(loop: LoopModel) -> ctypes.CDLL:
     """The compiled constraint functions and loop kernel of ``loop`` (cached by content).
     One at a time: a call while a build started ahead (:func:`build_loop_library_soon`)
     generates the source waits for it instead of generating it again."""
-    with _LIBRARY_LOCK:
+    with build_lock("loop library"):
         return _loop_library(loop)
-
-
-_LIBRARY_LOCK = threading.Lock()
-
-
-def _fresh_lock() -> None:  # a child forked while a thread built: the parent's lock, held
-    global _LIBRARY_LOCK
-    _LIBRARY_LOCK = threading.Lock()
-
-
-os.register_at_fork(after_in_child=_fresh_lock)
 
 
 def build_loop_library_soon(loop: LoopModel) -> None:

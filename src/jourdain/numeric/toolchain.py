@@ -295,15 +295,21 @@ def build(key: str, source: str | Sequence[str], extra_flags: Sequence[str] = ()
     lib = cached_library(key)
     if lib is not None:
         return lib
-    with _BUILDING_GUARD:  # one build per key at a time (a background build, then a caller)
-        lock = _BUILDING.setdefault(key, threading.Lock())
-    with lock:
+    with build_lock(key):  # one build per key at a time (a background build, then a caller)
         lib = cached_library(key)  # built meanwhile by another thread
         return lib if lib is not None else _build(key, source, extra_flags, unit_flags)
 
 
 _BUILDING: dict[str, threading.Lock] = {}
 _BUILDING_GUARD = threading.Lock()
+
+
+def build_lock(name: str) -> threading.Lock:
+    """The lock of one build, by ``name`` (a library's key, or a name of the caller's for a
+    larger step that builds, such as generating a source): one thread at a time builds it,
+    the others wait and then find it built. Fresh in a child forked while it was held."""
+    with _BUILDING_GUARD:
+        return _BUILDING.setdefault(name, threading.Lock())
 
 
 def _forget_builds() -> None:
