@@ -286,6 +286,21 @@ def test_local_processes_and_dask_cluster_equal_the_serial_run() -> None:
     _same(beside, serial)
 
 
+@pytest.mark.parametrize("blocks, n", [(20, 8), (20, 4), (7, 2), (3, 8), (1, 4), (16, 8)])
+def test_cluster_tasks_are_equal_groups_of_consecutive_blocks(blocks: int, n: int) -> None:
+    """A cluster's tasks: every block once, in order, in at most n groups whose sizes differ by
+    one block at most (20 blocks on 8 tasks: 3, 3, 3, 3, 2, 2, 2, 2, ten for each of two
+    workers taking them as they finish)."""
+    from jourdain.study.runner import _groups
+
+    todo = [(512 * i, 512 * (i + 1)) for i in range(blocks)]
+    groups = _groups(todo, n)
+    assert [b for g in groups for b in g] == todo
+    sizes = [len(g) for g in groups]
+    assert len(groups) == min(n, blocks) and min(sizes) >= 1 and max(sizes) - min(sizes) <= 1
+    assert sizes == sorted(sizes, reverse=True)
+
+
 def test_auto_pool_uses_threads_unless_cases_simulate_one_by_one(
         monkeypatch: pytest.MonkeyPatch) -> None:
     """pool="auto": a linearization study (one C call and stacked LAPACK per block, the GIL

@@ -13,6 +13,7 @@ written.
 
 from __future__ import annotations
 
+import itertools
 import json
 import os
 import shutil
@@ -254,6 +255,16 @@ def _compute_blocks(spec: StudySpec, todo: list[tuple[int, int]], keys: dict[str
 TASKS_PER_THREAD = 4
 
 
+def _groups(todo: list[tuple[int, int]], n: int) -> list[list[tuple[int, int]]]:
+    """``todo`` in at most ``n`` consecutive groups whose sizes differ by one block at most
+    (20 blocks in 8 groups: 3, 3, 3, 3, 2, 2, 2, 2, so that two workers taking them as they
+    finish get ten blocks each; groups of ⌈20/8⌉ = 3 gave seven, four to one worker)."""
+    n = max(1, min(n, len(todo)))
+    size, extra = divmod(len(todo), n)
+    bounds = [i * size + min(i, extra) for i in range(n + 1)]
+    return [todo[a:b] for a, b in itertools.pairwise(bounds) if b > a]
+
+
 def _run_dask(spec: StudySpec, todo: list[tuple[int, int]], scheduler: Any,
               keys: dict[str, str]) -> Iterator[dict[str, Any]]:
     try:
@@ -270,11 +281,14 @@ def _run_dask(spec: StudySpec, todo: list[tuple[int, int]], scheduler: Any,
     try:
         threads = sum(w.get("nthreads", 1)
                       for w in client.scheduler_info()["workers"].values()) or 1
-        size = -(-len(todo) // (TASKS_PER_THREAD * threads))
-        groups = [todo[i:i + size] for i in range(0, len(todo), size)]
-        # the spec (a few kB: the study and model texts) travels with each task; a scattered
-        # copy, content-keyed, raced with its release when the same study ran again
-        futures = [client.submit(_compute_blocks, spec, g, keys, pure=False) for g in groups]
+        groups = _groups(todo, TASKS_PER_THREAD * threads)
+        # all tasks in one message to the scheduler: a client sends what it is given within
+        # 10 ms of its last message in its next batch, so that tasks submitted one by one
+        # reached an idle second worker 10 ms after the first. The spec (a few kB: the study
+        # and model texts) travels with each task; a scattered copy, content-keyed, raced
+        # with its release when the same study ran again
+        futures = client.map(_compute_blocks, [spec] * len(groups), groups,
+                             [keys] * len(groups), pure=False)
         try:
             # results gathered as they finish, in batches: one round trip for several tasks;
             # on this client's loop (as_completed takes the default client's otherwise, and
