@@ -13,7 +13,9 @@
    * *1 → 2 workers*: the whole ``run_study`` call on 1 and 2 threads (``pool="auto"``), on 2
      fresh processes (worker start and model rebuild included) and on warm Dask
      ``LocalCluster``s of 1 and 2 workers, medians of ``--rounds`` interleaved rounds, beside
-     the ceiling of the map's own LAPACK work on two threads measured in the same rounds.
+     the ceiling of the map's own LAPACK work on two threads measured in the same rounds; and
+     the same again on a 300 × 300 map (``--scaling-n``), where the work outweighs a run's
+     fixed costs (a Dask run's scheduler, messages and results, on the same two cores).
 
    The batched verdicts are compared with the loop's on the cases the loop ran.
 
@@ -24,7 +26,8 @@
    :mod:`jourdain.study.ensemble`), on 1 and 2 workers (processes; threads for the ensembles,
    which release the GIL), side by side; the C integration alone, for the share left to it.
 
-    python benchmarks/study.py             # 10 000 cases, 1 000 runs (about a minute)
+    python benchmarks/study.py             # 10 000 cases (and 1 -> 2 workers on 90 000),
+                                           # 1 000 runs (about two minutes)
     python benchmarks/study.py --quick     # 40 × 40 cases, 200 runs
     python benchmarks/study.py --only mc   # the Monte-Carlo part alone
 """
@@ -150,6 +153,16 @@ def stability_map(n: int, loop_cases: int, rounds: int = 9) -> dict:
         **scaling,
     }
     return out
+
+
+def map_scaling(n: int, rounds: int) -> dict:
+    """1 → 2 workers alone (:func:`_scaling`) on an n × n map: the 10 000-case map runs 70 ms on
+    one worker, of which a Dask run's fixed costs (scheduler, messages, results; on the same two
+    cores as its workers) take a third; on a larger map the work outweighs them."""
+    spec = loads_study(_map_spec(n))
+    ctx = context(spec)
+    ref = run_study(spec, workers=1, quiet=True)
+    return {"cases": len(ctx.cases), **_scaling(spec, ctx, ref, rounds)}
 
 
 def _scaling(spec: object, ctx: object, ref: object, rounds: int) -> dict:
@@ -370,22 +383,29 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=3, help="Monte-Carlo timings: best of N")
     ap.add_argument("--rounds", type=int, default=9,
                     help="stability map, 1 -> 2 workers: interleaved rounds (medians)")
+    ap.add_argument("--scaling-n", type=int, default=300,
+                    help="also 1 -> 2 workers on an N x N map, where the work outweighs the "
+                         "fixed costs of a run (0: not)")
     ap.add_argument("--only", choices=("map", "mc"), help="run one of the two parts")
     ap.add_argument("--json", metavar="FILE", help="also write the figures as JSON")
     args = ap.parse_args()
     if args.quick:
-        args.n, args.loop_cases, args.mc, args.rounds = 40, 100, 200, 3
+        args.n, args.loop_cases, args.mc, args.rounds, args.scaling_n = 40, 100, 200, 3, 0
     with tempfile.TemporaryDirectory() as tmp:
         os.chdir(tmp)
         res = {"cpus": os.cpu_count(), "load_before": os.getloadavg(),
                "ceiling_before": machine_ceiling()}
         if args.only != "mc":
             res["stability_map"] = stability_map(args.n, args.loop_cases, args.rounds)
+            if args.scaling_n:
+                res["stability_map_scaling"] = map_scaling(args.scaling_n, args.rounds)
         if args.only != "map":
             res["monte_carlo"] = monte_carlo(args.mc, args.repeat)
         res.update(ceiling_after=machine_ceiling(), load_after=os.getloadavg())
     if "stability_map" in res:
         _print_map(res["stability_map"])
+    if "stability_map_scaling" in res:
+        _print_scaling(res["stability_map_scaling"])
     if "monte_carlo" in res:
         _print_mc(res["monte_carlo"])
     print(f"this machine's own ceiling for 2 processes (pure-Python busy loop): "
@@ -403,6 +423,17 @@ def _print_map(m: dict) -> None:
     print(f"  batched (run_study, 1 process):    {m['batched_cases_per_s']:10.0f} cases/s  "
           f"{m['speedup_vs_loop']:.0f}x the loop, {m['speedup_vs_compiled_loop']:.0f}x the "
           f"compiled loop; verdicts agree {m['verdicts_agree']}")
+    _print_workers(m)
+    print(f"  loop calling System.linearize per case: {m['relinearize_loop_cases_per_s']:.1f} "
+          f"cases/s (batched: {m['speedup_vs_relinearize_loop']:.0f}x)")
+
+
+def _print_scaling(m: dict) -> None:
+    print(f"stability map, {m['cases']} cases, 1 -> 2 workers alone:")
+    _print_workers(m)
+
+
+def _print_workers(m: dict) -> None:
     print(f"  1 -> 2 workers, medians of {m['rounds']} interleaved rounds (identical to the serial "
           f"run: {all(m['identical'].values())}):")
     print(f"    run_study, 1 worker {m['1_worker_s']:.3f} s; 2 workers (threads) "
@@ -415,8 +446,6 @@ def _print_map(m: dict) -> None:
     print(f"    ceiling now: the map's eigenvalues alone (LAPACK, no GIL), 1 thread "
           f"{m['lapack_1_thread_s']:.3f} s, 2 threads {m['lapack_2_threads_s']:.3f} s: "
           f"{m['lapack_ceiling']:.2f}x")
-    print(f"  loop calling System.linearize per case: {m['relinearize_loop_cases_per_s']:.1f} "
-          f"cases/s (batched: {m['speedup_vs_relinearize_loop']:.0f}x)")
 
 
 def _print_mc(c: dict) -> None:
