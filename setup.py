@@ -13,7 +13,7 @@ import sys
 from pathlib import Path
 from types import ModuleType
 
-from setuptools import Command, setup
+from setuptools import Command, Distribution, setup
 from setuptools.command.build import build
 
 SRC = Path(__file__).resolve().parent / "src"
@@ -87,5 +87,15 @@ class build_with_integrator(build):
     sub_commands = [*build.sub_commands, ("build_integrator", None)]
 
 
+class MachineCodeDistribution(Distribution):
+    """A wheel that carries the integrator library is compiled code for one platform and one
+    Python: tagged so (``cp311-cp311-linux_x86_64``), not as pure Python (``py3-none-any``,
+    which pip would install anywhere, with a library that no other machine's key finds)."""
+
+    def has_ext_modules(self) -> bool:
+        return True
+
+
 if __name__ == "__main__":
-    setup(cmdclass={"build": build_with_integrator, "build_integrator": build_integrator})
+    setup(cmdclass={"build": build_with_integrator, "build_integrator": build_integrator},
+          distclass=MachineCodeDistribution)

@@ -142,3 +142,15 @@ def test_the_build_step_writes_where_the_install_takes_it(tmp_path, editable):
     want = (Path(toolchain.__file__).with_name("prebuilt") if editable
             else tmp_path / "lib" / "jourdain" / "numeric" / "prebuilt")
     assert cmd._dest() == want
+
+
+def test_a_wheel_with_the_library_is_tagged_for_its_platform(tmp_path):
+    """A wheel that carries the compiled integrator is not pure Python: its tag names the
+    interpreter, ABI and platform (py3-none-any would let pip install it on any machine)."""
+    ns = runpy.run_path(str(ROOT / "setup.py"), run_name="jourdain_setup")
+    dist = ns["MachineCodeDistribution"]({"name": "jourdain", "version": "0"})
+    cmd = dist.get_command_obj("bdist_wheel")
+    cmd.bdist_dir = str(tmp_path)
+    cmd.ensure_finalized()
+    impl, abi, plat = cmd.get_tag()
+    assert impl.startswith("cp") and abi != "none" and plat != "any"
