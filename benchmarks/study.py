@@ -36,10 +36,12 @@ from __future__ import annotations
 
 import argparse
 import json
+import logging
 import os
 import sys
 import tempfile
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -252,8 +254,12 @@ def _dask_rounds(spec: object, ref: object, var: str, rounds: int, times: dict,
     runs: dict = {}
     try:
         for n in (1, 2):
-            cl = distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                          dashboard_address=None)
+            with warnings.catch_warnings():
+                # the two schedulers' HTTP servers (health routes; no dashboard): the second
+                # finds the default port taken and says so
+                warnings.filterwarnings("ignore", "Port 8787 is already in use")
+                cl = distributed.LocalCluster(n_workers=n, threads_per_worker=1,
+                                              processes=True, dashboard_address=None)
             client = distributed.Client(cl)
             clusters.append((cl, client))
             runs[f"dask_{n}"] = lambda client=client: run_study(spec, scheduler=client,
@@ -389,6 +395,14 @@ def main() -> None:
     ap.add_argument("--only", choices=("map", "mc"), help="run one of the two parts")
     ap.add_argument("--json", metavar="FILE", help="also write the figures as JSON")
     args = ap.parse_args()
+    # the clusters' INFO lines (workers started, clients removed, ...) between the figures:
+    # dask.distributed's own handler set to warnings, as its LocalCluster does while it starts
+    try:
+        import distributed  # noqa: F401  (configures its logging on import)
+    except ImportError:
+        pass
+    for handler in logging.getLogger("distributed").handlers:
+        handler.setLevel(logging.WARNING)
     if args.quick:
         args.n, args.loop_cases, args.mc, args.rounds, args.scaling_n = 40, 100, 200, 3, 0
     with tempfile.TemporaryDirectory() as tmp:
