@@ -59,3 +59,37 @@ def test_same_sources_and_numbers_in_fresh_processes(tmp_path):
         assert proc.returncode == 0, proc.stderr[-3000:]
         results.append(json.loads(proc.stdout.strip().splitlines()[-1]))
     assert results[0] == results[1] == results[2]
+
+
+STUDY_CHILD = r"""
+import hashlib, json, sys
+import numpy as np
+from jourdain.study import load_study, run_study
+
+junk = [object() for _ in range(int(sys.argv[1]))]
+out = {}
+for name in ("map", "montecarlo", "critical"):
+    ds = run_study(load_study(f"tests/data/study/{name}.toml"), workers=1, quiet=True)
+    out[name] = {k: hashlib.sha256(np.ascontiguousarray(v.values).tobytes()).hexdigest()
+                 for k, v in ds.data_vars.items()}
+    out[name]["coords"] = repr({k: v.values.tolist() for k, v in ds.coords.items()})
+    out[name]["attrs"] = repr(sorted(ds.attrs.items()))
+print(json.dumps(out))
+"""
+
+
+def test_same_study_results_in_fresh_processes(tmp_path):
+    """A grid map, a Monte-Carlo run (drawn from its seed, simulated) and critical values by
+    bisection: every variable, coordinate and attribute of the datasets equal to the bit in
+    fresh interpreters with other hash seeds, memory histories and compile caches."""
+    root = Path(__file__).resolve().parent.parent
+    results = []
+    for k, seed in enumerate(("0", "4242")):
+        env = {**os.environ, "PYTHONHASHSEED": seed,
+               "JOURDAIN_CACHE": str(tmp_path / f"cache{k}")}
+        proc = subprocess.run([sys.executable, "-c", STUDY_CHILD, str(1000 * (k + 1) ** 3)],
+                              env=env, cwd=root, capture_output=True, text=True, timeout=600)
+        assert proc.returncode == 0, proc.stderr[-3000:]
+        results.append(json.loads(proc.stdout.strip().splitlines()[-1]))
+    assert results[0] == results[1]
+    assert set(results[0]["montecarlo"]) > {"coords", "attrs"}
