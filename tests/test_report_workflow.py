@@ -148,7 +148,8 @@ def test_figures_of_a_lost_worker_are_drawn_here():
 
     import numpy as np
 
-    from jourdain.io.report import figures, workers
+    from jourdain.io import workers
+    from jourdain.io.report import figures
 
     if workers.cores() < 2:
         pytest.skip("one core: the report forks no workers")
@@ -209,7 +210,7 @@ def test_stop_workers_does_not_wait_for_a_worker_still_starting(tmp_path):
     import sys
     import time as _time
 
-    from jourdain.io.report.workers import fork_workers, stop_workers
+    from jourdain.io.workers import fork_workers, stop_workers
 
     pool = fork_workers(_sleep_long)
     if pool is None:

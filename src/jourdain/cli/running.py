@@ -13,7 +13,7 @@ from ..io import capabilities as integration
 from ..io.fmu import export_fmu
 from ..io.report import write_report
 from ..io.report.figures import prepare_worker
-from ..io.report.workers import fork_workers, stop_workers
+from ..io.workers import fork_workers, stop_workers
 from ..simulation.simulate import OUTPUT_SUFFIXES
 from ..workflow import require
 from .arguments import UsageError, load, overrides, sim_options, tree_only

@@ -5,22 +5,20 @@ linearizes; in this process where a second core or ``fork`` is missing."""
 
 from __future__ import annotations
 
-import multiprocessing
-import os
 from concurrent.futures import Future, ProcessPoolExecutor
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from ..io.workers import fork_workers
 
-def _import_matplotlib() -> bool:
+
+def _import_matplotlib() -> None:
     import matplotlib  # noqa: PLC0415 (heavy, optional: the report's figures only)
 
     matplotlib.use("Agg")
     import matplotlib.pyplot  # noqa: F401, PLC0415
-
-    return True
 
 
 #: the report's figures in the order the page shows them
@@ -96,22 +94,9 @@ class Painter:
     def __init__(self, pool: ProcessPoolExecutor | None = None) -> None:
         """``pool``: a worker forked earlier (``jourdain run`` forks it before it reads the
         model, so that Matplotlib is imported meanwhile), used instead of a new one."""
-        self.pool: ProcessPoolExecutor | None = pool
-        self.ready: Future[bool] | None = None
-        if pool is not None:
-            return
-        try:
-            cores = len(os.sched_getaffinity(0))
-        except AttributeError:  # not on Linux
-            cores = os.cpu_count() or 1
-        if cores < 2:
-            return
-        try:
-            context = multiprocessing.get_context("fork")
-        except ValueError:  # no fork on this platform
-            return
-        self.pool = ProcessPoolExecutor(1, mp_context=context)
-        self.ready = self.pool.submit(_import_matplotlib)
+        # else forked now, Matplotlib imported there at once; none on one core or without fork
+        self.pool: ProcessPoolExecutor | None = (
+            pool if pool is not None else fork_workers(_import_matplotlib))
 
     def draw(self, out: Path, d: dict[str, Any]) -> Future[list[str]]:
         """:func:`draw_figures` started in the worker (done here where there is none)."""

@@ -17,6 +17,7 @@ from ...version import __version__
 from ...workflow import has_capability, summary
 from .. import export
 from ..modelfile import ModelFile
+from ..workers import fork_workers, ignore_interrupt
 from .equations import (
     Display,
     cached,
@@ -32,7 +33,6 @@ from .linearization import linearization_section, nominal_placeholder
 from .sections import model_section, numbers_section
 from .simulation import simulation_section
 from .state import RUN_FORMAT, ReportInfo, Run
-from .workers import fork_workers, ignore_interrupt
 
 #: the number of computed sections (the list of files is the sixth)
 SECTIONS = 5
