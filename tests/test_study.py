@@ -286,19 +286,25 @@ def test_local_processes_and_dask_cluster_equal_the_serial_run() -> None:
     _same(beside, serial)
 
 
-@pytest.mark.parametrize("blocks, n", [(20, 8), (20, 4), (7, 2), (3, 8), (1, 4), (16, 8)])
-def test_cluster_tasks_are_equal_groups_of_consecutive_blocks(blocks: int, n: int) -> None:
-    """A cluster's tasks: every block once, in order, in at most n groups whose sizes differ by
-    one block at most (20 blocks on 8 tasks: 3, 3, 3, 3, 2, 2, 2, 2, ten for each of two
-    workers taking them as they finish)."""
+@pytest.mark.parametrize("blocks, threads, tasks", [
+    (20, 2, 2), (20, 1, 2), (32, 2, 2), (33, 2, 4), (176, 2, 12), (3, 8, 3), (1, 4, 1),
+    (100, 8, 8), (300, 8, 24)])
+def test_cluster_tasks_are_few_strided_groups_of_at_most_16_blocks(
+        blocks: int, threads: int, tasks: int) -> None:
+    """A cluster's tasks: every block once; one task per worker thread while a thread's share
+    is at most 16 blocks (a task's blocks are saved when it ends), else a multiple of the
+    threads; sizes differ by one block at most; task k takes blocks k, k + n, k + 2n, ... (a
+    region of costly cases is shared, not left to one worker)."""
     from jourdain.study.runner import _groups
 
     todo = [(512 * i, 512 * (i + 1)) for i in range(blocks)]
-    groups = _groups(todo, n)
-    assert [b for g in groups for b in g] == todo
+    groups = _groups(todo, threads)
+    assert len(groups) == tasks
+    assert sorted(b for g in groups for b in g) == todo
     sizes = [len(g) for g in groups]
-    assert len(groups) == min(n, blocks) and min(sizes) >= 1 and max(sizes) - min(sizes) <= 1
-    assert sizes == sorted(sizes, reverse=True)
+    assert max(sizes) <= 16 and max(sizes) - min(sizes) <= 1
+    for k, g in enumerate(groups):
+        assert [s // 512 for s, _ in g] == list(range(k, blocks, tasks))
 
 
 def test_auto_pool_uses_threads_unless_cases_simulate_one_by_one(
