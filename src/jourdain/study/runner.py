@@ -251,10 +251,10 @@ def _compute_blocks(spec: StudySpec, todo: list[tuple[int, int]], keys: dict[str
 #: the most blocks in one Dask task. A task's blocks reach the client, and are saved, when the
 #: task ends, so this bounds what an interrupted study loses per worker thread (16 blocks:
 #: 8 192 cases at the default block size). Below it a thread gets one task: each task costs
-#: the scheduler and the client a few ms of Python (measured, 10 000-case map on a 2-worker
-#: LocalCluster: 28 ms of the client process's CPU per run for 8 tasks, on the workers' cores)
-#: and its worker a gap of 1 to 3 ms before the next; in alternated runs 1 → 2 workers gave
-#: 1.59× with one task per thread against 1.39× with four
+#: the scheduler and the client a few ms of Python, on the workers' cores where the cluster
+#: is local, and its worker a gap of 1 to 3 ms before the next. Measured on the 10 000-case map
+#: (20 blocks), 2-worker LocalCluster, alternated runs: the client process's CPU per run 39 ms
+#: with four tasks per thread, 21 ms with one; 1 → 2 workers 1.23× against 1.52×
 BLOCKS_PER_TASK = 16
 
 
