@@ -272,6 +272,9 @@ def test_local_processes_and_dask_cluster_equal_the_serial_run() -> None:
                                   dashboard_address=None) as cluster, \
             distributed.Client(cluster) as client:
         on_cluster = run_study(spec, scheduler=client)
+        # blocks of 16 cases: 8 blocks, two tasks of four (blocks 0, 2, 4, 6 and 1, 3, 5, 7)
+        fine = run_study(loads_study(spec.source.replace("block = 64", "block = 16"),
+                                     base=DATA), scheduler=client)
         again = run_study(spec, scheduler=client)  # the same study twice on one client
         by_address = run_study(spec, scheduler=cluster.scheduler_address)
         # another client made later (the process's default client now): the study still
@@ -281,6 +284,7 @@ def test_local_processes_and_dask_cluster_equal_the_serial_run() -> None:
         # both workers took part (two blocks, one each or both on one: at least ran there)
         assert len(client.scheduler_info()["workers"]) == 2
     _same(on_cluster, serial)
+    _same(fine, serial)
     _same(again, serial)
     _same(by_address, serial)
     _same(beside, serial)
