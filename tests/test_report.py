@@ -4,6 +4,7 @@ The browser test uses headless Chromium (Debian's ``chromium`` package; ``make t
 when missing and it runs as root). Without it the test is skipped with the reason.
 """
 
+import json
 import os
 import re
 import shutil
@@ -156,3 +157,46 @@ def test_report_embeds_the_3d_view(report):
     sc = _scene_of(html.unescape(m.group(1)))
     assert [b["name"] for b in sc["bodies"]] == ["rod1", "rod2"]
     assert sc["n_frames"] > 100
+
+
+def test_report_compiles_the_evaluation_library_beside_the_summarys(tmp_path, monkeypatch):
+    """write_report starts System.evaluate's library (the recursion's M̄, J̄, …, Q̄) in its own
+    thread before the summary compiles the integrator's M, k, q, so that the two compilers run
+    side by side; the numbers are those of the library built in this thread alone."""
+    import threading
+    import time
+
+    from jourdain import numeric
+    from jourdain.numeric import compiled, toolchain
+
+    monkeypatch.setenv("JOURDAIN_CACHE", str(tmp_path / "cache"))  # nothing compiled yet
+    numeric.clear_cache()
+    toolchain._loaded.clear()
+    spans: dict[str, tuple[str, float, float]] = {}
+    build = compiled.build
+
+    def timed(key, *args, **kwargs):
+        t0 = time.perf_counter()
+        lib = build(key, *args, **kwargs)
+        spans.setdefault(key, (threading.current_thread().name, t0, time.perf_counter()))
+        return lib
+
+    monkeypatch.setattr(compiled, "build", timed)
+    model = load_model(ROOT / "examples" / "robot_arm.toml")
+    write_report(model, tmp_path / "out")
+    eom_key = compiled._eom_function(model.system).key
+    mkq_key = compiled.mkq_function(model.system).key
+    assert spans[eom_key][0] == "jourdain-eom-build"
+    assert spans[mkq_key][0] == threading.main_thread().name
+    # the two builds overlapped in time
+    assert spans[eom_key][1] < spans[mkq_key][2] and spans[mkq_key][1] < spans[eom_key][2]
+    doc = json.loads((tmp_path / "out" / "values.json").read_text())
+    numeric.clear_cache()
+    toolchain._loaded.clear()
+    monkeypatch.setenv("JOURDAIN_CACHE", str(tmp_path / "cache2"))  # built again, here
+    ref = load_model(ROOT / "examples" / "robot_arm.toml").system.evaluate(
+        np.asarray(doc["y"]), np.asarray(doc["yd"]), t=doc["t"], parameters=doc["parameters"],
+        inputs=doc["inputs"])
+    for name in ("M_bar", "J_bar", "M", "k", "q"):
+        assert np.array_equal(np.asarray(doc["values"][name], dtype=float),
+                              np.asarray(ref[name], dtype=float)), name

@@ -20,6 +20,7 @@ from .compiled import (
     SYMBOLIC_MAX_F,
     SYMBOLIC_NODES,
     arguments,
+    build_eom_soon,
     clear_cache,
     dynamics_function,
     lambdify,
@@ -34,6 +35,7 @@ from .state import evaluate, parameter_vector, state_vectors, time_value
 from .toolchain import CompilerError, cache_dir
 
 __all__ = ["ACCEL_MAX_F", "ACCEL_TEMPLATE", "SYMBOLIC_MAX_F", "SYMBOLIC_NODES", "time_value",
-           "CompiledFunction", "CompilerError", "InterpretedFunction", "arguments", "cache_dir",
+           "CompiledFunction", "CompilerError", "InterpretedFunction", "arguments",
+           "build_eom_soon", "cache_dir",
            "clear_cache", "dynamics_function", "evaluate", "lambdify", "mkq_function",
            "parameter_vector", "state_vectors"]

@@ -28,6 +28,7 @@ from .recursive import LDL_SOLVE, recursive_units
 from .toolchain import (
     CompilerError,
     build,
+    build_soon,
     cache_dir,
     compiler,
     content_key,
@@ -203,6 +204,16 @@ def _eom_function(system: System) -> CompiledFunction:
     except JourdainError:  # the equations of motion exist; the reactions report the reason
         directions = None
     return _recursive(system, full=True, directions=directions)
+
+
+def build_eom_soon(system: System) -> None:
+    """Start compiling the library of :func:`_eom_function` (M̄, J̄, q̄^c, q̄^e, M, k, q and Q̄ by
+    the recursion: what ``System.evaluate`` and the reactions call) in a thread and return at
+    once (:func:`jourdain.numeric.toolchain.build_soon`): for a caller that compiles other
+    functions of the model meanwhile, such as ``jourdain run``, whose summary compiles the
+    integrator's M, k, q, so that the two compilers run side by side. A later call of
+    ``_eom_function`` waits for that build. Call it after any ``fork`` of this process."""
+    build_soon(_eom_function, system, name="jourdain-eom-build")
 
 
 #: largest f for which the integrator's jd_accel is compiled (its work arrays live on the stack)
