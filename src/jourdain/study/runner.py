@@ -266,8 +266,8 @@ def _groups(todo: list[tuple[int, int]], threads: int) -> list[list[tuple[int, i
     is shared by all tasks instead of falling to one."""
     threads = max(1, threads)
     per_thread = -(-len(todo) // threads)
-    n = threads * max(1, -(-per_thread // BLOCKS_PER_TASK))
-    n = max(1, min(n, len(todo)))
+    # none where every block was saved already (a resumed study submits no task)
+    n = min(threads * max(1, -(-per_thread // BLOCKS_PER_TASK)), len(todo))
     return [todo[k::n] for k in range(n)]
 
 
