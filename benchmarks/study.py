@@ -158,9 +158,9 @@ def stability_map(n: int, loop_cases: int, rounds: int = 9) -> dict:
 
 
 def map_scaling(n: int, rounds: int) -> dict:
-    """1 → 2 workers alone (:func:`_scaling`) on an n × n map: the 10 000-case map runs 65 ms on
-    one worker, to which a Dask run's fixed costs (scheduler, messages, results; on the same two
-    cores as its workers) add about 25 ms; on a larger map the work outweighs them."""
+    """1 → 2 workers alone (:func:`_scaling`) on an n × n map: the 10 000-case map runs 70–100
+    ms on one worker, to which a Dask run's fixed costs (scheduler, messages, results; on the
+    same two cores as its workers) add about 20 ms; on a larger map the work outweighs them."""
     spec = loads_study(_map_spec(n))
     ctx = context(spec)
     ref = run_study(spec, workers=1, quiet=True)
