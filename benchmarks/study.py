@@ -35,6 +35,7 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import logging
 import os
@@ -367,20 +368,26 @@ def _busy(_: int) -> int:
     return s
 
 
-def machine_ceiling() -> float:
+def machine_ceiling(rounds: int = 7) -> tuple[float, float, float]:
     """What 2 processes give on this machine now: two units of pure-Python work, one after the
     other against one each on 2 processes (2.0 on two free cores; less where other work holds
-    them). The scaling figures are to be read against it."""
+    them), as the median, lowest and highest of ``rounds`` interleaved rounds (one round alone
+    swings from 1.3 to over 2 on a shared VM whose speed changes within a second). The
+    scaling figures are to be read against it."""
     import multiprocessing as mp
+    import statistics
 
-    t1, _ = _timed(lambda: (_busy(0), _busy(1)))
+    ratios = []
     with mp.get_context("fork").Pool(2) as pool:
         pool.map(_busy, [0, 1])
-        t2, _ = _timed(lambda: pool.map(_busy, [0, 1]))
-    return t1 / t2
+        for _ in range(rounds):
+            t1, _ = _timed(lambda: (_busy(0), _busy(1)))
+            t2, _ = _timed(lambda: pool.map(_busy, [0, 1]))
+            ratios.append(t1 / t2)
+    return statistics.median(ratios), min(ratios), max(ratios)
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> dict:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--n", type=int, default=100, help="grid points per axis of the map")
     ap.add_argument("--loop-cases", type=int, default=300, help="cases timed in the loop")
@@ -392,9 +399,11 @@ def main() -> None:
     ap.add_argument("--scaling-n", type=int, default=300,
                     help="also 1 -> 2 workers on an N x N map, where the work outweighs the "
                          "fixed costs of a run (0: not)")
+    ap.add_argument("--ceiling-rounds", type=int, default=7,
+                    help="the machine's own ceiling for 2 processes: median of N rounds")
     ap.add_argument("--only", choices=("map", "mc"), help="run one of the two parts")
     ap.add_argument("--json", metavar="FILE", help="also write the figures as JSON")
-    args = ap.parse_args()
+    args = ap.parse_args(argv)
     # the clusters' INFO lines (workers started, clients removed, ...) between the figures:
     # dask.distributed's own handler set to warnings, as its LocalCluster does while it starts
     try:
@@ -405,29 +414,33 @@ def main() -> None:
         handler.setLevel(logging.WARNING)
     if args.quick:
         args.n, args.loop_cases, args.mc, args.rounds, args.scaling_n = 40, 100, 200, 3, 0
-    with tempfile.TemporaryDirectory() as tmp:
-        os.chdir(tmp)
+    # the studies' saved blocks in a folder of their own, removed when done; the working folder
+    # back afterwards (a relative --json path, a test calling main)
+    with tempfile.TemporaryDirectory() as tmp, contextlib.chdir(tmp):
         res = {"cpus": os.cpu_count(), "load_before": os.getloadavg(),
-               "ceiling_before": machine_ceiling()}
+               "ceiling_before": machine_ceiling(args.ceiling_rounds)}
         if args.only != "mc":
             res["stability_map"] = stability_map(args.n, args.loop_cases, args.rounds)
             if args.scaling_n:
                 res["stability_map_scaling"] = map_scaling(args.scaling_n, args.rounds)
         if args.only != "map":
             res["monte_carlo"] = monte_carlo(args.mc, args.repeat)
-        res.update(ceiling_after=machine_ceiling(), load_after=os.getloadavg())
+        res.update(ceiling_after=machine_ceiling(args.ceiling_rounds), load_after=os.getloadavg())
     if "stability_map" in res:
         _print_map(res["stability_map"])
     if "stability_map_scaling" in res:
         _print_scaling(res["stability_map_scaling"])
     if "monte_carlo" in res:
         _print_mc(res["monte_carlo"])
-    print(f"this machine's own ceiling for 2 processes (pure-Python busy loop): "
-          f"{res['ceiling_before']:.2f}x before, {res['ceiling_after']:.2f}x after "
+    (b, b_lo, b_hi), (a, a_lo, a_hi) = res["ceiling_before"], res["ceiling_after"]
+    print(f"this machine's own ceiling for 2 processes (pure-Python busy loop, median of "
+          f"{args.ceiling_rounds} rounds): {b:.2f}x ({b_lo:.2f}-{b_hi:.2f}) before, {a:.2f}x ({a_lo:.2f}-{a_hi:.2f}) "
+          f"after "
           f"({res['cpus']} CPUs; load average {res['load_before'][0]:.1f} before, "
           f"{res['load_after'][0]:.1f} after)")
     if args.json:
         Path(args.json).write_text(json.dumps(res, indent=1))
+    return res
 
 
 def _print_map(m: dict) -> None:
