@@ -210,7 +210,8 @@ def _scaling(spec: object, ctx: object, ref: object, rounds: int) -> dict:
     # the Dask clusters apart: their idle workers' event loops would disturb the rest
     _dask_rounds(spec, ref, "max_real_part", rounds, times, identical,
                  {"dask_lapack_1_thread": local["lapack_1_thread"],
-                  "dask_lapack_2_threads": local["lapack_2_threads"]})
+                  "dask_lapack_2_threads": local["lapack_2_threads"]},
+                 fixed=loads_study(_map_spec(2)))
     med = {f"{k}_s": float(np.median(v)) for k, v in times.items()}
     out = {"rounds": rounds, **med, "identical": identical,
            "threads_speedup": med["1_worker_s"] / med["2_workers_s"],
@@ -220,6 +221,10 @@ def _scaling(spec: object, ctx: object, ref: object, rounds: int) -> dict:
         out["dask_speedup"] = med["dask_1_s"] / med["dask_2_s"]
         out["dask_lapack_ceiling"] = (med["dask_lapack_1_thread_s"]
                                       / med["dask_lapack_2_threads_s"])
+    if "dask_fixed_2_s" in med:
+        # two free cores: the 1-worker run's work halved, each run's fixed costs kept
+        work = med["dask_1_s"] - med["dask_fixed_1_s"]
+        out["dask_free_cores_bound"] = med["dask_1_s"] / (work / 2 + med["dask_fixed_2_s"])
     return out
 
 
@@ -243,10 +248,12 @@ def _rounds(runs: dict, rounds: int, ref: object, times: dict, identical: dict,
 
 
 def _dask_rounds(spec: object, ref: object, var: str, rounds: int, times: dict,
-                 identical: dict, extra: dict | None = None) -> None:
+                 identical: dict, extra: dict | None = None, fixed: object = None) -> None:
     """The study on warm LocalClusters of 1 and of 2 worker processes (one thread each), both
     up, in interleaved rounds with the ``extra`` runs (:func:`_rounds`: times under
-    ``dask_1`` and ``dask_2``); nothing without dask.distributed."""
+    ``dask_1`` and ``dask_2``); then, where given, the ``fixed`` study (a few cases: what a
+    run costs beside its work: the scheduler, the messages, the results, the dataset) on
+    both, under ``dask_fixed_1`` and ``dask_fixed_2``; nothing without dask.distributed."""
     try:
         import distributed
     except ImportError:
@@ -267,6 +274,12 @@ def _dask_rounds(spec: object, ref: object, var: str, rounds: int, times: dict,
                                                                 quiet=True)
         runs.update(extra or {})
         _rounds(runs, rounds, ref, times, identical, var)
+        if fixed is not None:  # after the rest: a worker keeps the model of one study
+            few = {f"dask_fixed_{n}": lambda client=client: run_study(fixed, scheduler=client,
+                                                                      quiet=True)
+                   for n, (_, client) in zip((1, 2), clusters)}
+            _rounds(few, rounds, run_study(fixed, workers=1, quiet=True), times, identical,
+                    var)
     finally:
         for cl, client in clusters:
             client.close()
@@ -470,6 +483,11 @@ def _print_workers(m: dict) -> None:
         print(f"    Dask LocalCluster (warm): 1 worker {m['dask_1_s']:.3f} s, 2 workers "
               f"{m['dask_2_s']:.3f} s: {m['dask_speedup']:.2f}x (ceiling in those rounds: "
               f"{m['dask_lapack_ceiling']:.2f}x)")
+    if "dask_free_cores_bound" in m:
+        print(f"    Dask's fixed costs, a 4-case study: 1 worker {m['dask_fixed_1_s'] * 1e3:.1f} "
+              f"ms, 2 workers {m['dask_fixed_2_s'] * 1e3:.1f} ms; on two free cores (the "
+              f"1-worker run's work halved, those costs kept) 1 -> 2 would give "
+              f"{m['dask_free_cores_bound']:.2f}x")
     print(f"    ceiling now: the map's eigenvalues alone (LAPACK, no GIL), 1 thread "
           f"{m['lapack_1_thread_s']:.3f} s, 2 threads {m['lapack_2_threads_s']:.3f} s: "
           f"{m['lapack_ceiling']:.2f}x")

@@ -26,9 +26,11 @@ def test_study_benchmark_tiny_case(capsys, tmp_path, monkeypatch):
     # the batched run's verdict against stability() of the symbolic linearization, per case
     assert m["verdicts_agree"] == "12/12" and m["compiled_loop_agrees"]
     assert m["identical"] == dict.fromkeys(
-        ("1_worker", "2_workers", "2_processes", "dask_1", "dask_2"), True)
+        ("1_worker", "2_workers", "2_processes", "dask_1", "dask_2", "dask_fixed_1",
+         "dask_fixed_2"), True)
     assert 0 < m["unstable_fraction"] < 1  # the map crosses the stability boundary
     assert m["batched_cases_per_s"] > 0 and m["dask_speedup"] > 0
+    assert m["dask_fixed_1_s"] > 0 and m["dask_free_cores_bound"] > 0
 
     c = r["monte_carlo"]
     assert c["runs"] == 16 and c["failed"] == 0
