@@ -277,7 +277,7 @@ def _dask_rounds(spec: object, ref: object, var: str, rounds: int, times: dict,
         if fixed is not None:  # after the rest: a worker keeps the model of one study
             few = {f"dask_fixed_{n}": lambda client=client: run_study(fixed, scheduler=client,
                                                                       quiet=True)
-                   for n, (_, client) in zip((1, 2), clusters)}
+                   for n, (_, client) in enumerate(clusters, start=1)}
             _rounds(few, rounds, run_study(fixed, workers=1, quiet=True), times, identical,
                     var)
     finally:
