@@ -281,7 +281,7 @@ def _dask_rounds(spec: object, ref: object, var: str, rounds: int, times: dict,
             _rounds(few, rounds, run_study(fixed, workers=1, quiet=True), times, identical,
                     var)
     finally:
-        for cl, client in clusters:
+        for cl, client in reversed(clusters):  # each client restores the Dask config it found
             client.close()
             cl.close()
 

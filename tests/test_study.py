@@ -358,6 +358,24 @@ def test_results_to_xarray() -> None:
     assert ds.attrs["model_hash"] == mkq_function(model.system).key
 
 
+def test_study_written_while_dask_config_names_a_closed_distributed_client(
+        tmp_path: Path) -> None:
+    """Two Dask clients closed in the order they were made leave ``scheduler =
+    "dask.distributed"`` in Dask's configuration with no client; xarray's writer asks for that
+    scheduler even for arrays in memory, and failed with Dask's "no Client active"."""
+    import dask
+
+    spec = load_study(DATA / "map.toml")
+    ref = run_study(spec, workers=1, quiet=True)
+    with dask.config.set(scheduler="dask.distributed"):
+        ds = run_study(spec, tmp_path / "map.nc", workers=1, quiet=True)
+        assert dask.config.get("scheduler") == "dask.distributed"  # the caller's, kept
+    back = open_study(tmp_path / "map.nc")
+    assert list(back.data_vars) == list(ref.data_vars)
+    for name in ref.data_vars:  # values and coordinates; NaN equal to NaN
+        assert back[name].equals(ref[name]) and ds[name].equals(ref[name]), name
+
+
 def test_cli_study(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
     from jourdain.cli import main
 

@@ -184,9 +184,26 @@ def write_netcdf(ds: Any, path: str | Path) -> Path:
     path = Path(path)
     engine = _engine()
     tmp = path.with_name(path.name + ".tmp")
-    ds.to_netcdf(tmp, engine=engine)
+    with _scheduler_for(ds):
+        ds.to_netcdf(tmp, engine=engine)
     os.replace(tmp, path)
     return path
+
+
+def _scheduler_for(ds: Any) -> Any:
+    """Dask's synchronous scheduler while a dataset in memory is written. xarray asks Dask for
+    its scheduler even then, and Dask's configuration can name the distributed one with no
+    client left to serve it: after two clients closed in the order they were made, each
+    restoring the configuration it found. A dataset of Dask arrays keeps the caller's."""
+    import contextlib
+
+    if ds.chunks:
+        return contextlib.nullcontext()
+    try:
+        import dask
+    except ImportError:
+        return contextlib.nullcontext()
+    return dask.config.set(scheduler="synchronous")
 
 
 def open_study(path: str | Path) -> Any:
