@@ -12,13 +12,18 @@ from benchmarks import study  # noqa: E402
 
 
 def test_study_benchmark_tiny_case(capsys, tmp_path, monkeypatch):
+    import dask
+
     monkeypatch.chdir(tmp_path)
+    scheduler = dask.config.get("scheduler", None)
     r = study.main(["--n", "12", "--loop-cases", "12", "--mc", "16", "--rounds", "1",
                     "--repeat", "1", "--scaling-n", "0", "--ceiling-rounds", "1",
                     "--json", "figures.json"])
     text = capsys.readouterr().out
     assert "stability map, 144 cases" in text and "Monte-Carlo, 16 runs" in text
-    # the working folder is back, and the relative --json path was written there
+    # Dask's configuration as it was (its clients closed last-made first), the working folder
+    # back, and the relative --json path written there
+    assert dask.config.get("scheduler", None) == scheduler
     assert os.getcwd() == str(tmp_path) and (tmp_path / "figures.json").is_file()
 
     m = r["stability_map"]
