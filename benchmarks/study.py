@@ -447,8 +447,8 @@ def main(argv: list[str] | None = None) -> dict:
         _print_mc(res["monte_carlo"])
     (b, b_lo, b_hi), (a, a_lo, a_hi) = res["ceiling_before"], res["ceiling_after"]
     print(f"this machine's own ceiling for 2 processes (pure-Python busy loop, median of "
-          f"{args.ceiling_rounds} rounds): {b:.2f}x ({b_lo:.2f}-{b_hi:.2f}) before, {a:.2f}x ({a_lo:.2f}-{a_hi:.2f}) "
-          f"after "
+          f"{args.ceiling_rounds} rounds): {b:.2f}x ({b_lo:.2f}-{b_hi:.2f}) before, "
+          f"{a:.2f}x ({a_lo:.2f}-{a_hi:.2f}) after "
           f"({res['cpus']} CPUs; load average {res['load_before'][0]:.1f} before, "
           f"{res['load_after'][0]:.1f} after)")
     if args.json:

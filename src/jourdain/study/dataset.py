@@ -191,10 +191,12 @@ def write_netcdf(ds: Any, path: str | Path) -> Path:
 
 
 def _scheduler_for(ds: Any) -> Any:
-    """Dask's synchronous scheduler while a dataset in memory is written. xarray asks Dask for
-    its scheduler even then, and Dask's configuration can name the distributed one with no
-    client left to serve it: after two clients closed in the order they were made, each
-    restoring the configuration it found. A dataset of Dask arrays keeps the caller's."""
+    """Dask's synchronous scheduler while a dataset in memory is written, where Dask's
+    configuration names the distributed scheduler but no client is left to serve it (two
+    clients closed in the order they were made: each restores the configuration it found).
+    xarray's writer asks Dask for its scheduler even for arrays in memory, and failed there
+    with "no Client active". Otherwise, and for a dataset of Dask arrays, the configuration
+    stays as the caller has it."""
     import contextlib
 
     if ds.chunks:
@@ -203,7 +205,15 @@ def _scheduler_for(ds: Any) -> Any:
         import dask
     except ImportError:
         return contextlib.nullcontext()
-    return dask.config.set(scheduler="synchronous")
+    if dask.config.get("scheduler", None) not in ("dask.distributed", "distributed"):
+        return contextlib.nullcontext()
+    try:
+        from distributed import default_client
+
+        default_client()
+    except (ImportError, ValueError):  # named, with no client
+        return dask.config.set(scheduler="synchronous")
+    return contextlib.nullcontext()
 
 
 def open_study(path: str | Path) -> Any:
