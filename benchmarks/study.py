@@ -159,9 +159,9 @@ def stability_map(n: int, loop_cases: int, rounds: int = 9) -> dict:
 
 
 def map_scaling(n: int, rounds: int) -> dict:
-    """1 → 2 workers alone (:func:`_scaling`) on an n × n map: the 10 000-case map runs 70–100
+    """1 → 2 workers alone (:func:`_scaling`) on an n × n map: the 10 000-case map runs 70–130
     ms on one worker, to which a Dask run's fixed costs (scheduler, messages, results; on the
-    same two cores as its workers) add about 20 ms; on a larger map the work outweighs them."""
+    same two cores as its workers) add 12–20 ms; on a larger map the work outweighs them."""
     spec = loads_study(_map_spec(n))
     ctx = context(spec)
     ref = run_study(spec, workers=1, quiet=True)
@@ -385,7 +385,7 @@ def machine_ceiling(rounds: int = 7) -> tuple[float, float, float]:
     """What 2 processes give on this machine now: two units of pure-Python work, one after the
     other against one each on 2 processes (2.0 on two free cores; less where other work holds
     them), as the median, lowest and highest of ``rounds`` interleaved rounds (one round alone
-    swings from 1.3 to over 2 on a shared VM whose speed changes within a second). The
+    swung from below 1 to 2.6 on a shared VM whose speed changes within a second). The
     scaling figures are to be read against it."""
     import multiprocessing as mp
     import statistics
