@@ -35,7 +35,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from jourdain.loops import LoopEvaluator, constraints  # noqa: E402
-from jourdain.loops.models import four_bar, slider_crank  # noqa: E402
+from jourdain.models.loops import four_bar, slider_crank  # noqa: E402
 from jourdain.loops.simulate import simulate_loop  # noqa: E402
 
 
@@ -86,7 +86,7 @@ def simulate_ida(loop, z0, zd0, T, rtol):  # noqa: ANN001, ANN201
     from sksundae.ida import IDA
 
     ev = LoopEvaluator(loop, z0)
-    n = loop.n
+    n = loop.f
     m = len(ev.labels)
     zdd, lam = ev.redundant_accelerations(z0, zd0, 0.0)
 

@@ -1,7 +1,7 @@
 """The N four-bar mechanism (IFToMM multibody benchmark library: N parallelograms in a row,
 bars of 1 m and 1 kg, gravity 9.81 m/s² along −y), through its singular flat positions.
 
-``jourdain.loops.models.n_four_bar(N)``: n + 1 cranks, n couplers, n revolute closing joints
+``jourdain.models.loops.n_four_bar(N)``: n + 1 cranks, n couplers, n revolute closing joints
 (2N + 1 tree coordinates, 2N constraints, one degree of freedom). Started with the cranks
 vertical and turning at 1 rad/s (our reading of the benchmark's initial state), every crank
 passes the horizontal, where all bars lie on one line and Φ_z loses N ranks: a partition
@@ -34,7 +34,7 @@ from scipy.integrate import solve_ivp
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from jourdain.loops import constraints  # noqa: E402
-from jourdain.loops.models import n_four_bar  # noqa: E402
+from jourdain.models.loops import n_four_bar  # noqa: E402
 from jourdain.loops.simulate import simulate_penalty  # noqa: E402
 
 

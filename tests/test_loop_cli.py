@@ -29,8 +29,8 @@ def test_linearize_a_loop_model_with_set(capsys: pytest.CaptureFixture) -> None:
     for m2 in (2.0, 4.0):
         assert main(["linearize", path, "--json", "--set", f"m2={m2}"]) == 0
         docs[m2] = json.loads(capsys.readouterr().out)
-        z = equilibrium(mf.loops, mf.simulation.y0, parameters={"m2": m2})
-        lin = linearize_loop(mf.loops, z, parameters={"m2": m2})
+        z = equilibrium(mf.system, mf.simulation.y0, parameters={"m2": m2})
+        lin = linearize_loop(mf.system, z, parameters={"m2": m2})
         got = np.array([complex(*v) for v in docs[m2]["eigenvalues"]])
         w = float(np.max(np.abs(lin.eigenvalues)))
         # the exact linearization (CLI) against central differences (error ~ ε^(2/3))

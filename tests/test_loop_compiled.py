@@ -14,7 +14,7 @@ import pytest
 from jourdain.io.modelfile import loads_model
 from jourdain.loops import LoopEvaluator
 from jourdain.loops.compiled import LoopKernel
-from jourdain.loops.models import four_bar, n_four_bar, slider_crank
+from jourdain.models.loops import four_bar, n_four_bar, slider_crank
 from jourdain.loops.simulate import simulate_loop
 from tests.tolerance import EPS, cond, solve_tol
 
@@ -23,7 +23,7 @@ EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 def _rssr() -> tuple:
     mf = loads_model((EXAMPLES / "spatial_rssr.toml").read_text(), "spatial_rssr.toml")
-    return mf.loops, np.asarray(mf.simulation.y0, float), np.asarray(mf.simulation.yd0, float)
+    return mf.system, np.asarray(mf.simulation.y0, float), np.asarray(mf.simulation.yd0, float)
 
 
 CASES = {
@@ -38,7 +38,7 @@ def test_compiled_state_equals_python_evaluator(name: str) -> None:
     """z, ż, z̈, Φ̇ and λ of the C kernel equal LoopEvaluator's (Newton, linear solves and the
     projection in NumPy/LAPACK) at states along a sweep of the independent coordinates."""
     loop, z0, zd0 = CASES[name]()
-    n = loop.n
+    n = loop.f
     z0 = np.zeros(n) if z0 is None else z0
     zd0 = np.ones(n) if zd0 is None else zd0
     ev = LoopEvaluator(loop, z0)
@@ -124,9 +124,8 @@ def test_flat_position_of_the_n_four_bar_is_reported() -> None:
 
 
 def _driven_four_bar():  # noqa: ANN202
-    """The four-bar of jourdain.loops.models with an input torque tau on the crank."""
+    """The four-bar of jourdain.models.loops with an input torque tau on the crank."""
     import jourdain as jd
-    from jourdain.loops import ClosedLoopSystem
 
     base = four_bar()
     tau = jd.symbols("tau")
@@ -134,7 +133,7 @@ def _driven_four_bar():  # noqa: ANN202
     driven = jd.System(tree.coordinates, list(tree.bodies),
                        [*tree.forces, jd.GeneralizedForce("drive", tree.coordinates[0], tau)],
                        parameters=dict(tree.parameters), inputs=[tau], name="driven four-bar")
-    return ClosedLoopSystem(driven, base.closing, independent=("theta1",)), tau
+    return driven.closed_by(base.closing, independent=("theta1",)), tau
 
 
 def test_input_expressions_drive_the_c_engine() -> None:

@@ -24,10 +24,10 @@ def test_exact_linearization_equals_closed_form_four_bar() -> None:
     potential by a five-point difference (error h⁴·V⁽⁶⁾/90 ≈ 1e-12·K at h = 1e-3)."""
     k_s = 20.0
     mf = load_model(EXAMPLES / "four_bar.toml")
-    ref = four_bar_at_rest(mf.loops, k_s)
+    ref = four_bar_at_rest(mf.system, k_s)
     z, K_ref, M_ref, hh = ref.z, ref.K, ref.M, ref.h
     th = float(z[0])
-    lin = linearize_loop_exact(mf.loops, z)
+    lin = linearize_loop_exact(mf.system, z)
     assert lin.names == ("theta1",)
     assert abs(lin.M_tilde[0, 0] - M_ref) <= 1e3 * EPS * M_ref
     # the difference quotient's rounding, ε·|V|/h², bounds the reference's error
@@ -43,8 +43,8 @@ def test_exact_and_finite_difference_linearizations_agree(name: str) -> None:
     """Central differences err by about ε^(2/3) relative (δ = ε^(1/3)): the two agree to
     100·ε^(2/3) of the matrices' scale."""
     mf = load_model(EXAMPLES / f"{name}.toml")
-    z = equilibrium(mf.loops, mf.simulation.y0)
-    fd, ex = linearize_loop(mf.loops, z), linearize_loop_exact(mf.loops, z)
+    z = equilibrium(mf.system, mf.simulation.y0)
+    fd, ex = linearize_loop(mf.system, z), linearize_loop_exact(mf.system, z)
     assert fd.names == ex.names
     tol = 100 * EPS ** (2 / 3)
     for key in ("M_tilde", "K", "D", "G", "N"):

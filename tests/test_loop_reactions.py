@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from jourdain.loops import evaluate
-from jourdain.loops.models import four_bar
+from jourdain.models.loops import four_bar
 from jourdain.loops.reactions import closing_reactions
 from jourdain.loops.simulate import simulate_loop
 from tests.test_loops import slider_tree
@@ -82,18 +82,18 @@ def _loops() -> dict:
     from pathlib import Path
 
     from jourdain.io.modelfile import loads_model
-    from jourdain.loops import ClosedLoopSystem, ClosingJoint
+    from jourdain.loops import ClosingJoint
 
     ex = Path(__file__).resolve().parents[1] / "examples" / "spatial_rssr.toml"
     mf = loads_model(ex.read_text(), "spatial_rssr.toml")
     tree = slider_tree()
     return {
         "revolute": (four_bar(), [1.1, 0.3, 1.9], [1.5, 0, 0]),
-        "spherical": (mf.loops, list(mf.simulation.y0), [1.0, 0.5, 0, 0.3, 0]),
-        "prismatic": (ClosedLoopSystem(tree, [ClosingJoint("guide", "prismatic", "world",
+        "spherical": (mf.system, list(mf.simulation.y0), [1.0, 0.5, 0, 0.3, 0]),
+        "prismatic": (tree.closed_by([ClosingJoint("guide", "prismatic", "world",
                                                            "slider", axis="x")], ("phi",)),
                       [0.5, -0.6, 0.1], [2.0, 0, 0]),
-        "point_on_line": (ClosedLoopSystem(tree, [ClosingJoint(
+        "point_on_line": (tree.closed_by([ClosingJoint(
             "line", "point_on_line", "crank", "slider", point_a=(0, 0.2, 0), axis=(1, 0.5, 0))],
             ("phi", "chi")), [0.5, -0.6, 0.1], [2.0, 0, 0.7]),
     }
@@ -121,7 +121,7 @@ def test_closing_wrench_does_the_virtual_work_of_its_rows(kind: str) -> None:
     con = constraints(loop)
     W = closing_wrench_map(loop).W_inertial
     by_name = {cj.name: cj for cj in loop.closing}
-    n = loop.n
+    n = loop.f
     # any rates (off the manifold's tangent: Φ̇ ≠ 0) and the motion's own (Φ̇ = 0)
     rng = np.random.default_rng(7)
     for yd in (rng.uniform(-1.5, 1.5, n), np.asarray(s["zd"])):

@@ -3,6 +3,8 @@ an independent Lagrange-multiplier formulation, energy, singular positions, mode
 
 from __future__ import annotations
 
+from typing import Any
+
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -15,8 +17,8 @@ from scipy.integrate import solve_ivp
 
 from jourdain.errors import ModelError
 from jourdain.io.modelfile import ModelFileError, loads_model
-from jourdain.loops import ClosedLoopSystem, ClosingJoint, LoopEvaluator, evaluate
-from jourdain.loops.models import four_bar, slider_crank
+from jourdain.loops import ClosingJoint, LoopEvaluator, evaluate
+from jourdain.models.loops import four_bar, slider_crank
 from jourdain.loops.simulate import simulate_loop
 from tests.tolerance import EPS, cond, solve_tol
 
@@ -60,7 +62,8 @@ def _four_bar_closed_form(th1: float, th1_d: float, p: dict) -> tuple[float, flo
 def slider_tree():  # noqa: ANN201
     """The slider-crank's open tree: crank, rod and slider hinged in a row (the slider not yet
     guided), with gravity along −y."""
-    from jourdain.model import Body, Gravity, Revolute, System, rod, symbols
+    from jourdain import System
+    from jourdain.model import Body, Gravity, Revolute, rod, symbols
 
     phi, psi, chi = symbols("phi psi chi")
     r, l, m1, m2, m3, g = symbols("r l m1 m2 m3 g")
@@ -88,7 +91,7 @@ class FourBarAtRest:
     M: float
 
 
-def four_bar_at_rest(loop: ClosedLoopSystem, k_s: float = 20.0) -> FourBarAtRest:
+def four_bar_at_rest(loop: Any, k_s: float = 20.0) -> FourBarAtRest:
     """The four-bar of examples/four_bar.toml (torsion spring k_s on the crank, rest angle 1)
     at its equilibrium near θ1 = 0.5."""
     from jourdain.loops.linearization import equilibrium
@@ -363,25 +366,25 @@ def test_singular_position_reported_or_repartitioned() -> None:
 
 def test_partition_pivoting_and_grubler() -> None:
     loop = four_bar(None)
-    ev = loop.evaluator([0.5, 0.8, 1.9])
+    ev = LoopEvaluator(loop, [0.5, 0.8, 1.9])
     assert ev.part.f == 1 and len(ev.part.rows) == 2
     assert ev.rank([0.5, 0.15, 1.5]) == 2
     assert loop.grubler() == -2  # spatial count: the planar four-bar is overconstrained
     with pytest.raises(ModelError, match="leave 1 degrees of freedom, but 2"):
-        ClosedLoopSystem(loop.tree, loop.closing, ("theta1", "theta2")).evaluator(
+        LoopEvaluator(loop.tree.closed_by(loop.closing, ("theta1", "theta2")),
             [0.5, 0.8, 1.9])
     # theta1 + theta2 = theta3: coupler parallel to the rocker, theta1 cannot be independent
     with pytest.raises(ModelError, match="theta1 do not determine the others here"):
-        four_bar(("theta1",)).evaluator([0.5, 1.0, 1.5])
+        LoopEvaluator(four_bar(("theta1",)), [0.5, 1.0, 1.5])
 
 
 def test_model_file_four_bar_and_errors() -> None:
     from jourdain.io.modelfile import load_model
 
     mf = load_model(EXAMPLES / "four_bar.toml")
-    assert mf.loops is not None and mf.loops.independent == ("theta1",)
-    assert [c.name for c in mf.loops.closing] == ["closure"]
-    s = evaluate(mf.loops, mf.simulation.y0, mf.simulation.yd0)
+    assert mf.system.closing and mf.system.independent == ("theta1",)
+    assert [c.name for c in mf.system.closing] == ["closure"]
+    s = evaluate(mf.system, mf.simulation.y0, mf.simulation.yd0)
     phi2, th3, _, _ = _four_bar_closed_form(0.5, 1.0, FB)
     assert abs(s["z"][2] - th3) <= 1e-12
     text = (EXAMPLES / "four_bar.toml").read_text()
@@ -395,17 +398,17 @@ def test_model_file_four_bar_and_errors() -> None:
     with pytest.raises(ModelFileError, match='"theta9" is not a declared coordinate'):
         loads_model(bad, "four_bar.toml")
     mf2 = load_model(EXAMPLES / "slider_crank.toml")
-    assert mf2.loops is not None and mf2.loops.closing[0].name == "wrist"
+    assert mf2.system.closing and mf2.system.closing[0].name == "wrist"
 
 
 def test_closing_joint_api_errors() -> None:
     loop = four_bar()
     with pytest.raises(ModelError, match='unknown body "nope"'):
-        ClosedLoopSystem(loop.tree, [ClosingJoint("x", "spherical", "coupler", "nope")])
+        loop.tree.closed_by([ClosingJoint("x", "spherical", "coupler", "nope")])
     with pytest.raises(ModelError, match="unknown type"):
         ClosingJoint("x", "weld", "coupler", "rocker")
     with pytest.raises(ModelError, match="unknown name"):
-        ClosedLoopSystem(loop.tree, [ClosingJoint(
+        loop.tree.closed_by([ClosingJoint(
             "x", "constraint", expressions=[se.Symbol("theta1") - se.Symbol("zeta")])])
 
 
@@ -418,10 +421,10 @@ def test_linearization_about_equilibrium_equals_closed_form_four_bar() -> None:
     from jourdain.loops.linearization import linearize_loop
 
     mf = load_model(EXAMPLES / "four_bar.toml")
-    ref = four_bar_at_rest(mf.loops)
+    ref = four_bar_at_rest(mf.system)
     z, K_ref, M_ref = ref.z, ref.K, ref.M
     assert abs(ref.dV) <= 1e-9 * K_ref
-    lin = linearize_loop(mf.loops, z)
+    lin = linearize_loop(mf.system, z)
     assert lin.names == ("theta1",)
     assert abs(lin.M_tilde[0, 0] - M_ref) <= 1e-12 * M_ref * 10
     assert abs(lin.K[0, 0] - K_ref) <= 1e-7 * K_ref
@@ -461,7 +464,7 @@ def test_spatial_rssr_with_a_spherical_closing_joint() -> None:
     whole motion cos θ3 = (a² + d² + c² − b² − 2ad·cos θ1)/(2ac·sin θ1) (closed form of
     |A(θ1) − B(θ3)| = b), while the energy stays constant and the partition may change."""
     mf = loads_model((EXAMPLES / "spatial_rssr.toml").read_text(), "spatial_rssr.toml")
-    loop = mf.loops
+    loop = mf.system
     assert [r for r in loop.constraints().labels] == ["ball.Fx", "ball.Fy", "ball.Fz"]
     assert loop.grubler() == 2
     res = simulate_loop(loop, (0.0, 2.0), mf.simulation.y0, mf.simulation.yd0, samples=41,
@@ -490,7 +493,7 @@ def test_general_constraint_and_prismatic_closing_joint_give_the_same_motion() -
     closure = ClosingJoint("loop", "constraint", expressions=[
         a * se.cos(th1) + b * se.cos(th1 + th2) - d - c * se.cos(th3),
         a * se.sin(th1) + b * se.sin(th1 + th2) - c * se.sin(th3)])
-    gen = ClosedLoopSystem(fb.tree, [closure], ("theta1",))
+    gen = fb.tree.closed_by([closure], ("theta1",))
     s1 = evaluate(fb, [1.1, 0.3, 1.9], [1.5, 0, 0])
     s2 = evaluate(gen, [1.1, 0.3, 1.9], [1.5, 0, 0])
     tol = solve_tol(s1["Phi_z"][:, 1:], 1 + float(np.max(np.abs(s1["q_tree"]))))
@@ -502,7 +505,7 @@ def test_general_constraint_and_prismatic_closing_joint_give_the_same_motion() -
 
     tree = slider_tree()
     guide = ClosingJoint("guide", "prismatic", "world", "slider", axis="x")
-    loop = ClosedLoopSystem(tree, [guide], ("phi",))
+    loop = tree.closed_by([guide], ("phi",))
     assert [row for row in loop.constraints().labels] == ["guide.N2", "guide.Mz"]
     res = simulate_loop(loop, (0.0, 1.0), [0.5, -0.6, 0.1], [2.0, 0, 0], samples=11,
                         rtol=1e-10, atol=1e-12)
@@ -542,13 +545,13 @@ def test_n_four_bar_through_its_singular_flat_positions() -> None:
     augmented-Lagrangian form; the crank angle follows the exact one-degree-of-freedom motion
     of the parallelogram chain (benchmarks/n_four_bar.py runs N = 5, 10, 40 over 20 s)."""
     from benchmarks.n_four_bar import initial_state, reference
-    from jourdain.loops.models import n_four_bar
+    from jourdain.models.loops import n_four_bar
     from jourdain.loops.simulate import simulate_penalty
 
     n = 3
     loop = n_four_bar(n)
     z, zd = initial_state(n)
-    ev = loop.evaluator(z)
+    ev = LoopEvaluator(loop, z)
     assert ev.rank([0.0, 0.0] * n + [0.0]) < 2 * n  # flat: rank lost
     res = simulate_penalty(loop, (0.0, 4.0), z, zd, samples=41)
     assert res.status == "finished"

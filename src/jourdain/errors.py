@@ -24,6 +24,26 @@ class EvaluationError(JourdainError, ValueError):
     """Numeric evaluation was given bad input: wrong sizes, unknown names, NaN or inf values."""
 
 
+class ClosedSystemError(ModelError):
+    """A function of the open tree was given a closed system (one with closing joints), or a
+    capability does not handle closing joints yet. It names the system, the closing joints and
+    the capability; jourdain never falls back to the open tree (ask for ``system.tree`` by
+    name where the open tree is meant)."""
+
+    def __init__(self, system: object, capability: str, hint: str = "") -> None:
+        names = ", ".join(c.name for c in getattr(system, "closing", ()))
+        msg = (f"{getattr(system, 'name', 'the system')!r} is closed by the closing joint(s) "
+               f"{names}: {capability}")
+        super().__init__(msg + (f"; {hint}" if hint else ""))
+        self.capability = capability
+
+
+def refuse_closed(system: object, capability: str, hint: str = "") -> None:
+    """Raise :class:`ClosedSystemError` when ``system`` has closing joints."""
+    if getattr(system, "closing", ()):
+        raise ClosedSystemError(system, capability, hint)
+
+
 class JourdainWarning(UserWarning):
     """Base class of the warnings of jourdain: a result that is computed but may not mean what
     it seems to (``warnings.simplefilter("error", JourdainWarning)`` turns them into errors)."""

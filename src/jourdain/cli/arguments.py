@@ -120,8 +120,8 @@ def load(path: str) -> Any:
 
 def tree_only(model: Any, command: str) -> None:
     """Refuse a command that would treat a loop model as its open tree."""
-    if getattr(model, "loops", None) is not None:
-        names = ", ".join(c.name for c in model.loops.closing)
+    if model.system.closing:
+        names = ", ".join(c.name for c in model.system.closing)
         raise ModelError(f"{model.path}: the model closes kinematic loops (closing joints "
                          f"{names}); jourdain {command} works on trees and would ignore them: "
                          "use jourdain check and jourdain run, or jourdain.loops in Python "

@@ -21,12 +21,12 @@ def cmd_check(args: argparse.Namespace) -> int:
         # the joints' constrained directions must satisfy the orthogonality J̄ᵀQ̄ = 0, joint by
         # joint and assembled (the numeric reactions' own checks, without the symbolic N̂)
         try:
-            check_reactions(model.system)
+            check_reactions(model.system.tree)  # the closing joints' rows: loop_summary
         except JourdainError as exc:
             raise model.error(str(exc)) from None
     check_initial_state(model)
     s = summary(model)
-    loops = getattr(model, "loops", None)
+    loops = model.system if model.system.closing else None
     if loops is not None:  # closing joints (jourdain.loops): the loops and their mobility
         # jourdain.loops brings SciPy's linear algebra (0.2 s): imported for loop models only
         from ..loops.report import check_lines, loop_summary

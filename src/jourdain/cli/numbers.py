@@ -152,7 +152,7 @@ def display_scales(values: dict[str, np.ndarray]) -> dict[str, Any]:
 
 def cmd_linearize(args: argparse.Namespace) -> int:
     model = load(args.model)
-    if getattr(model, "loops", None) is not None:  # LOOPS-LINEARIZE (H2): independent coordinates
+    if model.system.closing:  # LOOPS-LINEARIZE (H2): independent coordinates
         from ..loops.cli import linearize_command  # SciPy's linear algebra: loop models only
 
         return linearize_command(model, overrides(model.system, args.set), args.json, args.about)

@@ -93,7 +93,7 @@ def _run(args: argparse.Namespace, pool: ProcessPoolExecutor | None) -> int:
     params = overrides(model.system, args.set)
     opts = sim_options(model, args)
     out = output_folder(args.out, args.force, model)
-    if getattr(model, "loops", None) is not None:  # a loop model: jourdain.loops' report
+    if model.system.closing:  # a loop model: jourdain.loops' report
         # jourdain.loops brings SciPy's linear algebra (0.2 s): imported for loop models only
         from ..loops.report import run_report
 

@@ -1,11 +1,14 @@
-"""Kinematic loops (issue 11): closing joints, coordinate partitioning, assembly, M, k, q in
-independent coordinates, simulation on the constraint manifold, reactions of the closing
-joints and linearization. See :mod:`jourdain.loops.closed_loop` for the method."""
+"""The numbers of closed systems (closing joints, METHOD.md §7): coordinate partitioning,
+assembly, M, k, q in independent coordinates, simulation on the constraint manifold, reactions
+of the closing joints and linearization. A closed system is a :class:`jourdain.System` with
+``closing`` joints; its methods and the package's functions call these. See
+:mod:`jourdain.loops.closed_loop` for the method."""
 
+from ..model.closing import KINDS, ClosingJoint, grubler
+from ..stages.constraints import ConstraintRow
 from .closed_loop import (
     Assembly,
     AssemblyError,
-    ClosedLoopSystem,
     Constraints,
     LoopEvaluator,
     Partition,
@@ -14,8 +17,7 @@ from .closed_loop import (
     evaluate,
     partition,
 )
-from .closing_joints import KINDS, ClosingJoint, ConstraintRow, grubler
 
-__all__ = ["KINDS", "Assembly", "AssemblyError", "ClosedLoopSystem", "ClosingJoint",
-           "ConstraintRow", "Constraints", "LoopEvaluator", "Partition",
-           "SingularConfiguration", "constraints", "evaluate", "grubler", "partition"]
+__all__ = ["KINDS", "Assembly", "AssemblyError", "ClosingJoint", "ConstraintRow",
+           "Constraints", "LoopEvaluator", "Partition", "SingularConfiguration", "constraints",
+           "evaluate", "grubler", "partition"]

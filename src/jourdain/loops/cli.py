@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import JourdainError
-from .closed_loop import ClosedLoopSystem
+from ..model import System
 from .linearization import (
     LoopLinearization,
     equilibrium,
@@ -24,7 +24,7 @@ from .linearization import (
 )
 
 
-def linearize_near(loop: ClosedLoopSystem, z0: Any,
+def linearize_near(loop: System, z0: Any,
                    parameters: Mapping[str, float] | None = None
                    ) -> tuple[LoopLinearization, str]:
     """The linearization about the equilibrium nearest ``z0``, else about ``z0`` at rest;
@@ -43,12 +43,12 @@ def linearize_document(model: Any, parameters: Mapping[str, float] | None = None
                        ) -> dict[str, Any]:
     """The linearization of the loop model ``model`` (a model file's, with ``.loops`` and
     ``.simulation``) as a JSON-able document."""
-    loop: ClosedLoopSystem = model.loops
+    loop: System = model.system
     lin, about = linearize_near(loop, model.simulation.y0, parameters)
     return linearization_document(loop, lin, about)
 
 
-def linearization_document(loop: ClosedLoopSystem, lin: LoopLinearization, about: str
+def linearization_document(loop: System, lin: LoopLinearization, about: str
                            ) -> dict[str, Any]:
     """A linearization of :func:`linearize_near` as a JSON-able document."""
     ev = lin.eigenvalues

@@ -1,8 +1,8 @@
-"""Closed kinematic loops in independent coordinates (issue 11).
+"""Closed kinematic loops in independent coordinates, in numbers.
 
-A :class:`ClosedLoopSystem` is a spanning tree (a :class:`jourdain.System` in the coordinates
-``z``, n of them) cut open at its closing joints, whose m independent scalar constraints
-``Φ(z, t) = 0`` (:mod:`jourdain.loops.closing_joints`) tie the tree's coordinates together. The
+A closed :class:`jourdain.System` is a spanning tree (its coordinates, named ``z`` in this
+package, n of them) cut open at its closing joints, whose m independent scalar constraints
+``Φ(z, t) = 0`` (:mod:`jourdain.stages.constraints`) tie the tree's coordinates together. The
 method stays the seed's (METHOD.md §1–3) with one more kinematic stage:
 
 * **Coordinate partitioning.** ``z = (y, d)``: f = n − m independent coordinates y and m
@@ -34,35 +34,17 @@ the bordered matrix can be solved; the augmented-Lagrangian form
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from typing import Any
-
 from .evaluator import Assembly, LoopEvaluator, evaluate
 from .partitioning import Partition, partition
 from .system import (
     AssemblyError,
     Constraints,
-    LoopModel,
     SingularConfiguration,
     constraint_function,
     constraints,
 )
 
 
-class ClosedLoopSystem(LoopModel):
-    """A tree :class:`~jourdain.System` (coordinates z) closed by closing joints, with its
-    stages as methods; the parameters (tree, closing, independent, name) are those of
-    :class:`~jourdain.loops.system.LoopModel`, which holds the data."""
-
-    def constraints(self) -> Constraints:
-        return constraints(self)
-
-    def evaluator(self, z0: Any = None, t: float = 0.0,
-                  parameters: Mapping[str, float] | None = None) -> LoopEvaluator:
-        """A :class:`LoopEvaluator` partitioned at ``z0`` (default: zeros)."""
-        return LoopEvaluator(self, z0, t, parameters)
-
-
-__all__ = ["Assembly", "AssemblyError", "ClosedLoopSystem", "Constraints", "LoopEvaluator",
-           "LoopModel", "Partition", "SingularConfiguration", "constraint_function",
-           "constraints", "evaluate", "partition"]
+__all__ = ["Assembly", "AssemblyError", "Constraints", "LoopEvaluator", "Partition",
+           "SingularConfiguration", "constraint_function", "constraints", "evaluate",
+           "partition"]

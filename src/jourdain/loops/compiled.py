@@ -29,8 +29,8 @@ from ..numeric.ccode import HEADER, argument_names, function_source
 from ..numeric.toolchain import build, build_lock, build_soon, content_key
 from ..simulation.problem import address
 from ..symbolic import SymMatrix
-from .closed_loop import ClosedLoopSystem, LoopEvaluator, Partition, constraints
-from .system import LoopModel
+from ..model import System
+from .closed_loop import LoopEvaluator, Partition, constraints
 
 _VERSION = "loop-c4"
 #: reasons in ``info[2]`` (``loop_c.h``)
@@ -52,7 +52,7 @@ class _Loop(ctypes.Structure):
                 ("u_buf", ctypes.c_void_p)]
 
 
-def loop_library(loop: LoopModel) -> ctypes.CDLL:
+def loop_library(loop: System) -> ctypes.CDLL:
     """The compiled constraint functions and loop kernel of ``loop`` (cached by content).
     One at a time: a call while a build started ahead (:func:`build_loop_library_soon`)
     generates the source waits for it instead of generating it again."""
@@ -60,19 +60,19 @@ def loop_library(loop: LoopModel) -> ctypes.CDLL:
         return _loop_library(loop)
 
 
-def build_loop_library_soon(loop: LoopModel) -> None:
+def build_loop_library_soon(loop: System) -> None:
     """Start :func:`loop_library` in a thread (:func:`jourdain.numeric.toolchain.build_soon`):
     its source generated and compiled while the caller compiles the tree's functions."""
     build_soon(loop_library, loop, name="jourdain-loop-build")
 
 
 @lru_cache(maxsize=16)
-def _loop_library(loop: LoopModel) -> ctypes.CDLL:
+def _loop_library(loop: System) -> ctypes.CDLL:
     tree = loop.tree
     con = constraints(loop)
     names = argument_names(tree.y, tree.yd, tree.t, tree.parameter_symbols, tree.inputs)
     kernel = (resources.files(__package__) / "loop_c.h").read_text()
-    source = (HEADER + function_source("jd_con", [*con.Phi.entries(), *con.Phi_z.entries(),
+    source = (HEADER + function_source("jd_con", [*con.Phi.entries(), *con.Phi_y.entries(),
                                                   *con.Phi_t.entries()], names)
               + function_source("jd_gam", con.c.entries(), names) + kernel)
     lib = build(content_key(_VERSION, source), source, ("-O2",))
@@ -84,7 +84,7 @@ def _loop_library(loop: LoopModel) -> ctypes.CDLL:
     return lib
 
 
-def input_function(loop: ClosedLoopSystem, inputs: Mapping[str, Any]) -> CompiledFunction:
+def input_function(loop: System, inputs: Mapping[str, Any]) -> CompiledFunction:
     """The inputs of ``loop``'s tree as compiled expressions of t and the parameters (an
     input not given is 0); an expression in anything else is refused, naming it."""
     tree = loop.tree

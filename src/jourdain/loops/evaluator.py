@@ -22,7 +22,7 @@ from .partitioning import Partition, _cond, _rank_tol, partition
 from .system import (
     EPS,
     AssemblyError,
-    LoopModel,
+    System,
     SingularConfiguration,
     constraint_function,
     constraints,
@@ -43,7 +43,7 @@ class Assembly:
 
 
 class LoopEvaluator:
-    """Numeric evaluation of a :class:`LoopModel` in its independent coordinates.
+    """Numeric evaluation of a :class:`System` in its independent coordinates.
 
     Holds the compiled tree ``M, k, q`` (:func:`jourdain.numeric.mkq_function`), the compiled
     constraints (:func:`constraint_function`), the parameter vector and the current
@@ -51,7 +51,7 @@ class LoopEvaluator:
     solve; every result is the converged solution, whatever the guess.
     """
 
-    def __init__(self, loop: LoopModel, z0: Any = None, t: float = 0.0,
+    def __init__(self, loop: System, z0: Any = None, t: float = 0.0,
                  parameters: Mapping[str, float] | None = None, inputs: Any = None) -> None:
         self.loop = loop
         tree = loop.tree
@@ -277,7 +277,7 @@ class LoopEvaluator:
         return int(np.sum(s > _rank_tol(Pz) * 1e3))
 
 
-def evaluate(loop: LoopModel, z: Any, zd: Any = None, t: float = 0.0,
+def evaluate(loop: System, z: Any, zd: Any = None, t: float = 0.0,
              parameters: Mapping[str, float] | None = None,
              inputs: Sequence[float] | None = None
              ) -> dict[str, Any]:

@@ -28,7 +28,8 @@ from ..stages.kinematics import kinematics
 from ..stages.newton_euler import newton_euler
 from ..stages.projection import projection
 from ..symbolic import SymMatrix
-from .closed_loop import AssemblyError, ClosedLoopSystem, LoopEvaluator, constraints
+from ..model import System
+from .closed_loop import AssemblyError, LoopEvaluator, constraints
 
 
 @dataclass(frozen=True)
@@ -52,7 +53,7 @@ class LoopLinearization:
     eigenvalues: np.ndarray
 
 
-def linearize_loop(loop: ClosedLoopSystem, z_s: Any, zd_s: Any = None, t: float = 0.0,
+def linearize_loop(loop: System, z_s: Any, zd_s: Any = None, t: float = 0.0,
                    ydd_s: Any = None, parameters: Mapping[str, float] | None = None
                    ) -> LoopLinearization:
     """Linearize ``loop`` about the configuration assembled from ``z_s`` (independent
@@ -96,7 +97,7 @@ def linearize_loop(loop: ClosedLoopSystem, z_s: Any, zd_s: Any = None, t: float 
 
 
 @lru_cache(maxsize=16)
-def _exact_parts(loop: ClosedLoopSystem) -> CompiledFunction:
+def _exact_parts(loop: System) -> CompiledFunction:
     """Compiled ``∂(k − q)/∂z``, ``∂(k − q)/∂ż`` of the tree and the Hessians ``∂²Φ_i/∂z²``
     (stacked, m·n × n)."""
     tree = loop.tree
@@ -105,7 +106,7 @@ def _exact_parts(loop: ClosedLoopSystem) -> CompiledFunction:
     zd = [rate(c) for c in z]
     r = [eom.k.rows[i][0] - eom.q.rows[i][0] for i in range(len(z))]
     con = constraints(loop)
-    H = [[se.diff(con.Phi_z.rows[i][j], zk) for zk in z]
+    H = [[se.diff(con.Phi_y.rows[i][j], zk) for zk in z]
          for i in range(len(con.rows)) for j in range(len(z))]
     return lambdify(tree, {"R_z": SymMatrix.from_rows([[se.diff(e, c) for c in z] for e in r]),
                            "R_zd": SymMatrix.from_rows([[se.diff(e, c) for c in zd]
@@ -113,7 +114,7 @@ def _exact_parts(loop: ClosedLoopSystem) -> CompiledFunction:
                            "H": SymMatrix.from_rows(H)})
 
 
-def linearize_loop_exact(loop: ClosedLoopSystem, z_s: Any, t: float = 0.0,
+def linearize_loop_exact(loop: System, z_s: Any, t: float = 0.0,
                          parameters: Mapping[str, float] | None = None) -> LoopLinearization:
     """The linearization about an equilibrium at rest (``ẏ_s = ÿ_s = 0``, scleronomic
     constraints) from symbolic derivatives instead of differences. With the multipliers λ of
@@ -130,7 +131,7 @@ def linearize_loop_exact(loop: ClosedLoopSystem, z_s: Any, t: float = 0.0,
     f = len(ind)
     s = ev.accelerations(asm.z[ind], np.zeros(f), t)
     lam = ev.multipliers(s)
-    n = loop.n
+    n = loop.f
     parts = _exact_parts(loop).split(_exact_parts(loop).raw(
         np.ascontiguousarray(asm.z), np.zeros(n), t, ev.p, ev.u))
     H = parts["H"].reshape(len(lam), n, n)
@@ -148,7 +149,7 @@ def linearize_loop_exact(loop: ClosedLoopSystem, z_s: Any, t: float = 0.0,
                              eig[order])
 
 
-def equilibrium(loop: ClosedLoopSystem, z_guess: Any, t: float = 0.0,
+def equilibrium(loop: System, z_guess: Any, t: float = 0.0,
                 parameters: Mapping[str, float] | None = None, tol: float = 1e-12,
                 max_iter: int = 50) -> np.ndarray:
     """An equilibrium ``q − k = 0`` at rest near ``z_guess`` (Newton in the independent
@@ -174,3 +175,48 @@ def equilibrium(loop: ClosedLoopSystem, z_guess: Any, t: float = 0.0,
 
 
 __all__ = ["LoopLinearization", "equilibrium", "linearize_loop", "linearize_loop_exact"]
+
+
+def linearize_closed(system: System, nominal: Any, inputs: Mapping[str, float] | None = None,
+                     parameters: Mapping[str, float] | None = None) -> LoopLinearization:
+    """:meth:`jourdain.System.linearize` of a closed system about the state ``nominal``: a
+    mapping ``{coordinate: value, "<coordinate>_d": rate, "<coordinate>_dd": acceleration}``
+    (constant numbers; coordinates left out are 0 and assembled) or the f tree coordinates."""
+    from ..errors import ClosedSystemError, EvaluationError
+
+    if inputs:
+        raise ClosedSystemError(system, "a linearization with nominal inputs is not available "
+                                "for closed systems yet")
+    names = system.coordinate_names
+    f = system.f
+    y, yd, ydd = np.zeros(f), np.zeros(f), None
+    if isinstance(nominal, Mapping):
+        acc: dict[str, float] = {}
+        for k, v in nominal.items():
+            key = str(k)
+            try:
+                val = float(v)
+            except (TypeError, ValueError):
+                raise ClosedSystemError(system, f"the nominal value of {key} is {v!r}: closed "
+                                        "systems are linearized about a state (numbers), not "
+                                        "a motion given by expressions, yet") from None
+            if key in names:
+                y[names.index(key)] = val
+            elif key.endswith("_dd") and key[:-3] in names:
+                acc[key[:-3]] = val
+            elif key.endswith("_d") and key[:-2] in names:
+                yd[names.index(key[:-2])] = val
+            else:
+                raise EvaluationError(f'nominal: unknown coordinate "{key}"; coordinates are '
+                                      f"{', '.join(names)}")
+        if acc:
+            ydd = acc
+    else:
+        y = np.asarray(nominal, dtype=float).reshape(-1)
+        if y.size != f:
+            raise EvaluationError(f"nominal: {f} coordinates expected ({', '.join(names)}), "
+                                  f"got {y.size}")
+    if isinstance(ydd, dict):  # accelerations of the independent coordinates, by name
+        ev = LoopEvaluator(system, y, 0.0, parameters)
+        ydd = np.array([ydd.get(c, 0.0) for c in ev.independent_names])
+    return linearize_loop(system, y, yd, 0.0, ydd, parameters)

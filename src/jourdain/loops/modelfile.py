@@ -1,4 +1,4 @@
-"""Model-file sections of loop systems: ``[closing_joints.<name>]`` and ``[loops]``.
+"""Model-file sections of closed systems: ``[closing_joints.<name>]`` and ``[loops]``.
 
 Read by :mod:`jourdain.io.modelfile` (which calls :func:`read_loops` with its loader, so the
 errors name the file, line and key like every other section). The syntax is documented in
@@ -10,8 +10,8 @@ from __future__ import annotations
 from typing import Any
 
 from ..errors import ModelError
-from .closed_loop import ClosedLoopSystem
-from .closing_joints import KINDS, ClosingJoint
+from ..model import System
+from ..model.closing import KINDS, ClosingJoint
 
 #: keys of a [closing_joints.<name>] table, by its type
 _KEYS: dict[str, set[str]] = {
@@ -25,8 +25,8 @@ _KEYS: dict[str, set[str]] = {
 }
 
 
-def read_loops(loader: Any, data: dict, system: Any) -> ClosedLoopSystem | None:
-    """The :class:`ClosedLoopSystem` the file describes (None without closing joints).
+def read_loops(loader: Any, data: dict, system: System) -> System:
+    """The tree ``system`` closed by the file's closing joints (itself without any).
 
     ``loader`` is :class:`jourdain.io.modelfile._Loader` (its typed accessors locate errors).
     """
@@ -38,7 +38,7 @@ def read_loops(loader: Any, data: dict, system: Any) -> ClosedLoopSystem | None:
     if not tbl:
         if loops:
             raise loader.fail(lp, "[loops] without any [closing_joints.<name>]")
-        return None
+        return system
     params = set(loader.params)
     bodies = ["world", *system.body_names]
     closing = []
@@ -93,7 +93,7 @@ def read_loops(loader: Any, data: dict, system: Any) -> ClosedLoopSystem | None:
                                   f"{loader.suggest(c, list(loader.coords))}")
         independent = tuple(v)
     try:
-        return ClosedLoopSystem(system, closing, independent)
+        return system.closed_by(closing, independent)
     except ModelError as exc:
         raise loader.fail(p, str(exc)) from None
 

@@ -11,7 +11,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from ..errors import ModelError
-from .system import EPS, LoopModel
+from .system import EPS, System
 
 
 @dataclass(frozen=True)
@@ -43,7 +43,7 @@ def _cond(A: np.ndarray) -> float:
     return float(s[0] / s[-1]) if s[-1] > 0 else float("inf")
 
 
-def partition(loop: LoopModel, Phi_z: np.ndarray,
+def partition(loop: System, Phi_z: np.ndarray,
               independent: Sequence[str] | None = None) -> Partition:
     """Choose ``z = (y, d)`` from the constraint Jacobian ``Phi_z`` (m×n) at a configuration.
 

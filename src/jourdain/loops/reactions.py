@@ -30,8 +30,9 @@ from ..model.expressions import Mat3, Vec3
 from ..numeric import CompiledFunction, lambdify, parameter_vector
 from ..stages.kinematics import _cross, _mv, kinematics
 from ..symbolic import SymMatrix
-from .closed_loop import ClosedLoopSystem, constraints
-from .closing_joints import ZERO3
+from ..model import System
+from .closed_loop import constraints
+from ..model.closing import ZERO3
 
 _IDENT = ((se.Integer(1), se.Integer(0), se.Integer(0)),
           (se.Integer(0), se.Integer(1), se.Integer(0)),
@@ -51,7 +52,7 @@ class ClosingReactions:
 
 
 @lru_cache(maxsize=16)
-def closing_wrench_map(loop: ClosedLoopSystem) -> ClosingReactions:
+def closing_wrench_map(loop: System) -> ClosingReactions:
     """The symbolic wrench map of :class:`ClosingReactions` for ``loop``."""
     kin = kinematics(loop.tree)
     con = constraints(loop)
@@ -97,12 +98,12 @@ def _frame(kin: Any, body: str) -> tuple[Vec3, Any]:
 
 
 @lru_cache(maxsize=16)
-def _wrench_function(loop: ClosedLoopSystem) -> CompiledFunction:
+def _wrench_function(loop: System) -> CompiledFunction:
     cr = closing_wrench_map(loop)
     return lambdify(loop.tree, {"W": cr.W, "W_inertial": cr.W_inertial})
 
 
-def closing_reactions(loop: ClosedLoopSystem, z: Any, lam: Any, t: Any = 0.0,
+def closing_reactions(loop: System, z: Any, lam: Any, t: Any = 0.0,
                       p: Any = None) -> dict[str, dict[str, np.ndarray]]:
     """The force ``F`` and torque ``T`` (N × 3 each, in A's frame, B on A at A's joint point;
     ``F_inertial``, ``T_inertial``: inertial components) of every closing joint with points, from configurations ``z`` (N × n) and multipliers

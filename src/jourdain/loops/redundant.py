@@ -20,12 +20,13 @@ from ..numeric import mkq_function
 from ..simulation.problem import address
 from ..simulation.simulate import check_t_span
 from .c_run import C_METHODS, FAILED, Segment
-from .closed_loop import ClosedLoopSystem, LoopEvaluator
+from ..model import System
+from .closed_loop import LoopEvaluator
 from .compiled import loop_library
 from .results import LoopResults
 
 
-def simulate_redundant(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: Any,
+def simulate_redundant(loop: System, t_span: tuple[float, float], z0: Any,
                        zd0: Any = None, *, samples: int = 501, rtol: float = 1e-10,
                        atol: float = 1e-12, alpha: float = 0.0, beta: float = 0.0,
                        parameters: Mapping[str, float] | None = None) -> LoopResults:
@@ -41,7 +42,7 @@ def simulate_redundant(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: 
     t0, t1 = check_t_span(t_span)
     ev = LoopEvaluator(loop, z0, t0, parameters)
     asm = ev.assemble(z0, zd0, t0)
-    n = loop.n
+    n = loop.f
 
     def rhs(t: float, x: np.ndarray) -> np.ndarray:  # noqa: D401
         zdd, _ = ev.redundant_accelerations(x[:n], x[n:], t, alpha, beta)
@@ -60,7 +61,7 @@ def simulate_redundant(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: 
     return _redundant_results(loop, ev, sol, sample, t0, wall)
 
 
-def simulate_penalty(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: Any,
+def simulate_penalty(loop: System, t_span: tuple[float, float], z0: Any,
                      zd0: Any = None, *, samples: int = 501, rtol: float = 1e-10,
                      atol: float = 1e-12, alpha: float = 1e7, xi: float = 1.0,
                      omega: float = 30.0, iterations: int = 4,
@@ -90,7 +91,7 @@ def simulate_penalty(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: An
         raise EvaluationError(f'engine must be "c" or "scipy", got {engine!r}')
     ev = LoopEvaluator(loop, z0, t0, parameters)
     asm = ev.assemble(z0, zd0, t0)
-    n = loop.n
+    n = loop.f
 
     def accel(z: np.ndarray, zd: np.ndarray, t: float) -> tuple[np.ndarray, np.ndarray,
                                                                dict[str, np.ndarray]]:
@@ -168,13 +169,13 @@ def _penalty_c(ev: LoopEvaluator, t0: float, t1: float, x0: np.ndarray, tev: np.
                            nfev=int(seg.cnt[0]))
 
 
-def _redundant_results(loop: ClosedLoopSystem, ev: Any, sol: Any,
+def _redundant_results(loop: System, ev: Any, sol: Any,
                        sample: Callable[[np.ndarray, np.ndarray, float], tuple], t0: float,
                        wall: float, method: str = "scipy:DOP853") -> LoopResults:
     """The results of a redundant-coordinate run (``simulate_redundant``,
     ``simulate_penalty``) from SciPy's solution, each sample evaluated by ``sample(z, ż, t)``
     → ``(z̈, λ, constraint data)``."""
-    n = loop.n
+    n = loop.f
     out: dict[str, list] = {k: [] for k in ("z", "zd", "zdd", "Phi", "Phi_dot", "lam", "T",
                                              "V")}
     for k in range(len(sol.t)):

@@ -23,16 +23,17 @@ from ..errors import JourdainError
 from ..simulation.problem import build_integrator_soon
 from ..simulation.simulate import DEFAULT_ATOL, DEFAULT_RTOL
 from .cli import linearization_document, linearize_near
-from .closed_loop import ClosedLoopSystem, constraints
+from ..model import System
+from .closed_loop import LoopEvaluator, constraints
 from .figures import FIGURES, Painter
 from .simulate import SOLVERS, simulate_loop
 
 
 def loop_summary(model: Any) -> dict[str, Any]:
     """Closing joints, constraint rows, degrees of freedom (Grübler, rank) and partition."""
-    loop: ClosedLoopSystem = model.loops
+    loop: System = model.system
     sim = model.simulation
-    ev = loop.evaluator(sim.y0)
+    ev = LoopEvaluator(loop, sim.y0)
     asm = ev.assemble(sim.y0, sim.yd0)
     rank = ev.rank(asm.z)
     planar = _planar_grubler(loop)
@@ -43,7 +44,7 @@ def loop_summary(model: Any) -> dict[str, Any]:
         "tree_coordinates": loop.coordinate_names,
         "degrees_of_freedom_grubler_spatial": loop.grubler(),
         "degrees_of_freedom_grubler_planar": planar,
-        "degrees_of_freedom_rank": loop.n - rank,
+        "degrees_of_freedom_rank": loop.f - rank,
         "rank_Phi_z": rank,
         "independent": list(ev.independent_names),
         "dependent": list(ev.dependent_names),
@@ -54,7 +55,7 @@ def loop_summary(model: Any) -> dict[str, Any]:
     }
 
 
-def _planar_grubler(loop: ClosedLoopSystem) -> int | None:
+def _planar_grubler(loop: System) -> int | None:
     """Grübler's planar count 3·n − Σ(3 − f_j) when every joint is a revolute about z or a
     prismatic joint in the x-y plane (None otherwise)."""
     from ..model.joints import Rot, Trans
@@ -117,7 +118,7 @@ def run_report(model: Any, out: Path, parameters: Mapping[str, float] | None = N
 
 def _report(model: Any, out: Path, parameters: Mapping[str, float] | None,
             t_end: float | None, painter: Painter) -> list[str]:
-    loop: ClosedLoopSystem = model.loops
+    loop: System = model.system
     sim = model.simulation
     t1 = float(t_end if t_end is not None else sim.t_end)
     out.mkdir(parents=True, exist_ok=True)

@@ -10,7 +10,8 @@ from typing import Any
 import numpy as np
 
 from ..errors import EvaluationError
-from .closed_loop import ClosedLoopSystem, SingularConfiguration
+from ..model import System
+from .closed_loop import SingularConfiguration
 from .reactions import closing_reactions
 
 
@@ -26,7 +27,7 @@ class LoopResults:
     ``method``: the integrator that ran.
     """
 
-    loop: ClosedLoopSystem
+    loop: System
     t: np.ndarray
     z: np.ndarray
     zd: np.ndarray

@@ -32,7 +32,7 @@ the mechanism — or re-partitioning is off, the run stops with status "singular
 (:func:`jourdain.loops.redundant.simulate_penalty`) passes singular positions.
 
 Why not SUNDIALS IDA (scikit-sundae) here, measured (``python benchmarks/loops.py``, the
-four-bar of :func:`jourdain.loops.models.four_bar` over 5 s, on the shared 2-core development
+four-bar of :func:`jourdain.models.loops.four_bar` over 5 s, on the shared 2-core development
 machine): IDA 1.2.0 on the index-1 redundant form in (z, ż, λ), with jourdain's compiled tree
 and constraints in its Python residual and its own finite-difference Jacobian, took 18.5 s at
 rtol 1e-8 (error 1.2e-3, |Φ(5 s)| = 1.2e-4: the index-1 form lets the positions drift), against
@@ -50,12 +50,12 @@ from typing import Any
 import numpy as np
 
 from ..errors import EvaluationError
-from ..numeric import CompiledFunction, parameter_vector
+from ..numeric import CompiledFunction, mkq_function, parameter_vector
 from ..simulation.simulate import check_t_span
 from .c_run import C_METHODS, FAILED, Segment
 from .charts import decide
+from ..model import System
 from .closed_loop import (
-    ClosedLoopSystem,
     LoopEvaluator,
     SingularConfiguration,
     constraint_function,
@@ -68,7 +68,7 @@ from .scipy_run import SOLVERS, run_scipy
 _KEYS = ("z", "zd", "zdd", "Phi", "Phi_dot", "lam")
 
 
-def simulate_loop(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: Any,
+def simulate_loop(loop: System, t_span: tuple[float, float], z0: Any,
                   zd0: Any = None, *, t_eval: Sequence[float] | None = None,
                   samples: int = 501, rtol: float = 1e-10, atol: float = 1e-12,
                   method: str = "DOP853", parameters: Mapping[str, float] | None = None,
@@ -131,12 +131,12 @@ def simulate_loop(loop: ClosedLoopSystem, t_span: tuple[float, float], z0: Any,
         run_method)
 
 
-def _input_values(loop: ClosedLoopSystem, inputs: Any, fn_u: CompiledFunction | None,
+def _input_values(loop: System, inputs: Any, fn_u: CompiledFunction | None,
                   parameters: Mapping[str, float] | None) -> Callable[[float], Any]:
     """The inputs as a function of time (for the evaluator and the SciPy engine)."""
     n_u = len(loop.tree.inputs)
     if fn_u is not None:  # expressions of t and the parameters, compiled
-        p_u, zeros, u_zero = (parameter_vector(loop.tree, parameters), np.zeros(loop.n),
+        p_u, zeros, u_zero = (parameter_vector(loop.tree, parameters), np.zeros(loop.f),
                               np.zeros(n_u))
         return lambda t: fn_u(zeros, zeros, t, p_u, u_zero)["u"][:, 0]
     if callable(inputs):
@@ -242,5 +242,73 @@ def _record(out: dict[str, list], kernel: LoopKernel, con: Any, t: np.ndarray,
     out["V"].extend(e["V"][:, 0, 0].tolist())
 
 
-__all__ = ["C_METHODS", "LoopResults", "SOLVERS", "simulate_loop", "simulate_penalty",
-           "simulate_redundant"]
+
+
+
+def simulate_closed(system: System, t_span: tuple[float, float], y0: Any, yd0: Any = None,
+                    parameters: Mapping[str, float] | None = None,
+                    inputs: Mapping[str, Any] | Sequence[float] | Callable[[float], Any]
+                    | None = None, method: str = "DOP853", rtol: float = 1e-8,
+                    atol: float = 1e-10, t_eval: Sequence[float] | None = None,
+                    max_step: float = math.inf, samples: int = 501,
+                    repartition: bool = True, cond_limit: float = 1e6,
+                    **options: Any) -> Any:
+    """:meth:`jourdain.System.simulate` of a closed system: the motion on the constraint
+    manifold (coordinate partitioning, :func:`simulate_loop`) as :class:`jourdain.Results`
+    with the tree's coordinates ``y`` (every sample on ``Φ = 0``) and the closing rows in
+    :attr:`Results.constraints` (``Phi``, ``Phi_dot``, ``multipliers``).
+
+    ``method``: "DOP853", "RK45", "Radau" (jourdain's C integrator with the compiled loop
+    right-hand side), "BDF", "LSODA" or "scipy:<method>" (SciPy's steppers). ``t_eval``
+    default: ``samples`` equally spaced times. Options of tree runs that closed systems do not
+    take yet raise :class:`jourdain.errors.ClosedSystemError` naming them.
+    """
+    from ..errors import ClosedSystemError
+    from ..simulation.results import Results
+    from ..simulation.results.data import ConstraintHistories
+
+    unknown = {k: v for k, v in options.items() if v not in (None, False, ())}
+    if unknown:
+        raise ClosedSystemError(system, f"simulate(..., {', '.join(sorted(unknown))}=...) "
+                                "is not available for closed systems yet")
+    engine = "c"
+    if method.startswith("scipy:"):
+        engine, method = "scipy", method.split(":", 1)[1]
+    elif method not in C_METHODS:
+        engine = "scipy"
+    if isinstance(inputs, Mapping) and inputs and not all(
+            isinstance(v, int | float | str) for v in inputs.values()):
+        raise ClosedSystemError(system, "inputs given as tables or Python functions in a "
+                                "mapping are not available for closed systems yet (give "
+                                "numbers or expressions of t, or one function of t)")
+    lr = simulate_loop(system, t_span, y0, yd0, t_eval=t_eval, samples=samples, rtol=rtol,
+                       atol=atol, method=method, parameters=parameters, inputs=inputs,
+                       repartition=repartition, cond_limit=cond_limit, max_step=max_step,
+                       engine=engine)
+    tree = system.tree
+    n_u = len(tree.inputs)
+    N = len(lr.t)
+    U = np.zeros((N, n_u))
+    if n_u and N:
+        fn_u = input_function(system, inputs) if isinstance(inputs, Mapping) else None
+        u_of = _input_values(system, inputs, fn_u, parameters)
+        U = np.array([np.asarray(u_of(float(t)), dtype=float).reshape(n_u) for t in lr.t])
+    # the work of the generalized applied forces, ∫ẏᵀq dt, by the trapezoidal rule over the
+    # samples (the constraint forces do no work on the manifold)
+    W = np.zeros(N)
+    if N > 1:
+        p = parameter_vector(tree, parameters)
+        mkq = mkq_function(tree)
+        qv = mkq.batch(lr.z, lr.zd, lr.t, p, U if n_u else None)["q"][:, :, 0]
+        power = np.einsum("ij,ij->i", lr.zd, qv)
+        W[1:] = np.cumsum(0.5 * (power[1:] + power[:-1]) * np.diff(lr.t))
+    cons = ConstraintHistories(tuple(lr.labels), lr.Phi, lr.Phi_dot, lr.lam,
+                               tuple(lr.partitions), lr.singular)
+    return Results(system, lr.t, lr.z, lr.zd, lr.zdd, U, W, dict(lr.parameters),
+                   method=lr.method, rtol=rtol, atol=atol, status=lr.status,
+                   message=lr.message, nfev=lr.nfev, wall_time=lr.wall_time,
+                   constraints=cons)
+
+
+__all__ = ["C_METHODS", "SOLVERS", "LoopResults", "simulate_closed", "simulate_loop",
+           "simulate_penalty", "simulate_redundant"]

@@ -1,26 +1,24 @@
-"""The data of a closed-loop system (issue 11): a spanning tree and its closing joints, the
-errors of the loop stages, and the symbolic constraint equations Φ, Φ_z, Φ_t and the
-convective term c (:func:`constraints`), compiled with the tree's energies
-(:func:`constraint_function`). The method is described in :mod:`jourdain.loops.closed_loop`."""
+"""The errors of the numbers of closed systems, and the constraint stage
+(:mod:`jourdain.stages.constraints`: Φ, Φ_y, Φ_t, c) of a closed :class:`jourdain.System`
+compiled with the tree's energies (:func:`constraint_function`). In this package ``z`` names
+the tree's coordinates (the system's ``y``) and ``y`` the independent ones. The method is
+described in :mod:`jourdain.loops.closed_loop`."""
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass
 from functools import lru_cache
 from typing import Any
 
 import numpy as np
-import symengine as se
 
 from ..analysis.energy import energy
 from ..errors import JourdainError, ModelError
 from ..model import System
-from ..model.forces import rate
 from ..numeric import CompiledFunction, lambdify
 from ..stages.kinematics import kinematics  # the model has no stage methods (issue 16)
+from ..stages.constraints import Constraints
+from ..stages.constraints import constraints as constraint_stage
 from ..symbolic import SymMatrix
-from .closing_joints import ClosingJoint, ConstraintRow, constraint_rows, grubler
 
 EPS = float(np.finfo(float).eps)
 
@@ -44,142 +42,36 @@ class AssemblyError(JourdainError, ValueError):
 
 
 
-@dataclass(frozen=True)
-class LoopModel:
-    """A tree :class:`~jourdain.System` (coordinates z) closed by closing joints (the data;
-    :class:`jourdain.loops.ClosedLoopSystem` adds the stages as methods).
-
-    Parameters
-    ----------
-    tree : System
-        The spanning tree; its coordinates are the redundant coordinates z.
-    closing : sequence of ClosingJoint
-    independent : sequence of coordinate names, optional
-        The independent coordinates y (else chosen by pivoting at the initial configuration).
-    name : str, optional
-    """
-
-    tree: System
-    closing: tuple[ClosingJoint, ...]
-    independent: tuple[str, ...] | None = None
-    name: str = ""
-
-    def __init__(self, tree: System, closing: Sequence[ClosingJoint],
-                 independent: Sequence[str] | None = None, name: str | None = None) -> None:
-        set_ = object.__setattr__
-        if not isinstance(tree, System):
-            raise ModelError(f"LoopModel: tree must be a System, got {type(tree).__name__}")
-        set_(self, "tree", tree)
-        closing = tuple(closing)
-        if not closing:
-            raise ModelError("LoopModel: no closing joints (a tree needs none)")
-        names: set[str] = set()
-        bodies = set(tree.body_names) | {"world"}
-        joint_names = {b.joint.name for b in tree.bodies}
-        params = {k for k, _ in tree.parameters}
-        coords = set(tree.coordinate_names)
-        for cj in closing:
-            if not isinstance(cj, ClosingJoint):
-                raise ModelError(f"closing joints: expected ClosingJoint objects, got "
-                                 f"{type(cj).__name__}")
-            if cj.name in names or cj.name in joint_names:
-                raise ModelError(f'closing joint "{cj.name}": the name is used twice')
-            names.add(cj.name)
-            for side in (cj.body_a, cj.body_b):
-                if side not in bodies:
-                    raise ModelError(f'closing joint "{cj.name}": unknown body "{side}"; bodies '
-                                     f"are {', '.join(sorted(bodies))}")
-            allowed = params | (coords | {"t"} if cj.type == "constraint" else set())
-            unknown = sorted(cj.symbols() - allowed)
-            if unknown:
-                what = ("coordinates, t and parameters" if cj.type == "constraint"
-                        else "parameters (points and axes are constant in their bodies)")
-                raise ModelError(f'closing joint "{cj.name}": unknown name(s) '
-                                 f"{', '.join(unknown)}; it may use {what}")
-        set_(self, "closing", closing)
-        if independent is not None:
-            ind = tuple(str(c) for c in independent)
-            for c in ind:
-                if c not in coords:
-                    raise ModelError(f'independent coordinate "{c}" is not a coordinate of the '
-                                     f"tree ({', '.join(tree.coordinate_names)})")
-            if len(set(ind)) != len(ind):
-                raise ModelError(f"independent coordinates {list(ind)} name one twice")
-            set_(self, "independent", ind)
-        else:
-            set_(self, "independent", None)
-        set_(self, "name", tree.name if name is None else str(name))
-
-    @property
-    def n(self) -> int:
-        """Number of tree coordinates z."""
-        return self.tree.f
-
-    @property
-    def coordinate_names(self) -> list[str]:
-        return self.tree.coordinate_names
-
-    def grubler(self) -> int:
-        """Degrees of freedom by the Grübler–Kutzbach count (spatial: 6 per body)."""
-        return grubler(len(self.tree.bodies), [len(b.joint.coordinates)
-                                               for b in self.tree.bodies], self.closing)
-
-
-@dataclass(frozen=True)
-class Constraints:
-    """The constraint equations of a loop system (symbolic, in z, ż, t and parameters).
-
-    ``rows`` (m ConstraintRow), ``Phi`` (m×1), ``Phi_z`` (m×n), ``Phi_t`` (m×1), ``c``
-    (m×1): ``Φ̈ = Φ_z·z̈ + c``.
-    """
-
-    rows: tuple[ConstraintRow, ...]
-    Phi: SymMatrix
-    Phi_z: SymMatrix
-    Phi_t: SymMatrix
-    c: SymMatrix
-
-    @property
-    def labels(self) -> list[str]:
-        return [r.label for r in self.rows]
-
-
-@lru_cache(maxsize=16)
-def constraints(loop: LoopModel) -> Constraints:
-    """Φ, Φ_z, Φ_t and the convective term c of ``loop`` from the tree's kinematics."""
-    tree = loop.tree
-    rows = constraint_rows(kinematics(tree), loop.closing)
-    if not rows:
+def constraints(loop: System) -> Constraints:
+    """The constraint stage of a closed ``loop`` (:func:`jourdain.stages.constraints.constraints`
+    on the tree's kinematics), kept by the system; ModelError when its closing joints give no
+    row."""
+    con = _constraints(loop)
+    if not con.rows:
         raise ModelError(f"{loop.name}: the closing joints give no constraint equation (every "
                          "row vanishes identically)")
-    z = tree.coordinates
-    zd = [rate(c) for c in z]
-    t = tree.t
-    Phi = [r.expr for r in rows]
-    Phi_z = [[se.diff(e, zj) for zj in z] for e in Phi]
-    Phi_t = [se.diff(e, t) for e in Phi]
-    # w = Φ̇ = Φ_z ż + Φ_t; c = ∂w/∂z·ż + ∂w/∂t (the part of Φ̈ without z̈)
-    c = []
-    for i in range(len(Phi)):
-        w = sum((Phi_z[i][j] * zd[j] for j in range(len(z))), se.Integer(0)) + Phi_t[i]
-        ci = sum((se.diff(w, z[j]) * zd[j] for j in range(len(z))), se.Integer(0)) \
-            + se.diff(w, t)
-        c.append(ci)
-    return Constraints(tuple(rows), SymMatrix.column(Phi), SymMatrix.from_rows(Phi_z),
-                       SymMatrix.column(Phi_t), SymMatrix.column(c))
+    return con
 
 
 @lru_cache(maxsize=16)
-def constraint_function(loop: LoopModel) -> CompiledFunction:
+def _constraints(loop: System) -> Constraints:
+    stage = getattr(loop, "constraints", None)
+    if callable(stage):  # a jourdain.System: its kept stage
+        return stage()
+    return constraint_stage(kinematics(loop.tree), loop.closing)
+
+
+@lru_cache(maxsize=16)
+def constraint_function(loop: System) -> CompiledFunction:
     """Compiled ``Phi, Phi_z, Phi_t, c`` and the tree's energies ``T, V`` (memoized)."""
     con = constraints(loop)
     e = energy(kinematics(loop.tree))
-    return lambdify(loop.tree, {"Phi": con.Phi, "Phi_z": con.Phi_z, "Phi_t": con.Phi_t,
+    return lambdify(loop.tree, {"Phi": con.Phi, "Phi_z": con.Phi_y, "Phi_t": con.Phi_t,
                                 "c": con.c, "T": SymMatrix.column([e.T]),
                                 "V": SymMatrix.column([e.V])})
 
 
 
 
-__all__ = ["EPS", "AssemblyError", "Constraints", "LoopModel", "SingularConfiguration",
+__all__ = ["EPS", "AssemblyError", "Constraints", "SingularConfiguration",
            "constraint_function", "constraints"]

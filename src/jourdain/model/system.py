@@ -14,6 +14,7 @@ import symengine as se
 
 from ..errors import ModelError
 from .bodies import Body
+from .closing import ClosingJoint, grubler
 from .expressions import as_expr, t
 from .forces import (
     Bushing,
@@ -70,6 +71,14 @@ class System:
     units : mapping name -> unit string, optional
         Units of parameters and coordinates, for reports.
     name : str
+    closing : sequence of ClosingJoint, optional
+        Joints that close kinematic loops of the tree (METHOD.md §7). With any, the system is
+        closed: its coordinates ``y`` are the tree's (f of them), tied by the closing joints'
+        rows ``Φ(y, t) = 0``, and every stage and function works on the closed mechanism; the
+        open tree is :attr:`tree`.
+    independent : sequence of coordinate names, optional
+        The independent coordinates of a closed system (else chosen by pivoting on ``Φ_y`` at
+        the initial configuration).
     """
 
     coordinates: tuple[se.Symbol, ...]
@@ -80,11 +89,14 @@ class System:
     units: tuple[tuple[str, str], ...]
     name: str
     quantities: tuple[Quantity, ...]
+    closing: tuple[ClosingJoint, ...] = ()
+    independent: tuple[str, ...] | None = None
 
     def __init__(self, coordinates: Sequence[object] | str, bodies: Sequence[Body],
                  forces: Sequence[ForceElement] = (), parameters: Mapping[str, float] | None = None,
                  inputs: Sequence[object] | str = (), units: Mapping[str, str] | None = None,
-                 name: str = "system") -> None:
+                 name: str = "system", closing: Sequence[ClosingJoint] = (),
+                 independent: Sequence[str] | None = None) -> None:
         y = _symbol_list(coordinates, "coordinates")
         u = _symbol_list(inputs, "inputs")
         params = dict(parameters or {})
@@ -119,6 +131,8 @@ class System:
         set_(self, "quantities", tuple(quantities_in(
             [e for f in forces for e in force_expressions(f)]).values()))
         validate(self)
+        set_(self, "closing", _closing_joints(self, closing))
+        set_(self, "independent", _independent(self, independent))
 
     def __hash__(self) -> int:
         """The hash of the fields, computed once: the memoized stages (``mkq_function(system)``
@@ -140,6 +154,40 @@ class System:
     def __setstate__(self, state: dict) -> None:
         for k, v in state.items():
             object.__setattr__(self, k, v)
+
+    # --- the tree and its closing joints --------------------------------------------------------
+    @property
+    def is_closed(self) -> bool:
+        """True when closing joints close kinematic loops of the tree."""
+        return bool(self.closing)
+
+    @property
+    def tree(self) -> System:
+        """The open tree: the same bodies, joints, forces and parameters without the closing
+        joints (the system itself when it has none), of the same class."""
+        if not self.closing:
+            return self
+        tree = self.__dict__.get("_tree")
+        if tree is None:
+            tree = type(self)(self.coordinates, self.bodies, self.forces,
+                              dict(self.parameters), self.inputs, dict(self.units), self.name)
+            object.__setattr__(self, "_tree", tree)
+        return tree
+
+    def closed_by(self, closing: Sequence[ClosingJoint], independent: Sequence[str] | None = None,
+                  name: str | None = None) -> System:
+        """This tree closed by the ``closing`` joints (a new system of the same class), with
+        the ``independent`` coordinates chosen (else by the partition at the initial
+        configuration)."""
+        return type(self)(self.coordinates, self.bodies, self.forces, dict(self.parameters),
+                          self.inputs, dict(self.units), self.name if name is None else name,
+                          closing=(*self.closing, *closing), independent=independent)
+
+    def grubler(self) -> int:
+        """Degrees of freedom by the Grübler–Kutzbach count (spatial: 6 per body), the tree's
+        joints and the closing joints counted."""
+        return grubler(len(self.bodies), [len(b.joint.coordinates) for b in self.bodies],
+                       self.closing)
 
     # --- names and symbols -------------------------------------------------------------------
     @property
@@ -195,6 +243,54 @@ class System:
         raise ModelError(f'unknown body "{name}"; bodies are: {", ".join(self.body_names)}')
 
     def __repr__(self) -> str:
-        return (f"System({self.name!r}: {len(self.bodies)} bodies, f={self.f}, "
+        closing = (f", closing joints {[c.name for c in self.closing]}" if self.closing
+                   else "")
+        return (f"System({self.name!r}: {len(self.bodies)} bodies{closing}, f={self.f}, "
                 f"coordinates={self.coordinate_names}, parameters={list(dict(self.parameters))}, "
                 f"inputs={self.input_names})")
+
+
+def _closing_joints(system: System, closing: Sequence[ClosingJoint]) -> tuple[ClosingJoint, ...]:
+    """The closing joints, checked against the tree: names unique among all joints, bodies
+    known, symbols only parameters (and, for general constraints, coordinates and t)."""
+    closing = tuple(closing)
+    names: set[str] = set()
+    bodies = set(system.body_names) | {"world"}
+    joint_names = {b.joint.name for b in system.bodies}
+    params = {k for k, _ in system.parameters}
+    coords = set(system.coordinate_names)
+    for cj in closing:
+        if not isinstance(cj, ClosingJoint):
+            raise ModelError(f"closing joints: expected ClosingJoint objects, got "
+                             f"{type(cj).__name__}")
+        if cj.name in names or cj.name in joint_names:
+            raise ModelError(f'closing joint "{cj.name}": the name is used twice')
+        names.add(cj.name)
+        for side in (cj.body_a, cj.body_b):
+            if side not in bodies:
+                raise ModelError(f'closing joint "{cj.name}": unknown body "{side}"; bodies '
+                                 f"are {', '.join(sorted(bodies))}")
+        allowed = params | (coords | {"t"} if cj.type == "constraint" else set())
+        unknown = sorted(cj.symbols() - allowed)
+        if unknown:
+            what = ("coordinates, t and parameters" if cj.type == "constraint"
+                    else "parameters (points and axes are constant in their bodies)")
+            raise ModelError(f'closing joint "{cj.name}": unknown name(s) '
+                             f"{', '.join(unknown)}; it may use {what}")
+    return closing
+
+
+def _independent(system: System, independent: Sequence[str] | None) -> tuple[str, ...] | None:
+    if independent is None:
+        return None
+    if not system.closing:
+        raise ModelError("independent coordinates are chosen for closed systems only (this "
+                         "one has no closing joints)")
+    ind = tuple(str(c) for c in independent)
+    for c in ind:
+        if c not in system.coordinate_names:
+            raise ModelError(f'independent coordinate "{c}" is not a coordinate of the tree '
+                             f"({', '.join(system.coordinate_names)})")
+    if len(set(ind)) != len(ind):
+        raise ModelError(f"independent coordinates {list(ind)} name one twice")
+    return ind

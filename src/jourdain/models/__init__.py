@@ -1,5 +1,6 @@
 """Sample models shared by the tests, the documentation and the benchmarks: textbook systems
-(:mod:`.classic`), serial chains from data (:mod:`.chains`), random trees (:mod:`.trees`).
+(:mod:`.classic`), serial chains from data (:mod:`.chains`), random trees (:mod:`.trees`),
+closed mechanisms (:mod:`.loops`: four-bar, slider-crank, the IFToMM N four-bar).
 Each builds a :class:`jourdain.System`."""
 
 from .chains import (
@@ -13,6 +14,7 @@ from .chains import (
     spatial_chain_data,
 )
 from .classic import double_pendulum, heavy_top, n_link_pendulum_on_cart
+from .loops import four_bar, n_four_bar, slider_crank
 from .trees import (
     CARDAN,
     TREE_JOINTS,
@@ -27,4 +29,5 @@ __all__ = [
     "spatial_chain", "spatial_chain_data", "robot_arm", "robot_arm_data", "chain_from_data",
     "ARM_AXES", "ARM_OFFSETS", "ARM_MASSES",
     "random_tree", "random_tree_data", "tree_from_data", "TREE_JOINTS", "TREE_WEIGHTS", "CARDAN",
+    "four_bar", "slider_crank", "n_four_bar",
 ]

@@ -18,11 +18,13 @@ from typing import Any, TypeVar
 import numpy as np
 
 from ..analysis.reactions import evaluate_keys
+from ..errors import refuse_closed
 from ..model.system import System as Model
 from ..numeric import evaluate as evaluate_eom
 from ..numeric.linearization import Linearization, linearization  # with its numbers
 from ..simulation.results import Results
 from ..simulation.simulate import DEFAULT_ATOL, DEFAULT_METHOD, DEFAULT_RTOL, simulate
+from ..stages.constraints import Constraints, constraints
 from ..stages.kinematics import Kinematics, kinematics
 from ..stages.newton_euler import NewtonEuler, newton_euler
 from ..stages.projection import EquationsOfMotion, projection
@@ -63,19 +65,41 @@ class System(Model):
             return d[key]
 
     def kinematics(self) -> Kinematics:
-        """Kinematics of every body (METHOD §1); see :func:`jourdain.stages.kinematics.kinematics`."""
+        """Kinematics of every body (METHOD §1); see :func:`jourdain.stages.kinematics.kinematics`.
+        A closed system's bodies move as its tree's: the tree's kinematics (``.system`` is
+        :attr:`tree`)."""
+        if self.closing:
+            return self.tree.kinematics()
         return self._stage("_kinematics", lambda: kinematics(self))
+
+    def constraints(self) -> Constraints:
+        """The constraint stage (METHOD §7): the closing joints' rows Φ, Φ_y, Φ_t, c and their
+        constrained directions Q̄_c; zero rows for a tree. See
+        :func:`jourdain.stages.constraints.constraints`."""
+        return self._stage("_constraints",
+                           lambda: constraints(self.tree.kinematics(), self.closing))
+
+    def _symbolic(self, stage: str) -> None:
+        refuse_closed(self, f"the symbolic {stage} of a closed system need its velocity map "
+                      "ẏ = L·ẏ_i + l, which exists in numbers only (coordinate partitioning at "
+                      "a configuration)",
+                      f"system.evaluate(y, yd) gives J̄ = J̄_tree·L, M, k, q and the reactions "
+                      f"in numbers; system.constraints() gives Φ, Φ_y; "
+                      f"system.tree.{stage.replace(' ', '_')}() the open tree's")
 
     def newton_euler(self) -> NewtonEuler:
         """Newton–Euler equations M̄·J̄·ÿ + q̄^c = q̄^e + Q̄·g (METHOD §2)."""
+        self._symbolic("newton euler")
         return self._stage("_newton_euler", lambda: newton_euler(self.kinematics()))
 
     def equations_of_motion(self) -> EquationsOfMotion:
         """Equations of motion M·ÿ + k = q by projection with J̄ᵀ (METHOD §3)."""
+        self._symbolic("equations of motion")
         return self._stage("_equations_of_motion", lambda: projection(self.newton_euler()))
 
     def reactions(self) -> Reactions:
         """Reaction forces: Q̄ from the joints, N̂·g = k̂ − q̂ (METHOD §4)."""
+        self._symbolic("reactions")
         return self._stage("_reactions", lambda: reactions(self.newton_euler()))
 
     def linearize(self, nominal: Mapping[Any, Any] | Any,
@@ -84,7 +108,18 @@ class System(Model):
         nominal ``inputs`` ``{input: u_s}`` where given (zero otherwise); see
         :func:`jourdain.stages.linearization.linearization`. The result has its numbers as
         methods (``evaluate``, ``compile``, ``check_nominal``:
-        :class:`jourdain.numeric.linearization.Linearization`)."""
+        :class:`jourdain.numeric.linearization.Linearization`).
+
+        A closed system is linearized in its independent coordinates about the state
+        ``nominal`` (``{coordinate: value, "<coordinate>_d": rate}`` or the f tree
+        coordinates; assembled onto the manifold): a
+        :class:`jourdain.loops.linearization.LoopLinearization` with ``M_tilde, P, Q, h, D,
+        G, K, N``, the state matrix ``A`` and its ``eigenvalues`` (central differences of the
+        compiled M, k, q on the manifold)."""
+        if self.closing:
+            from ..loops.linearization import linearize_closed
+
+            return linearize_closed(self, nominal, inputs)
         return linearization(self.equations_of_motion(), nominal, inputs)
 
     def evaluate(self, y: Any, yd: Any, t: float = 0.0,
@@ -99,6 +134,10 @@ class System(Model):
         the model's reactions cannot be formed). ``parameters`` overrides default values by
         name; ``inputs`` gives the inputs by name (or in the order of :attr:`input_names`).
         """
+        if self.closing:  # the closed system's numbers (METHOD §7): jourdain.loops.evaluation
+            from ..loops.evaluation import evaluate_closed
+
+            return evaluate_closed(self, y, yd, t, parameters, inputs)
         out: dict[str, Any] = dict(evaluate_eom(self, y, yd, t=t, parameters=parameters,
                                                 inputs=inputs))
         eom: dict[str, np.ndarray] = dict(out)
@@ -114,7 +153,19 @@ class System(Model):
         :class:`jourdain.simulation.results.Results` (see
         :func:`jourdain.simulation.simulate.simulate` for the methods, inputs, events and
         options). ``method``, ``rtol``, ``atol`` left out: the defaults of
-        :mod:`jourdain.simulation.simulate` (DOP853, 1e-8, 1e-10), the same as model files'."""
+        :mod:`jourdain.simulation.simulate` (DOP853, 1e-8, 1e-10), the same as model files'.
+
+        A closed system moves on its constraint manifold: ``y0, yd0`` are assembled (the
+        independent coordinates held) and the results carry the closing rows' residuals and
+        multipliers (:func:`jourdain.loops.simulate.simulate_closed`)."""
+        if self.closing:
+            from ..loops.simulate import simulate_closed
+
+            return simulate_closed(self, t_span, y0, yd0, parameters=parameters, inputs=inputs,
+                                   method=DEFAULT_METHOD if method is None else method,
+                                   rtol=DEFAULT_RTOL if rtol is None else rtol,
+                                   atol=DEFAULT_ATOL if atol is None else atol,
+                                   t_eval=t_eval, **options)
         return simulate(self, t_span, y0, yd0, parameters=parameters, inputs=inputs,
                         method=DEFAULT_METHOD if method is None else method,
                         rtol=DEFAULT_RTOL if rtol is None else rtol,

@@ -20,7 +20,7 @@ def summary(model: Any) -> dict[str, Any]:
     directions: dict[str, list[str]] = {}
     if has_capability("reactions"):
         try:
-            for jr in system.reactions().joints:
+            for jr in system.tree.reactions().joints:  # the closing joints: loop_summary
                 directions[jr.joint.name] = [n.split(".", 1)[-1] for n in jr.names]
         except JourdainError:
             directions = {}
@@ -49,7 +49,7 @@ def summary(model: Any) -> dict[str, Any]:
         "quantities": [{"name": q.name, "type": q.kind, "symbols": list(q.symbol_names),
                         "definition": q.describe()} for q in system.quantities],
         "nominal_motions": [n.name for n in model.nominal],
-        "cyclic_coordinates": list(cyclic(system)),
+        "cyclic_coordinates": [] if system.closing else list(cyclic(system)),
     }
 
 

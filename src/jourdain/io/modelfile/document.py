@@ -69,7 +69,9 @@ class SimulationSettings:
 
 @dataclass(frozen=True)
 class ModelFile:
-    """A loaded model file: the :class:`~jourdain.System` and what else the file describes."""
+    """A loaded model file: the :class:`~jourdain.System` (closed by the file's
+    ``[closing_joints.<name>]`` where it has any; its open tree is ``system.tree``) and what
+    else the file describes."""
 
     path: str
     system: System
@@ -78,8 +80,6 @@ class ModelFile:
     simulation: SimulationSettings = field(default_factory=SimulationSettings)
     descriptions: tuple[tuple[str, str], ...] = ()
     view: str | None = None
-    #: the :class:`jourdain.loops.ClosedLoopSystem` of ``[closing_joints.<name>]`` (else None)
-    loops: Any = None
 
     def error(self, message: str) -> ModelFileError:
         """A :class:`ModelFileError` for a problem a later stage found in this model (e.g. a

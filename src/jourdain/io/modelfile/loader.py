@@ -85,15 +85,14 @@ class _Loader(_Forces):
             raise self.fail(self.locate(str(exc)), str(exc)) from None
         nominal = self.read_nominal(data, system)
         sim = self.read_simulation(data, system)
-        loops = None
         if "closing_joints" in data or "loops" in data:
             # imported here, not at the top: jourdain.loops loads scipy.linalg (0.3 s), which
             # only models with closing joints need (no circle: loops imports nothing of io)
             from ...loops.modelfile import read_loops
 
-            loops = read_loops(self, data, system)
+            system = read_loops(self, data, system)
         return ModelFile(self.file, system, description, nominal, sim,
-                         tuple(self.descriptions.items()), view, loops)
+                         tuple(self.descriptions.items()), view)
 
 
     def read_coordinates(self, data: dict) -> None:

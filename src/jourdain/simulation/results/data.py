@@ -6,6 +6,7 @@ files"): the time histories and the run's metadata, their units, the motion betw
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 from functools import lru_cache
 from typing import TYPE_CHECKING, Any
 
@@ -23,11 +24,26 @@ if TYPE_CHECKING:
 PLOT_POINTS = 2000
 
 
+@dataclass(frozen=True)
+class ConstraintHistories:
+    """The closing joints' rows along a closed system's motion (METHOD.md §7): ``labels`` (r
+    names), ``Phi``, ``Phi_dot`` (N, r) the residuals of ``Φ = 0``, ``Φ̇ = 0``, ``multipliers``
+    (N, r) the λ of ``M_tree·ÿ + k_tree − q_tree = Φ_yᵀλ``, ``partitions``: ``[(t_start,
+    independent names), ...]``, ``singular``: the exception that stopped the run, or None."""
+
+    labels: tuple[str, ...]
+    Phi: np.ndarray
+    Phi_dot: np.ndarray
+    multipliers: np.ndarray
+    partitions: tuple[tuple[float, tuple[str, ...]], ...] = ()
+    singular: BaseException | None = None
+
+
 @lru_cache(maxsize=32)
 def _positions_function(system: System) -> Any:
     from ...numeric import lambdify
 
-    kin = kinematics(system)
+    kin = kinematics(system.tree)  # a closed system's bodies move as its tree's at the same y
     mats = {}
     for bk in kin.bodies:
         mats[f"{bk.name}.r_O"] = bk.r_O
@@ -50,7 +66,8 @@ class TimeHistories:
                  coordinate_names: Sequence[str] | None = None,
                  input_names: Sequence[str] | None = None,
                  units: dict[str, str] | None = None, energies: dict | None = None,
-                 name: str | None = None) -> None:
+                 name: str | None = None,
+                 constraints: ConstraintHistories | None = None) -> None:
         self.system = system
         self.t, self.y, self.yd, self.ydd, self.u, self.W = t, y, yd, ydd, u, W
         self.parameters = parameters
@@ -70,6 +87,37 @@ class TimeHistories:
                           else model_units(system))  # type: ignore[arg-type]
         self.name = name if name is not None else (system.name if system else "")
         self._energies = dict(energies or {})
+        self.constraints = constraints
+
+    # --- the closing joints' rows (width 0 for a tree) -------------------------------------
+    @property
+    def constraint_labels(self) -> list[str]:
+        """Names of the closing joints' rows (empty for a tree)."""
+        return list(self.constraints.labels) if self.constraints is not None else []
+
+    @property
+    def Phi(self) -> np.ndarray:
+        """Residuals of the closing joints' rows ``Φ``, (N, r); r = 0 for a tree."""
+        c = self.constraints
+        return c.Phi if c is not None else np.zeros((len(self.t), 0))
+
+    @property
+    def Phi_dot(self) -> np.ndarray:
+        """Residuals of ``Φ̇ = 0``, (N, r); r = 0 for a tree."""
+        c = self.constraints
+        return c.Phi_dot if c is not None else np.zeros((len(self.t), 0))
+
+    @property
+    def multipliers(self) -> np.ndarray:
+        """The closing rows' multipliers λ, (N, r) (their reactions; r = 0 for a tree)."""
+        c = self.constraints
+        return c.multipliers if c is not None else np.zeros((len(self.t), 0))
+
+    @property
+    def closure_residual(self) -> tuple[float, float]:
+        """``(max |Φ|, max |Φ̇|)`` along the motion (0, 0 for a tree)."""
+        return (float(np.max(np.abs(self.Phi), initial=0.0)),
+                float(np.max(np.abs(self.Phi_dot), initial=0.0)))
 
     # --- state ---------------------------------------------------------------------------
     @property
@@ -171,6 +219,12 @@ class TimeHistories:
 
     def _reactions(self) -> None:
         system = self._need_system("the reaction forces")
+        if system.closing:  # every joint's, the closing joints' included (METHOD.md §7)
+            from ...loops.evaluation import closed_reactions_along
+
+            g, names = closed_reactions_along(system, self)
+            self._energies["g"], self._energies["g_names"] = g, names
+            return
         from ...analysis.reactions import _reactions_function, projected_reactions, solve_g
 
         lay, fn = _reactions_function(system)
@@ -203,9 +257,15 @@ class TimeHistories:
 
             system = self._need_system("the joint wrenches")
             p = np.array([self.parameters[k] for k, _ in system.parameters])
-            self._energies["joint_wrenches"] = joint_wrenches_along(system, self.g, self.t,
+            tree = system.tree  # a closed system's tree joints come first in g
+            q = len(self.g_names) - len(self._closing_g_names())
+            self._energies["joint_wrenches"] = joint_wrenches_along(tree, self.g[:, :q], self.t,
                                                                     self.y, self.yd, p)
         return self._energies["joint_wrenches"]
+
+    def _closing_g_names(self) -> list[str]:
+        labels = set(self.constraint_labels)
+        return [n for n in self.g_names if n in labels]
 
     def joint_wrench_table(self, joint: str) -> tuple[list[str], np.ndarray]:
         """One joint's wrench along the motion as a table: column names and an (N, 13) array

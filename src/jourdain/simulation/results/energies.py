@@ -32,6 +32,7 @@ def _energy_function(system: System) -> tuple[Any, bool, tuple[str, ...], bool]:
     from ...numeric import lambdify
     from ...symbolic import SymMatrix
 
+    system = system.tree  # a closed system's energies are its tree's at the same state
     e = energy(kinematics(system))
     fn = lambdify(system, {"T": SymMatrix.column([e.T]), "V": SymMatrix.column([e.V])},
                   lean=True)
@@ -46,6 +47,7 @@ def _potential_rate_function(system: System) -> Any:
     from ...numeric import lambdify
     from ...symbolic import SymMatrix
 
+    system = system.tree  # a closed system's potential is its tree's at the same state
     rate = se.diff(energy(kinematics(system)).V, system.t)
     if rate.is_Number and rate == 0:
         return None
@@ -67,6 +69,7 @@ def _drive_power_function(system: System) -> Any:
     from ...numeric import lambdify
     from ...symbolic import SymMatrix
 
+    system = system.tree  # a closed system's bodies move as its tree's at the same state
     kin = kinematics(system)
     ne = newton_euler(kin)
     zero = se.Integer(0)

@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 
 import symengine as se
 
+from ...errors import refuse_closed
 from ...identity import IdentityMap
 from ...model.forces import acceleration, rate
 from ...model.joints import Mat3, Vec3
@@ -92,7 +93,16 @@ class Kinematics:
 
 
 def kinematics(system: System) -> Kinematics:
-    """Kinematics of every body of ``system`` (METHOD.md §1), built recursively along the tree."""
+    """Kinematics of every body of ``system`` (METHOD.md §1), built recursively along the tree.
+
+    A closed system (with closing joints) is refused with :class:`ClosedSystemError`: every
+    stage after this one would treat it as the open tree. Its kinematics are its tree's,
+    ``kinematics(system.tree)``, and the closing joints enter through the constraint stage
+    (:func:`jourdain.stages.constraints.constraints`)."""
+    refuse_closed(system, "the tree-only stages (kinematics and all that is derived from it "
+                  "for a tree) would leave the loops open",
+                  "use the system's own methods or functions (evaluate, simulate, linearize, "
+                  "reactions), or system.tree for the open tree")
     y = system.coordinates
     ctx = _Context({c: i for i, c in enumerate(y)}, tuple(rate(c) for c in y), system.t)
     f = len(y)

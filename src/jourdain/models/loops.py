@@ -1,14 +1,14 @@
-"""Sample loop mechanisms shared by the tests, the examples and the benchmarks."""
+"""Sample closed mechanisms (systems with closing joints) shared by the tests, the examples and
+the benchmarks."""
 
 from __future__ import annotations
 
 from ..model import Body, Gravity, Prismatic, Revolute, rod, symbols
+from ..model.closing import ClosingJoint
 from ..pipeline import System  # jourdain.System: the model with its stages (issue 16)
-from .closed_loop import ClosedLoopSystem
-from .closing_joints import ClosingJoint
 
 
-def four_bar(independent: tuple[str, ...] | None = ("theta1",)) -> ClosedLoopSystem:
+def four_bar(independent: tuple[str, ...] | None = ("theta1",)) -> System:
     """Planar four-bar linkage in the x-y plane, gravity ``g`` along −y.
 
     Crank (length ``a``, mass ``m1``) hinged to the ground at the origin, angle ``theta1``
@@ -35,10 +35,10 @@ def four_bar(independent: tuple[str, ...] | None = ("theta1",)) -> ClosedLoopSys
                   name="four-bar linkage")
     closure = ClosingJoint("closure", "revolute", "coupler", "rocker", point_a=(b, 0, 0),
                            point_b=(c, 0, 0), axis="z")
-    return ClosedLoopSystem(tree, [closure], independent=independent)
+    return tree.closed_by([closure], independent=independent)
 
 
-def slider_crank(independent: tuple[str, ...] | None = ("phi",)) -> ClosedLoopSystem:
+def slider_crank(independent: tuple[str, ...] | None = ("phi",)) -> System:
     """Planar slider-crank: crank (radius ``r``, mass ``m1``) hinged at the origin, angle
     ``phi`` from the x axis; connecting rod (``l``, ``m2``) hinged at the crank pin, angle
     ``psi`` relative to the crank; slider (``m3``) on the x axis, position ``s``. The loop is
@@ -59,10 +59,10 @@ def slider_crank(independent: tuple[str, ...] | None = ("phi",)) -> ClosedLoopSy
                          "g": "m/s^2"},
                   name="slider-crank")
     wrist = ClosingJoint("wrist", "revolute", "rod", "slider", point_a=(l, 0, 0), axis="z")
-    return ClosedLoopSystem(tree, [wrist], independent=independent)
+    return tree.closed_by([wrist], independent=independent)
 
 
-def n_four_bar(n: int) -> ClosedLoopSystem:
+def n_four_bar(n: int) -> System:
     """The N four-bar mechanism of the IFToMM multibody benchmark library: n + 1 cranks of
     length ``L`` pinned to the ground at ``x = i·L`` (angles ``th0 … thn`` from the x axis)
     and n couplers of length ``L`` hinged at the tops of cranks 0 … n−1 (angles ``ph0 …`` relative
@@ -89,4 +89,4 @@ def n_four_bar(n: int) -> ClosedLoopSystem:
                   parameters={"L": 1.0, "m": 1.0, "g": 9.81}, name=f"{n} four-bar")
     closing = [ClosingJoint(f"close{i}", "revolute", f"coupler{i}", f"crank{i + 1}",
                             point_a=(L, 0, 0), point_b=(L, 0, 0), axis="z") for i in range(n)]
-    return ClosedLoopSystem(tree, closing, independent=("th0",))
+    return tree.closed_by(closing, independent=("th0",))
