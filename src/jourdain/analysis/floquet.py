@@ -157,6 +157,14 @@ def floquet(lin: Linearization | CompiledLinearization, period: float, t0: float
     """
     from scipy.linalg import cho_factor, cho_solve
 
+    from ..errors import refuse_closed
+
+    refuse_closed(getattr(lin, "system", None) or getattr(getattr(lin, "linearization", None),
+                                                          "system", None),
+                  "Floquet analysis needs the linearization about a periodic nominal motion, "
+                  "which closed systems do not give yet (their linearization is about one "
+                  "state)")
+
 
     T = float(period)
     if not np.isfinite(T) or T <= 0:

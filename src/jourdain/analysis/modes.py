@@ -219,6 +219,8 @@ def stability(system: StateSpace | AnyLinearization, t: float | None = None,
 
 
 def _cyclic_of(lin: AnyLinearization) -> tuple[str, ...]:
+    if callable(getattr(lin, "state_space", None)):  # a closed system's, in numbers: none
+        return ()
     base = lin.linearization if hasattr(lin, "linearization") else lin
     eom = getattr(base, "equations_of_motion", None)
     return cyclic_coordinates(eom if eom is not None else base.system)

@@ -180,6 +180,12 @@ def state_space(lin: AnyLinearization, t: float | None = None,
     SingularMassMatrix
         When M̃ is not positive definite at these values.
     """
+    own = getattr(lin, "state_space", None)
+    if callable(own):  # a closed system's linearization: numbers at one state already
+        if parameters:
+            raise EvaluationError("state_space: a closed system's linearization holds numbers "
+                                  "for one set of parameters; pass them to linearize instead")
+        return own()
     base = _linearization_of(lin)
     if not base.is_time_invariant and not allow_time_variant:
         raise TimeVariantError(

@@ -15,13 +15,14 @@ functions of y, which exist only implicitly.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 from typing import Any
 
 import numpy as np
 import symengine as se
 
+from ..errors import EvaluationError
 from ..model.forces import rate
 from ..numeric import CompiledFunction, lambdify
 from ..stages.kinematics import kinematics
@@ -51,6 +52,41 @@ class LoopLinearization:
     N: np.ndarray
     A: np.ndarray
     eigenvalues: np.ndarray
+    #: the closed system (None where built without it), the time and parameters used
+    system: Any = None
+    t: float = 0.0
+    parameters: dict[str, float] | None = None
+
+    @property
+    def coordinate_names(self) -> tuple[str, ...]:
+        """The independent coordinates η refers to (the same as :attr:`names`)."""
+        return self.names
+
+    def evaluate(self, t: float | None = None,
+                 parameters: Mapping[str, float] | None = None) -> dict[str, np.ndarray]:
+        """The numbers by the seed's names, like a tree's linearization's ``evaluate``."""
+        if (t is not None and float(t) != self.t) or parameters:
+            raise EvaluationError("a closed system's linearization holds numbers for one t "
+                                  "and one set of parameters; linearize again for others")
+        f = len(self.names)
+        return {"M_tilde": self.M_tilde, "P": self.P, "Q": self.Q, "h": self.h,
+                "B": np.zeros((f, 0)), "D": self.D, "G": self.G, "K": self.K, "N": self.N}
+
+    def state_space(self) -> Any:
+        """The state-space form ``ẋ = A·x + E·h`` in ``x = [η; η̇]`` of the independent
+        coordinates (:class:`jourdain.analysis.StateSpace`; no inputs)."""
+        from ..analysis.state_space import StateSpace
+
+        f = len(self.names)
+        E = np.zeros((2 * f, f))
+        E[f:] = np.linalg.inv(self.M_tilde)
+        pars = dict(self.parameters or {})
+        if not pars and self.system is not None:
+            pars = self.system.parameter_values
+        return StateSpace(A=self.A, B=np.zeros((2 * f, 0)), E=E, M_tilde=self.M_tilde,
+                          P=self.P, Q=self.Q, B_u=np.zeros((f, 0)), h=self.h,
+                          coordinate_names=tuple(self.names), input_names=(), t=self.t,
+                          parameters=pars)
 
 
 def linearize_loop(loop: System, z_s: Any, zd_s: Any = None, t: float = 0.0,
@@ -182,7 +218,7 @@ def linearize_closed(system: System, nominal: Any, inputs: Mapping[str, float] |
     """:meth:`jourdain.System.linearize` of a closed system about the state ``nominal``: a
     mapping ``{coordinate: value, "<coordinate>_d": rate, "<coordinate>_dd": acceleration}``
     (constant numbers; coordinates left out are 0 and assembled) or the f tree coordinates."""
-    from ..errors import ClosedSystemError, EvaluationError
+    from ..errors import ClosedSystemError
 
     if inputs:
         raise ClosedSystemError(system, "a linearization with nominal inputs is not available "
@@ -219,4 +255,7 @@ def linearize_closed(system: System, nominal: Any, inputs: Mapping[str, float] |
     if isinstance(ydd, dict):  # accelerations of the independent coordinates, by name
         ev = LoopEvaluator(system, y, 0.0, parameters)
         ydd = np.array([ydd.get(c, 0.0) for c in ev.independent_names])
-    return linearize_loop(system, y, yd, 0.0, ydd, parameters)
+    lin = linearize_loop(system, y, yd, 0.0, ydd, parameters)
+    pars = system.parameter_values
+    pars.update(dict(parameters or {}))
+    return replace(lin, system=system, parameters=pars)

@@ -145,6 +145,14 @@ def simulate(system: System, t_span: tuple[float, float], y0: Any, yd0: Any,
     EvaluationError
         bad arguments (wrong sizes, NaN initial values, unknown names).
     """
+    if system.closing:  # a closed system moves on its constraint manifold (METHOD §7)
+        from ..loops.simulate import simulate_closed
+
+        return simulate_closed(system, t_span, y0, yd0, parameters=parameters, inputs=inputs,
+                               method=method, rtol=rtol, atol=atol, t_eval=t_eval,
+                               max_step=max_step, events=tuple(events), first_step=first_step,
+                               progress=progress, output=output,
+                               raise_on_interrupt=raise_on_interrupt)
     f = system.f
     t0, t1 = check_t_span(t_span)
     yv = _initial(y0, f, "y0", system, "")
