@@ -56,10 +56,13 @@ def output_layout(ctx: Context) -> dict[str, tuple[tuple[str, ...], tuple[int, .
         for j in e["reactions"]:
             out[f"wrench_{j}"] = (("wrench_component",), (6,), "f8")
     if "linearize" in comp:
-        out["eigenvalue_real"] = (("mode",), (2 * f,), "f8")
-        out["eigenvalue_imag"] = (("mode",), (2 * f,), "f8")
+        fl = ctx.f_linear  # a closed system's: its independent coordinates
+        out["eigenvalue_real"] = (("mode",), (2 * fl,), "f8")
+        out["eigenvalue_imag"] = (("mode",), (2 * fl,), "f8")
         out["max_real_part"] = ((), (), "f8")
         out["verdict"] = ((), (), "i1")
+        if ctx.closed:  # the configuration (tree coordinates) each case was linearized about
+            out["linearized_about"] = (("coordinate",), (f,), "f8")
     if "critical" in comp:
         out[f"critical_{comp['critical']['parameter']}"] = ((), (), "f8")
     if "frequency_response" in comp:
@@ -78,6 +81,9 @@ def output_layout(ctx: Context) -> dict[str, tuple[tuple[str, ...], tuple[int, .
             out[f"max_abs_{n}"] = ((), (), "f8")
         for n in s["series"]:
             out[f"series_{n}"] = (("time",), (s["samples"],), "f8")
+        if ctx.closed:  # max |Φ| and max |Φ̇| of the closing rows along the run
+            out["closure_residual"] = ((), (), "f8")
+            out["closure_rate_residual"] = ((), (), "f8")
     return out
 
 
@@ -111,9 +117,11 @@ def compute_block(spec: StudySpec, start: int, stop: int,
     if "linearize" in comp or "frequency_response" in comp:
         idx = np.flatnonzero(ok)
         # M̃, P, Q, B of the cases: one C call for both outputs
-        nums = linearization_numbers(ctx, P[idx]) if idx.size else None
+        nums = linearization_numbers(ctx, P[idx], Y[idx]) if idx.size else None
     if "linearize" in comp:
-        lam, maxre, verdict, errs = analyse(ctx, P[idx], nums)
+        lam, maxre, verdict, errs = analyse(ctx, P[idx], nums, Y[idx])
+        if ctx.closed and nums is not None:
+            out["linearized_about"][idx] = nums["y_s"]
         out["eigenvalue_real"][idx] = lam.real
         out["eigenvalue_imag"][idx] = lam.imag
         out["max_real_part"][idx] = maxre
@@ -121,7 +129,7 @@ def compute_block(spec: StudySpec, start: int, stop: int,
         record_errors(errors, idx, errs, "linearize")
     if "critical" in comp:
         idx = np.flatnonzero(ok)
-        crit, errs = critical(ctx, P[idx])
+        crit, errs = critical(ctx, P[idx], Y[idx])
         out[f"critical_{comp['critical']['parameter']}"][idx] = crit
         record_errors(errors, idx, errs, "critical")
     if "frequency_response" in comp:

@@ -58,6 +58,7 @@ class ComputeTables:
         comp = self.table(value, ("compute",), set(COMPUTE_KEYS))
         out: dict[str, dict[str, Any]] = {}
         nominal_names = [n.name for n in model.nominal]
+        self._closed = bool(getattr(system, "closing", ()))
         for what, entry in comp.items():
             path = ("compute", what)
             entry = self.table(entry, path, COMPUTE_KEYS[what])
@@ -106,11 +107,17 @@ class ComputeTables:
         return out
 
     def about(self, entry: dict, path: tuple[str | int, ...], nominal_names: list[str]) -> str:
-        """The nominal motion named by ``about`` (the model's first one by default)."""
-        about = entry.get("about", nominal_names[0] if nominal_names else None)
-        if about not in nominal_names:
+        """The nominal motion named by ``about`` (the model's first one by default). A closed
+        system (closing joints) may also be linearized about ``"equilibrium"``, the equilibrium
+        nearest each case's initial configuration: the default where its model has no nominal
+        motion."""
+        closed = getattr(self, "_closed", False)
+        default = (nominal_names[0] if nominal_names else "equilibrium" if closed else None)
+        about = entry.get("about", default)
+        if about not in nominal_names and not (closed and about == "equilibrium"):
+            more = ' (or "equilibrium": a closed system\'s nearest equilibrium)' if closed else ""
             raise self.error((*path, "about"), f"no nominal motion {about!r} in the model; it "
-                             f"has: {', '.join(nominal_names) or '(none)'}")
+                             f"has: {', '.join(nominal_names) or '(none)'}{more}")
         return about
 
     def frequency_response(self, entry: dict, path: tuple[str | int, ...], model: Any,

@@ -18,7 +18,7 @@ import numpy as np
 from ..errors import JourdainError
 from .spec import StudyError, StudySpec
 
-__all__ = ["FAILURES", "Context", "case_arrays", "context", "forget_contexts", "record_errors"]
+__all__ = ["EQUILIBRIUM", "FAILURES", "Context", "case_arrays", "context", "forget_contexts", "record_errors"]
 
 #: the errors of one case that are recorded (its outputs NaN) instead of stopping the block
 FAILURES = (JourdainError, ArithmeticError, ValueError, np.linalg.LinAlgError)
@@ -48,6 +48,21 @@ class Context:
     #: problems of the model's numbers found so far, by the values of the parameters the
     #: bodies and joints use ("" where the values passed the checks)
     checked: dict[tuple[float, ...], str] = field(default_factory=dict)
+    #: a closed system (closing joints): linearized per case by
+    #: :func:`jourdain.loops.linearization.linearize_closed`, simulated per case by its own
+    #: ``simulate`` (never the open tree)
+    closed: bool = False
+    #: the independent coordinates of a closed system's linearization (its modes: 2 per name)
+    independent: tuple[str, ...] = ()
+    #: a closed system's nominal state at a case's parameters (None: the equilibrium nearest
+    #: the case's initial configuration, ``about = "equilibrium"``)
+    nominal_state: Any = None
+
+    @property
+    def f_linear(self) -> int:
+        """Coordinates of the linearization: the system's, or a closed system's independent
+        ones."""
+        return len(self.independent) if self.closed else self.system.f
 
     @property
     def parameter_names(self) -> list[str]:
@@ -102,7 +117,9 @@ def _build(spec: StudySpec) -> Context:
         raise StudyError(f"{spec.filename}: linearize, critical and frequency_response must be "
                          f"about the same nominal motion, got {sorted(abouts)}", spec.filename)
     about = next(iter(abouts), None)
-    if about is not None:
+    if system.is_closed:
+        _closed(ctx, about)
+    elif about is not None:
         from ..analysis.modes import _cyclic_of
 
         lin = system.linearize(nominal_mapping(system, model.nominal_motion(about)))
@@ -129,9 +146,51 @@ def _build(spec: StudySpec) -> Context:
             else:
                 exprs.append(se.Float(v))
         ctx.bounds = se.Lambdify(syms, exprs, real=True)
-    if "simulate" in comp:
+    if "simulate" in comp and not ctx.closed:
+        # a closed system's runs are one System.simulate per case (the ensemble driver runs
+        # the tree's compiled equations only)
         ctx.ensemble = _ensemble(ctx)
     return ctx
+
+
+#: ``about`` of a closed system's linearization: the equilibrium nearest each case's initial
+#: configuration (the default where the model has no nominal motion)
+EQUILIBRIUM = "equilibrium"
+
+
+def _closed(ctx: Context, about: str | None) -> None:
+    """A closed system's context: no batched C evaluation (its M, k, q come from the
+    manifold, per case); what the study cannot do for it raises ClosedSystemError naming the
+    capability."""
+    from ..errors import ClosedSystemError
+    from ..loops.closed_loop import LoopEvaluator
+
+    system, comp = ctx.system, ctx.spec.compute
+    ctx.closed = True
+    for what, capability in (
+            ("evaluate", "the study's [compute.evaluate] (M, k, q, ÿ and joint wrenches of a "
+             "block in one C call of the open tree's equations)"),
+            ("frequency_response", "the study's [compute.frequency_response] (frequency "
+             "responses of the linearization in the independent coordinates)")):
+        if what in comp:
+            raise ClosedSystemError(system, f"{capability} is not available for closed "
+                                    "systems yet", "compute [compute.linearize] or "
+                                    "[compute.simulate], or call system.evaluate per case")
+    # the partition at the initial configuration: the linearization's coordinates
+    ev = LoopEvaluator(system, ctx.y0, 0.0, None)
+    ctx.independent = tuple(ev.independent_names)
+    if about is not None and about != EQUILIBRIUM:
+        import symengine as se
+
+        nominal = ctx.model.nominal_motion(about)
+        t = se.Symbol("t")
+        exprs = [*nominal.y, *nominal.yd]
+        if any(t in se.sympify(e).free_symbols for e in exprs) or nominal.inputs:
+            raise ClosedSystemError(system, f'the nominal motion "{about}" depends on t or has '
+                                    "nominal inputs: a closed system's study is linearized "
+                                    "about a state (numbers in the parameters)",
+                                    f'use about = "{EQUILIBRIUM}" or a constant state')
+        ctx.nominal_state = se.Lambdify(list(system.parameter_symbols), exprs, real=True)
 
 
 def _ensemble(ctx: Context) -> Any:

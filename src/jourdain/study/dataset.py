@@ -66,7 +66,6 @@ def to_dataset(ctx: Context, blocks: Sequence[dict[str, Any]]) -> Any:
     spec, system = ctx.spec, ctx.system
     layout = output_layout(ctx)
     units = _units(ctx)
-    f = system.f
     coords_names = system.coordinate_names
     grid = spec.design == "grid"
     lead = spec.names if grid and spec.varied else ("case",)
@@ -97,7 +96,7 @@ def to_dataset(ctx: Context, blocks: Sequence[dict[str, Any]]) -> Any:
     if "state" in used:
         coords["state"] = [*coords_names, *(f"{n}_d" for n in coords_names)]
     if "mode" in used:
-        coords["mode"] = np.arange(2 * f)
+        coords["mode"] = np.arange(2 * ctx.f_linear)
     if "wrench_component" in used:
         coords["wrench_component"] = list(WRENCH_COMPONENTS)
     if "omega" in used:
@@ -129,6 +128,9 @@ def to_dataset(ctx: Context, blocks: Sequence[dict[str, Any]]) -> Any:
         attrs["nominal_motion"] = (spec.compute.get("linearize")
                                    or spec.compute["critical"])["about"]
         attrs["cyclic_coordinates"] = ", ".join(ctx.cyclic)
+    if ctx.closed:
+        attrs["closing_joints"] = ", ".join(c.name for c in system.closing)
+        attrs["independent_coordinates"] = ", ".join(ctx.independent)
     return xr.Dataset(data_vars, coords=coords, attrs=attrs)
 
 
@@ -168,6 +170,13 @@ def _attrs(ctx: Context, name: str, units: dict[str, str]) -> dict[str, Any]:
     if name == "frf_phase":
         return {"long_name": "phase of the steady-state response (unwrapped over omega)",
                 "units": "rad"}
+    if name == "linearized_about":
+        return {"long_name": "configuration linearized about (the tree's coordinates, on the "
+                "constraint manifold)"}
+    if name == "closure_residual":
+        return {"long_name": "largest |Phi| of the closing joints' rows along the run"}
+    if name == "closure_rate_residual":
+        return {"long_name": "largest |dPhi/dt| of the closing joints' rows along the run"}
     if name == "final":
         return {"long_name": "state at the end of the run (coordinates, then rates)"}
     return {"long_name": {"evaluate_M": "mass matrix M", "evaluate_k": "k (M·ÿ + k = q)",

@@ -16,13 +16,14 @@ responses and critical values.
 from __future__ import annotations
 
 from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
 
 from .context import Context
 
 __all__ = ["ASYMPTOTICALLY_STABLE_CODE", "MARGINALLY_STABLE_CODE", "UNSTABLE_CODE", "VERDICTS",
-           "analyse", "critical", "frequency_responses", "linearization_numbers",
+           "analyse", "closed_linearizations", "critical", "frequency_responses", "linearization_numbers",
            "state_matrices"]
 
 #: verdict codes stored in the results (−1: the case failed)
@@ -30,24 +31,75 @@ ASYMPTOTICALLY_STABLE_CODE, MARGINALLY_STABLE_CODE, UNSTABLE_CODE = 0, 1, 2
 VERDICTS = ("asymptotically stable", "marginally stable", "unstable")
 
 
-def linearization_numbers(ctx: Context, P: np.ndarray) -> dict[str, np.ndarray]:
-    """M̃, P, Q, B, ... of the linearization at each row of ``P`` (n ≥ 1), in one C call."""
+def linearization_numbers(ctx: Context, P: np.ndarray, Y: np.ndarray | None = None
+                          ) -> dict[str, Any]:
+    """M̃, P, Q, B, ... of the linearization at each row of ``P`` (n ≥ 1), in one C call; for
+    a closed system :func:`closed_linearizations` (one linearization per case, ``Y`` the
+    cases' initial coordinates: the equilibria's starting guesses)."""
+    if ctx.closed:
+        return closed_linearizations(ctx, P, Y)
     n, f = len(P), ctx.system.f
     Z = np.zeros((n, f))
     U = np.zeros((n, len(ctx.system.inputs))) if ctx.system.inputs else None
     return ctx.compiled_linearization.function.batch(Z, Z, 0.0, P, U)
 
 
-def analyse(ctx: Context, P: np.ndarray, nums: Mapping[str, np.ndarray] | None = None
+def closed_linearizations(ctx: Context, P: np.ndarray, Y: np.ndarray | None = None
+                          ) -> dict[str, Any]:
+    """A closed system's linearization at each row of ``P``, one case at a time, exactly as
+    :func:`jourdain.loops.linearization.linearize_closed` (what ``System.linearize`` calls)
+    gives it for that case's parameters: about the model's nominal state (evaluated at the
+    case's parameters), or, with ``about = "equilibrium"``, about the equilibrium
+    :func:`jourdain.loops.linearization.equilibrium` finds nearest the case's initial
+    coordinates (a row of ``Y``; the model's ``y0`` where None). Returns ``M_tilde``, ``P``,
+    ``Q`` (n, f, f) and the state matrix ``A`` (n, 2f, 2f) in the independent coordinates,
+    ``y_s`` (n, tree coordinates: the configuration linearized about) and ``errors`` (row ->
+    message; those rows NaN)."""
+    from ..loops.linearization import equilibrium, linearize_closed
+    from .context import FAILURES
+
+    n, f, ft = len(P), ctx.f_linear, ctx.system.f
+    out: dict[str, Any] = {"M_tilde": np.full((n, f, f), np.nan), "P": np.full((n, f, f), np.nan),
+                           "Q": np.full((n, f, f), np.nan),
+                           "A": np.full((n, 2 * f, 2 * f), np.nan),
+                           "y_s": np.full((n, ft), np.nan), "errors": {}}
+    names, coords = ctx.parameter_names, ctx.system.coordinate_names
+    for i in range(n):
+        params = dict(zip(names, P[i].tolist(), strict=True))
+        try:
+            nominal: Any
+            if ctx.nominal_state is None:
+                guess = ctx.y0 if Y is None else Y[i]
+                nominal = equilibrium(ctx.system, guess, parameters=params)
+            else:
+                v = np.asarray(ctx.nominal_state(P[i]), dtype=float).reshape(-1)
+                nominal = {**dict(zip(coords, v[:ft].tolist(), strict=True)),
+                           **{f"{c}_d": x for c, x in zip(coords, v[ft:].tolist(), strict=True)}}
+            lin = linearize_closed(ctx.system, nominal, parameters=params)
+            if lin.A.shape != (2 * f, 2 * f):
+                raise ValueError(f"the linearization has {lin.A.shape[0] // 2} independent "
+                                 f"coordinates ({', '.join(lin.names)}), the study's "
+                                 f"{f} ({', '.join(ctx.independent)})")
+        except FAILURES as exc:
+            out["errors"][i] = str(exc)
+            continue
+        out["M_tilde"][i], out["P"][i], out["Q"][i], out["A"][i] = lin.M_tilde, lin.P, lin.Q, lin.A
+        out["y_s"][i] = lin.z_s
+    return out
+
+
+def analyse(ctx: Context, P: np.ndarray, nums: Mapping[str, Any] | None = None,
+            Y: np.ndarray | None = None
             ) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict[int, str]]:
     """Eigenvalues (n, 2f) sorted as :func:`jourdain.analysis.sweep` sorts them, the largest
     real part (n,) and the verdict code (n,) of the linearization at each row of ``P``; and
     the errors by row (their outputs NaN / −1). ``nums``: :func:`linearization_numbers` at
-    ``P`` where already computed."""
+    ``P`` where already computed. A closed system's state matrices are those of its per-case
+    linearizations (:func:`closed_linearizations`, ``Y`` the cases' initial coordinates)."""
     from ..analysis.cyclic import reduced_matrix
     from ..analysis.modes import ZERO_RTOL, _verdict
 
-    n, f = len(P), ctx.system.f
+    n, f = len(P), ctx.f_linear
     lam = np.full((n, 2 * f), np.nan + 0j)
     maxre = np.full(n, np.nan)
     verdict = np.full(n, -1, dtype=np.int8)
@@ -55,8 +107,14 @@ def analyse(ctx: Context, P: np.ndarray, nums: Mapping[str, np.ndarray] | None =
     if not n:
         return lam, maxre, verdict, errs
     if nums is None:
-        nums = linearization_numbers(ctx, P)
-    A, bad = state_matrices(nums["M_tilde"], nums["P"], nums["Q"])
+        nums = linearization_numbers(ctx, P, Y)
+    if "A" in nums:  # a closed system's: the linearizations' own state matrices
+        A, bad = np.array(nums["A"]), dict(nums["errors"])
+        for i in np.flatnonzero(~np.all(np.isfinite(A.reshape(n, -1)), axis=1)):
+            bad.setdefault(int(i), "the linearization has non-finite entries at this case")
+        A[list(bad)] = 0.0
+    else:
+        A, bad = state_matrices(nums["M_tilde"], nums["P"], nums["Q"])
     for i, msg in bad.items():
         errs[i] = msg
     good = np.ones(n, dtype=bool)
@@ -173,7 +231,8 @@ def state_matrices(M: np.ndarray, Pm: np.ndarray, Q: np.ndarray
 
 # --- critical value by bisection on the verdict ------------------------------------------
 
-def critical(ctx: Context, P: np.ndarray) -> tuple[np.ndarray, dict[int, str]]:
+def critical(ctx: Context, P: np.ndarray, Y: np.ndarray | None = None
+             ) -> tuple[np.ndarray, dict[int, str]]:
     """The value of the critical parameter in [lower, upper] where the verdict changes between
     stable and unstable, for every row of ``P`` (the other parameters); as
     :func:`jourdain.analysis.stability_boundary`: bisection on the verdict to ``rtol``, then,
@@ -193,7 +252,7 @@ def critical(ctx: Context, P: np.ndarray) -> tuple[np.ndarray, dict[int, str]]:
     def at(x: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray, dict[int, str]]:
         Px = P[rows].copy()
         Px[:, j] = x
-        _, mr, v, e = analyse(ctx, Px)
+        _, mr, v, e = analyse(ctx, Px, Y=None if Y is None else Y[rows])
         return v, mr, e
 
     rows = np.arange(n)

@@ -109,11 +109,17 @@ def _simulate_case(ctx: Context, i: int, P: np.ndarray, Y: np.ndarray, YD: np.nd
     system = ctx.system
     t_eval = np.linspace(0.0, s["t_end"], s["samples"]).tolist()
     inputs = {k: v for k, v in ctx.model.simulation.inputs} or None
+    parameters = dict(zip(ctx.parameter_names, P[i].tolist(), strict=True))
     try:
-        r = simulate(system, (0.0, s["t_end"]), Y[i], YD[i],
-                     parameters=dict(zip(ctx.parameter_names, P[i].tolist(), strict=True)),
-                     inputs=inputs, method=s["method"], rtol=s["rtol"], atol=s["atol"],
-                     t_eval=t_eval, raise_on_interrupt=True)  # Ctrl-C stops the study
+        if ctx.closed:  # on the constraint manifold: the closed system's own simulate()
+            r = system.simulate((0.0, s["t_end"]), Y[i], YD[i], parameters=parameters,
+                                inputs={k: str(v) for k, v in inputs.items()} if inputs
+                                else None, method=s["method"], rtol=s["rtol"], atol=s["atol"],
+                                t_eval=t_eval)
+        else:
+            r = simulate(system, (0.0, s["t_end"]), Y[i], YD[i], parameters=parameters,
+                         inputs=inputs, method=s["method"], rtol=s["rtol"], atol=s["atol"],
+                         t_eval=t_eval, raise_on_interrupt=True)  # Ctrl-C stops the study
         if len(r.t) != len(t_eval):
             raise StudyError(f"the run stopped at t = {r.t[-1]:.6g} ({r.status}: "
                              f"{r.message})")
@@ -121,6 +127,8 @@ def _simulate_case(ctx: Context, i: int, P: np.ndarray, Y: np.ndarray, YD: np.nd
         record_errors(errors, np.array([i]), {0: str(exc)}, "simulate")
         return
     _store(out, s, i, r.y, r.yd, system.coordinate_names)
+    if ctx.closed:
+        out["closure_residual"][i], out["closure_rate_residual"][i] = r.closure_residual
 
 
 def _store(out: dict[str, np.ndarray], s: Mapping[str, Any], i: int, y: np.ndarray,

@@ -238,7 +238,10 @@ def _releases_gil(ctx: Any) -> bool:
     """True when a block's work runs in C and LAPACK with the GIL released: the evaluations
     and linearizations (one C call for the block, stacked solves and eigenvalues), frequency
     responses, critical values, and simulations advanced as an ensemble; False for simulations
-    run case by case (``simulate()`` per case spends much of its time in Python)."""
+    run case by case (``simulate()`` per case spends much of its time in Python) and for
+    closed systems (linearized and simulated case by case)."""
+    if ctx.closed:  # a closed system's cases: one linearization or simulate() each, in Python
+        return False
     return "simulate" not in ctx.spec.compute or ctx.ensemble is not None
 
 

@@ -39,7 +39,8 @@ MAX_FILE_BYTES = 1_000_000
 RESERVED = frozenset({"case", "coordinate", "coordinate_j", "state", "mode", "time",
                       "wrench_component", "error", "final", "verdict", "max_real_part",
                       "eigenvalue_real", "eigenvalue_imag", "omega", "excitation",
-                      "frf_magnitude", "frf_phase"})
+                      "frf_magnitude", "frf_phase", "linearized_about", "closure_residual",
+                      "closure_rate_residual"})
 
 
 class StudyError(JourdainError, ValueError):
