@@ -16,7 +16,7 @@ from ..io.report.figures import prepare_worker
 from ..io.workers import fork_workers, stop_workers
 from ..simulation.simulate import OUTPUT_SUFFIXES
 from ..workflow import require
-from .arguments import UsageError, load, overrides, sim_options, tree_only
+from .arguments import UsageError, load, overrides, sim_options
 from .outputs import output_file, output_folder, progress_printer, samples
 
 EXIT_OK, EXIT_MODEL, EXIT_INTERRUPTED = 0, 1, 130
@@ -24,7 +24,6 @@ EXIT_OK, EXIT_MODEL, EXIT_INTERRUPTED = 0, 1, 130
 
 def cmd_simulate(args: argparse.Namespace) -> int:
     model = load(args.model)
-    tree_only(model, "simulate")
     system = model.system
     require(system, "simulate", "simulation")
 
@@ -32,10 +31,14 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     params = overrides(system, args.set)
     opts = sim_options(model, args)
     out = output_file(args.out, args.force, OUTPUT_SUFFIXES) if args.out else None
-    progress = progress_printer(args.progress, f"simulating {system.name}")
+    # a closed system's run (jourdain.loops) reports no progress: asked for, its
+    # ClosedSystemError says so; not asked for, none is passed
+    progress = (progress_printer(args.progress, f"simulating {system.name}")
+                if args.progress or not system.closing else None)
     failure: JourdainError | None = None
     try:
-        # with --out the results are written as the run goes, and complete at its end
+        # with --out the results are written as the run goes (a closed system's: at its end),
+        # and complete at its end
         res = integration.simulate(model, params, **opts, progress=progress or False,
                                    output=out)
     except JourdainError as exc:
@@ -93,20 +96,14 @@ def _run(args: argparse.Namespace, pool: ProcessPoolExecutor | None) -> int:
     params = overrides(model.system, args.set)
     opts = sim_options(model, args)
     out = output_folder(args.out, args.force, model)
-    if model.system.closing:  # a loop model: jourdain.loops' report
-        # jourdain.loops brings SciPy's linear algebra (0.2 s): imported for loop models only
-        from ..loops.report import run_report
-
-        for line in run_report(model, out, params, opts.get("t_end"), pool=pool):
-            print(line)
-        print(f"report: {out / 'index.html'}")
-        return EXIT_OK
     study = None
     if getattr(args, "study", None):  # a parameter study's section (H3): checked before the run
         from ..study import load_study
 
         study = load_study(args.study, model=model.path)
-    progress = progress_printer(args.progress, f"simulating {model.system.name}")
+    # a closed system's run reports no progress yet (simulate on the manifold takes none)
+    progress = (None if model.system.closing else
+                progress_printer(args.progress, f"simulating {model.system.name}"))
     try:
         info = write_report(model, out, parameters=params, t_end=opts.get("t_end"),
                             max_ops=args.max_ops, progress=progress or False,

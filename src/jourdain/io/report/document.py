@@ -46,6 +46,15 @@ def compute_sections(run: Run, sections: list[str], display: Future[Display] | N
     symbolic display (section 2) is ``run.display`` (from the cache), else the worker's
     ``display``, else computed here in turn."""
     sections.append(model_section(run))
+    if run.model.system.closing:  # a closed system: its numbers, and the loops' section
+        from . import loops
+
+        sections.append(loops.equations_section(run))
+        sections.append(numbers_section(run))
+        sections.append(loops.linearization_section(run))
+        sections.append(simulation_section(run))
+        sections.append(loops.loops_section(run, run.results))
+        return
     if run.display is None and display is None:
         run.display = cached_display(run.model, run.max_ops)
     if run.display is not None:
@@ -109,7 +118,10 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
     display: Future[Display] | None = None
     known: Display | None = None
     try:
-        if parallel:  # the display from the cache, else from a worker
+        closed = bool(system.closing)  # no symbolic display of a closed system
+        if parallel and closed and pool is None:  # the figures' worker alone
+            pool = fork_workers(prepare_worker)
+        if parallel and not closed:  # the display from the cache, else from a worker
             key = display_key(model, max_ops)  # derives the equations (the workers' copies)
             known = cached(key)
             if known is None or pool is None:
@@ -142,7 +154,8 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
         except KeyboardInterrupt:
             info.status = "interrupted"
             info.message = (f"interrupted by the user (Ctrl-C) after section {len(sections)} "
-                            f"of {SECTIONS}; the sections after it are missing")
+                            f"of {SECTIONS + bool(system.closing)}; the sections after it "
+                            "are missing")
         if display is not None:  # the worker's display, and its files
             try:
                 run.display = display.result()
@@ -165,7 +178,10 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
              if all(k in ops for k in ("M", "k", "q")) else "")
     info.summary_lines.insert(0, f"{system.name}: f = {system.f}, p = {len(system.bodies)} "
                                  f"bodies, {summ['constraints']} constrained directions; "
-                                 f"M·ÿ + k = q{count}")
+                                 f"M·ÿ + k = q{count}"
+                                 + (f"; closed by {', '.join(c.name for c in system.closing)}, "
+                                    f"independent {', '.join(system.independent)}"
+                                    if system.closing else ""))
     for n in info.notes:
         info.summary_lines.append(f"  note: {n}")
     if info.status != "complete":
@@ -180,7 +196,8 @@ def _page(run: Run, sections: list[str], t_start: float) -> str:
     info.files.insert(0, info.html)
     info.files.insert(1, run.out / "run.json")
     files = "".join(f"<li><a href='{esc(f.name)}'>{esc(f.name)}</a></li>" for f in info.files)
-    sections.append(f"<h2>6. Files</h2><ul>{files}</ul>")
+    number = SECTIONS + 1 + bool(model.system.closing)  # after a closed system's "Closed loops"
+    sections.append(f"<h2>{number}. Files</h2><ul>{files}</ul>")
     body = run.figures.fill("".join(sections))
     if run.display is not None:
         for i, nominal in enumerate(model.nominal):

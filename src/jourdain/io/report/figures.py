@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from .motion import Motion, frame_geometry, segments
+from .motion import Motion, closing_segments, frame_geometry, segments
 
 
 def new_figure(**kw: Any) -> Any:
@@ -121,6 +121,9 @@ def snapshot_strip(m: Motion, view: str | None, frames: int = 8) -> str:
         segs = [(proj(a), proj(b)) for a, b in segments(m, int(k))]
         if segs:  # one collection per frame: a Line2D per segment cost 40 ms a frame
             ax.add_collection(LineCollection(segs, colors="0.25", linewidths=1.5))
+        closing = [(proj(a), proj(b)) for a, b in closing_segments(m, int(k))]
+        if closing:  # a closed system's closing joints, in red
+            ax.add_collection(LineCollection(closing, colors="#d62728", linewidths=1.5))
         pc = np.array([proj(c[k]) for c in m.com.values()]).reshape(-1, 2)
         ax.scatter(pc[:, 0], pc[:, 1], s=sizes, color="C0", zorder=3)
         p0 = proj(np.zeros(3))

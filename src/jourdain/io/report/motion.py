@@ -4,7 +4,7 @@ simulated motion, their projection onto the drawing plane, and the SVG animation
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -43,6 +43,9 @@ class Motion:
     com: dict[str, np.ndarray]
     parent: dict[str, str]
     mass: dict[str, float]
+    #: per closing joint (a closed system's): body A's origin, its point, body B's origin,
+    #: its point, each (N, 3); the segments that draw the loops closed
+    closing: dict[str, tuple[np.ndarray, ...]] = field(default_factory=dict)
 
 
 def motion_of(model: ModelFile, res: Any, parameters: Mapping[str, float]) -> Motion:
@@ -58,7 +61,28 @@ def motion_of(model: ModelFile, res: Any, parameters: Mapping[str, float]) -> Mo
             mass[b.name] = float(b.mass.subs(subs))
         except (RuntimeError, TypeError, ValueError):
             mass[b.name] = 1.0
-    return Motion(res.t, origin, com, {b.name: b.parent for b in system.bodies}, mass)
+    closing: dict[str, tuple[np.ndarray, ...]] = {}
+    if system.closing:  # the closing joints' points, from the tree's poses at the same y
+        from ..viewer.poses import body_poses, closing_points
+
+        r, S = body_poses(res, np.asarray(res.t, float))
+        zero = np.zeros((len(res.t), 3))
+        for c in system.closing:
+            pts = closing_points(system, r, S, values).get(c.name)
+            if pts is not None:
+                closing[c.name] = (zero if c.body_a == "world" else origin[c.body_a], pts[0],
+                                   zero if c.body_b == "world" else origin[c.body_b], pts[1])
+    return Motion(res.t, origin, com, {b.name: b.parent for b in system.bodies}, mass,
+                  closing)
+
+
+def closing_segments(m: Motion, k: int) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The segments of the closing joints at sample ``k``: each body's origin to its point
+    and the two points joined (of zero length where the loop is closed)."""
+    segs = []
+    for oa, pa, ob, pb in m.closing.values():
+        segs += [(oa[k], pa[k]), (ob[k], pb[k]), (pa[k], pb[k])]
+    return segs
 
 
 def segments(m: Motion, k: int) -> list[tuple[np.ndarray, np.ndarray]]:
@@ -73,7 +97,8 @@ def segments(m: Motion, k: int) -> list[tuple[np.ndarray, np.ndarray]]:
 
 def frame_geometry(m: Motion, view: str | None) -> tuple[Callable[[np.ndarray], np.ndarray],
                                                            np.ndarray, np.ndarray]:
-    allp = [np.zeros((len(m.t), 3))] + list(m.origin.values()) + list(m.com.values())
+    allp = ([np.zeros((len(m.t), 3))] + list(m.origin.values()) + list(m.com.values())
+            + [p for c in m.closing.values() for p in (c[1], c[3])])
     pts = np.stack(allp, axis=1)  # (N, n, 3)
     proj, _ = projection(view, pts)
     flat = proj(pts).reshape(-1, 2)
@@ -107,14 +132,15 @@ def animation(m: Motion, view: str | None, frames: int = 120, size: int = 360) -
     parts = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{size}" height="{size}" '
              f'viewBox="0 0 {size} {size}" class="animation">',
              f'<rect width="{size}" height="{size}" fill="#fafafa" stroke="#ccc"/>']
-    nseg = len(segments(m, 0))
-    per_frame = [segments(m, int(k)) for k in idx]
-    for s in range(nseg):
+    ntree = len(segments(m, 0))
+    per_frame = [segments(m, int(k)) + closing_segments(m, int(k)) for k in idx]
+    for s in range(len(per_frame[0])):
         a = [xy(f[s][0]) for f in per_frame]
         b = [xy(f[s][1]) for f in per_frame]
+        color = "#444" if s < ntree else "#d62728"  # the closing joints' segments in red
         parts.append(
             f'<line x1="{a[0][0]:.2f}" y1="{a[0][1]:.2f}" x2="{b[0][0]:.2f}" y2="{b[0][1]:.2f}" '
-            f'stroke="#444" stroke-width="3" stroke-linecap="round">'
+            f'stroke="{color}" stroke-width="3" stroke-linecap="round">'
             + anim("x1", [p[0] for p in a]) + anim("y1", [p[1] for p in a])
             + anim("x2", [p[0] for p in b]) + anim("y2", [p[1] for p in b]) + "</line>")
     mmax = max(max(m.mass.values(), default=1.0), 1e-12)

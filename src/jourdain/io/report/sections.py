@@ -14,6 +14,7 @@ import symengine as se
 from ...errors import JourdainError
 from ...units import force_unit, model_units, torque_unit
 from ...workflow import eval_document, evaluate_all
+from ...workflow.evaluation import LINEARIZATION_NAMES
 from .. import export
 from ..capabilities import T
 from .html import SYM, esc, html_table, mathml, matrix_table, note, numstr
@@ -44,6 +45,12 @@ def model_section(run: Run) -> str:
     s.append(f"<p>f = {system.f} degrees of freedom, p = {p} bodies, "
              f"{summ['constraints']} constrained directions (reaction forces), "
              f"{len(system.forces)} force elements.</p>")
+    if system.closing:  # a closed system: the tree's coordinates bound by the loops
+        s.append(f"<p>Closed by the closing joint(s) {esc(', '.join(c.name for c in system.closing))}"
+                 f" (section 6): the {system.f} coordinates of the open tree are bound by "
+                 "the loops' constraint equations Φ = 0; independent coordinates: "
+                 f"{esc(', '.join(system.independent))}. The joints below are the tree's; "
+                 "the reaction forces of the closing joints are in sections 3, 5 and 6.</p>")
     s.append("<h3>Coordinates</h3>" + html_table(
         [(sym(c), esc(c), esc(units.get(c, "")), esc(desc.get(c, ""))) for c in
          system.coordinate_names], ["", "name", "unit", "description"], "info"))
@@ -98,9 +105,16 @@ def numbers_section(run: Run) -> str:
     extra: dict[str, Any] = {}
     try:
         values, extra, missing = evaluate_all(model, y0, yd0, 0.0, run.params, u0)
-        for k in ("M", "k", "q"):
-            s.append(f"<h3>{mathml(SYM[k], False)}</h3>"
-                     + matrix_table(values[k], coords, coords if k == "M" else None))
+        if system.closing:  # the closed system's numbers, in its independent coordinates
+            from .loops import numbers_rows
+
+            # the tree's linearization is no closed system's (section 4 has the closed one)
+            missing = {k: v for k, v in missing.items() if k not in LINEARIZATION_NAMES}
+            s += numbers_rows(run, values, extra)
+        else:
+            for k in ("M", "k", "q"):
+                s.append(f"<h3>{mathml(SYM[k], False)}</h3>"
+                         + matrix_table(values[k], coords, coords if k == "M" else None))
         if "g" in values:
             g = np.asarray(values["g"], float).reshape(-1)
             labels = list(extra.get("g_names", [str(i) for i in range(g.size)]))
@@ -118,6 +132,11 @@ def numbers_section(run: Run) -> str:
             s.append(note("not available: " + ", ".join(missing) + " — "
                            + next(iter(missing.values()))))
         vj = eval_document(model, y0, yd0, 0.0, pv, u0, values, extra, missing)
+        if system.closing:  # the closed system's: M, k, q in these coordinates
+            vj["independent"] = list(extra.get("independent", system.independent))
+            vj["dependent"] = list(extra.get("dependent", []))
+            vj["constraint_labels"] = list(extra.get("constraint_labels", []))
+            vj["closure_residual"] = extra.get("closure_residual")
         (out / "values.json").write_text(json.dumps(vj, indent=1), encoding="utf-8")
         info.files.append(out / "values.json")
     except JourdainError as exc:

@@ -36,16 +36,26 @@ def simulation_section(run: Run) -> str:
         try:
             t0 = time.perf_counter()
             try:  # written as the run goes; a failed run keeps the motion up to the failure
-                res = capabilities.simulate(model, run.params, t_end=run.t_end,
-                                            progress=run.progress, output=csv)
+                if system.closing:  # on the manifold; simulation.csv written after it
+                    res = capabilities.simulate(model, run.params, t_end=run.t_end)
+                    res.save(csv)
+                else:
+                    res = capabilities.simulate(model, run.params, t_end=run.t_end,
+                                                progress=run.progress, output=csv)
             except JourdainError as exc:
                 partial = getattr(exc, "results", None)  # the motion up to the failure
                 if partial is None or len(partial.t) < 2:
                     raise
                 res = partial
+                if system.closing:
+                    res.save(csv)
                 info.status, info.message = "failed", f"the simulation failed: {exc}"
             wall = time.perf_counter() - t0
+            run.results = res
             info.files.append(csv)
+            if system.closing and res.status not in ("finished", "interrupted"):
+                # stopped on the manifold (a singular position): the motion up to there
+                info.status, info.message = "failed", f"the simulation stopped: {res.message}"
             if res.interrupted:
                 info.status, info.message = "interrupted", f"the simulation was {res.message}"
             if res.status in ("interrupted", "failed"):
@@ -103,7 +113,9 @@ def simulation_section(run: Run) -> str:
                 s.append("<h3>Animation</h3>" + animation(mo, model.view)
                          + "<p class='meta'>Lines join the body frames along the tree; dots "
                            "are the centres of mass (size by mass); the triangle is the "
-                           "inertial origin.</p>")
+                           "inertial origin."
+                         + (" Red lines join each closing joint's body frames to its points "
+                            "(the loops drawn closed)." if mo.closing else "") + "</p>")
             except (JourdainError, KeyError, AttributeError, ValueError) as exc:
                 s.append(note(f"positions along the motion not available: {exc}"))
             # the 3-D view (jourdain.io.viewer): its own page with three.js, in a sandboxed

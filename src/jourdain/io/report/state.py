@@ -40,7 +40,10 @@ def report_files(model: ModelFile) -> list[str]:
     refuses to overwrite them without ``--force``)."""
     return ["report.html", "run.json", model_copy(model), "equations.tex", "equations.json",
             "values.json", *(f"linearization-{n.name}.json" for n in model.nominal),
-            "simulation.csv", *(f"wrench-{b.joint.name}.csv" for b in model.system.bodies)]
+            "simulation.csv", *(f"wrench-{b.joint.name}.csv" for b in model.system.bodies),
+            *((["loops.json", "linearization-equilibrium.json",
+                *(f"wrench-{c.name}.csv" for c in model.system.closing)])
+              if model.system.closing else [])]
 
 
 
@@ -65,3 +68,6 @@ class Run:
     figures: Figures
     display: Any
     ops: dict[str, int] = field(default_factory=dict)
+    #: the simulation's results (section 5), for the sections after it (a closed system's
+    #: "Closed loops"); None before the simulation or where it failed at once
+    results: Any = None

@@ -109,6 +109,33 @@ def body_poses(results: Results, times: np.ndarray) -> tuple[np.ndarray, np.ndar
     return r, S
 
 
+def closing_points(system: System, r: np.ndarray, S: np.ndarray,
+                   values: Any) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Per closing joint with points (``system.closing``; a general constraint of expressions
+    has none), the inertial positions (n, 3) of its point on body A and on body B, from the
+    body poses ``r`` (n, p, 3) and ``S`` (n, p, 3, 3) of :func:`body_poses` (the tree's at the
+    closed configuration); ``values``: the parameter values by name. On the manifold the two
+    coincide where the joint fixes the points together (revolute, spherical, ...)."""
+    from ...model.expressions import values_at
+
+    index = {b.name: i for i, b in enumerate(system.bodies)}
+    n = r.shape[0]
+    out: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+    for c in getattr(system, "closing", ()):
+        if c.point_a is None or c.point_b is None:
+            continue
+        ends = []
+        for body, point in ((c.body_a, c.point_a), (c.body_b, c.point_b)):
+            p = np.array(values_at(point, values), float)
+            if body == "world":
+                ends.append(np.broadcast_to(p, (n, 3)).copy())
+            else:
+                i = index[body]
+                ends.append(r[:, i] + np.einsum("nij,j->ni", S[:, i], p))
+        out[c.name] = (ends[0], ends[1])
+    return out
+
+
 def _system(results: Results) -> System:
     system = getattr(results, "system", None)
     if system is None:
