@@ -17,6 +17,16 @@ where every coordinate belongs to one joint, else LDLᵀ of M); co-simulation in
 the Dormand–Prince 5(4) pair under error control (tolerance of ``fmi2SetupExperiment``, default
 the DefaultExperiment's). The FMI 2.0 headers come from FMPy (the ``fmu`` extra:
 ``pip install "jourdain[fmu]"``).
+
+A closed system (closing joints, METHOD.md §7) is exported in its independent coordinates:
+the states are ``[y_i; ẏ_i]`` of the partition chosen at the (assembled) initial configuration
+and fixed in the FMU; ``jd_loop.c`` (the generated Φ, Φ_z, Φ_t and convective term, the kernel
+``jourdain/loops/loop_c.h`` and ``closed.c``) solves the dependent coordinates by Newton on
+``Φ = 0``, the dependent rates by the velocity map and ``ÿ_i`` from ``M = J_zᵀ M_tree J_z``
+with the tree's compiled ``M, k, q`` (``jd_fn`` of ``jd_engine.c``); the dependent coordinates,
+their rates and the closure residuals ``Phi.<row>`` are outputs. Where ``Φ_d`` becomes singular
+(its condition number passes ``cond_limit``) or Newton fails the FMU returns fmi2Error with a
+logged message.
 """
 
 from __future__ import annotations
@@ -39,10 +49,18 @@ from ...numeric.integrator_c import tables as rk_tables
 from ...numeric.recursive import recursive_units
 from ...numeric.toolchain import compiler
 from ...version import __version__
-from .binary import FMI_HEADERS, SOURCES, _binary, fmi_header_dir, platform_folder
+from .binary import (
+    CLOSED_SOURCES,
+    FMI_HEADERS,
+    SOURCES,
+    _binary,
+    fmi_header_dir,
+    platform_folder,
+)
 from .description import build_description, layout, model_description
 from .sources import (
     _C_KEYWORDS,
+    _closed_header,
     _finite,
     _model_header,
     _reaction_names,
@@ -70,6 +88,8 @@ class FmuExport:
     variables : the variable names in value-reference order
     reactions : the reaction components given as outputs
     binary : the binary's path inside the FMU, or None for a sources-only FMU
+    states : the number of continuous states (2f; a closed system's f independent coordinates)
+    independent : a closed system's independent coordinates (the states), else ()
     """
 
     path: Path
@@ -78,6 +98,8 @@ class FmuExport:
     variables: tuple[str, ...]
     reactions: tuple[str, ...]
     binary: str | None
+    states: int = 0
+    independent: tuple[str, ...] = ()
 
 
 def _model_of(model: Any) -> tuple[System, Any]:
@@ -86,9 +108,6 @@ def _model_of(model: Any) -> tuple[System, Any]:
     system = getattr(model, "system", None)
     if isinstance(system, System):
         return system, model
-    if type(model).__name__ == "ClosedLoopSystem":
-        raise ModelError("export_fmu: a model with closing joints (kinematic loops) cannot be "
-                         "exported; the FMU export covers tree-structured models only")
     raise ModelError(f"export_fmu: expected a jourdain.System or a model file (load_model), got "
                      f"{type(model).__name__}")
 
@@ -99,7 +118,8 @@ def export_fmu(model: Any, path: str | os.PathLike[str], *,
                yd0: Mapping[str, float] | Sequence[float] | None = None,
                parameters: Mapping[str, float] | None = None,
                model_identifier: str | None = None, stop_time: float | None = None,
-               tolerance: float = DEFAULT_TOLERANCE, binary: bool = True) -> FmuExport:
+               tolerance: float = DEFAULT_TOLERANCE, binary: bool = True,
+               cond_limit: float = 1e6) -> FmuExport:
     """Write ``model`` as an FMI 2.0 FMU (model exchange and co-simulation) to ``path``.
 
     Parameters
@@ -117,6 +137,8 @@ def export_fmu(model: Any, path: str | os.PathLike[str], *,
         else 5); ``tolerance`` is also co-simulation's relative tolerance when the importer
         gives none
     binary : compile the binary for this machine (False: sources only)
+    cond_limit : a closed system's limit on the condition number of Φ_d (the partition is
+        fixed in the FMU; past it the FMU returns fmi2Error), as System.simulate's
 
     Raises
     ------
@@ -127,9 +149,12 @@ def export_fmu(model: Any, path: str | os.PathLike[str], *,
     """
 
     system, mf = _model_of(model)
-    if getattr(mf, "loops", None) is not None:
-        raise ModelError(f"{system.name!r} has closing joints (kinematic loops): the FMU export "
-                         "covers tree-structured models only; its FMU would leave the loops open")
+    closed = bool(getattr(system, "closing", ()))
+    if closed and reactions is not None and (isinstance(reactions, str) or list(reactions)):
+        raise ModelError(f"{system.name!r} has closing joints: the FMU of a closed system gives "
+                         "no reaction outputs yet (export it without reactions)")
+    if not cond_limit > 1:
+        raise EvaluationError(f"cond_limit must be > 1, got {cond_limit!r}")
     if system.f == 0:
         raise ModelError(f"{system.name!r} has no coordinates: an FMU needs continuous states")
     if not (0.0 < float(tolerance) < 1.0):
@@ -148,8 +173,9 @@ def export_fmu(model: Any, path: str | os.PathLike[str], *,
     yd0v = _state(system, yd0, "yd0", "_d")
     # the start values, checked as every evaluation checks them (known names, finite numbers,
     # mass data a rigid body can have)
-    pvals = dict(zip(system.parameter_values,
-                     (float(x) for x in parameter_vector(system, parameters)), strict=True))
+    tree = system.tree if closed else system
+    pvals = dict(zip(tree.parameter_values,
+                     (float(x) for x in parameter_vector(tree, parameters)), strict=True))
     ident = model_identifier or model_identifier_of(system.name)
     if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]{0,63}", ident) or ident in _C_KEYWORDS:
         raise ModelError(f"model_identifier {ident!r} must be a C identifier (letters, digits, "
@@ -159,11 +185,18 @@ def export_fmu(model: Any, path: str | os.PathLike[str], *,
     if binary:
         compiler()  # the missing compiler is named before any work
 
-    joints, chosen = _reaction_names(system, reactions)
+    joints, chosen = ([], []) if closed else _reaction_names(system, reactions)
     units = dict(system.units)
     descriptions = dict(getattr(mf, "descriptions", ()) or ())
-    lay = layout(system.coordinate_names, pvals, system.input_names, chosen, y0v, yd0v,
-                 units, descriptions)
+    closed_h, loop_src, independent = "", "", ()
+    coords = system.coordinate_names
+    extra_out: list[tuple[str, str | None, str]] = []
+    if closed:
+        closed_h, loop_src, coords, y0v, yd0v, extra_out = _closed_parts(
+            system, pvals, y0v, yd0v, float(cond_limit), units, descriptions)
+        independent = tuple(coords)
+    lay = layout(coords, pvals, system.input_names, chosen, y0v, yd0v, units, descriptions,
+                 extra_out)
     names = [v.name for v in lay.variables]
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
@@ -178,22 +211,23 @@ def export_fmu(model: Any, path: str | os.PathLike[str], *,
             cnames = argument_names(system.y, system.yd, system.t, system.parameter_symbols,
                                     system.inputs)
             extra = function_source("jd_dirs", dir_exprs, cnames)
-        local, engine = recursive_units(system, full=False, extra_source=extra)
+        local, engine = recursive_units(tree, full=False, extra_source=extra)
     except JourdainError as exc:  # e.g. a function C has no counterpart for
         raise ModelError(f"{system.name!r} cannot be exported as an FMU: {exc}") from None
     rk = rk_tables()
     glue = (_HERE / "fmi2.c").read_text()
+    order = CLOSED_SOURCES if closed else SOURCES
 
     def describe(guid: str) -> str:
         return model_description(
             lay, model_name=system.name, model_identifier=ident, guid=guid,
             description=" ".join(str(getattr(mf, "description", "") or "").split()),
-            version=__version__, sources=SOURCES, start_time=0.0, stop_time=stop_time,
+            version=__version__, sources=order, start_time=0.0, stop_time=stop_time,
             tolerance=float(tolerance), step_size=None)
 
     # the GUID: a hash of everything that makes the FMU (reproducible, never random)
     h = hashlib.sha256()
-    for part in (describe("{}"), local, engine, glue, rk, tables):
+    for part in (describe("{}"), local, engine, glue, rk, tables, closed_h, loop_src):
         h.update(part.encode())
         h.update(b"\0")
     d = h.hexdigest()
@@ -203,20 +237,71 @@ def export_fmu(model: Any, path: str | os.PathLike[str], *,
         "sources/jd_local.c": local.encode(),
         "sources/jd_engine.c": engine.encode(),
         "sources/fmi2.c": glue.encode(),
-        "sources/model.h": _model_header(lay, guid, float(tolerance), len(system.bodies), tables).encode(),
+        "sources/model.h": _model_header(lay, guid, float(tolerance), len(tree.bodies), tables,
+                                         closed_h).encode(),
         "sources/rk_tables.h": rk.encode(),
-        "sources/buildDescription.xml": build_description(ident, SOURCES).encode(),
+        "sources/buildDescription.xml": build_description(ident, order).encode(),
     }
+    if closed:
+        files["sources/jd_loop.c"] = loop_src.encode()
     for hname in FMI_HEADERS:
         files[f"sources/{hname}"] = (headers / hname).read_bytes()
     binary_name = None
     if binary:
         binary_name = f"binaries/{folder}/{ident}{suffix}"
         files[binary_name] = _binary({k: v for k, v in files.items() if k.startswith("sources/")},
-                                     f"{ident}{suffix}")
+                                     f"{ident}{suffix}", order)
     out = Path(path)
     _write_zip(out, files)
-    return FmuExport(out, ident, guid, tuple(names), tuple(chosen), binary_name)
+    return FmuExport(out, ident, guid, tuple(names), tuple(chosen), binary_name,
+                     2 * len(coords), independent)
+
+
+def _closed_parts(system: System, pvals: Mapping[str, float], y0v: list[float],
+                  yd0v: list[float], cond_limit: float, units: Mapping[str, str],
+                  descriptions: Mapping[str, str]) -> tuple:
+    """A closed system's model.h part, the source of jd_loop.c, the independent coordinates
+    with their (assembled) start values and the further outputs: the initial configuration
+    assembled as System.simulate assembles it (the independent coordinates held), and the
+    partition chosen there, which the FMU keeps."""
+    from importlib import resources
+
+    from ...loops import LoopEvaluator, constraints
+    from ...numeric.ccode import HEADER
+
+    tree = system.tree
+    try:
+        ev = LoopEvaluator(system, y0v, 0.0, dict(pvals), None)
+        asm = ev.assemble(y0v, yd0v, 0.0)
+        con = constraints(system)
+        names = argument_names(tree.y, tree.yd, tree.t, tree.parameter_symbols, tree.inputs)
+        src = (HEADER + function_source("jd_con", [*con.Phi.entries(), *con.Phi_y.entries(),
+                                                   *con.Phi_t.entries()], names)
+               + function_source("jd_gam", con.c.entries(), names))
+    except JourdainError as exc:
+        raise ModelError(f"{system.name!r} cannot be exported as an FMU: {exc}") from None
+    kernel = (resources.files("jourdain.loops") / "loop_c.h").read_text()
+    loop_src = (src + kernel + "\n/* ---- the FMU's adapter (jourdain/io/fmu/closed.c) ---- */\n"
+                + (_HERE / "closed.c").read_text())
+    part = ev.part
+    all_names = tree.coordinate_names
+    ind, dep = list(part.independent), list(part.dependent)
+    head = _closed_header(tree.f, len(con.labels), ind, dep, part.rows,
+                          [float(v) for v in asm.z], ev.newton_tol, ev.max_newton, cond_limit)
+    coords = [all_names[i] for i in ind]
+    out: list[tuple[str, str | None, str]] = []
+    for i in dep:
+        c = all_names[i]
+        text = descriptions.get(c, f"coordinate {c}")
+        out.append((c, units.get(c), f"{text} (dependent: solved from the closure)"))
+    for i in dep:
+        c = all_names[i]
+        u = units.get(c)
+        out.append((f"{c}_d", f"{u}/s" if u else None, f"rate of {c} (dependent)"))
+    for label in con.labels:
+        out.append((f"Phi.{label}", None, f"closure residual: the constraint row {label}"))
+    return (head, loop_src, coords, [float(asm.z[i]) for i in ind],
+            [float(asm.zd[i]) for i in ind], out)
 
 
 def _write_zip(out: Path, files: Mapping[str, bytes]) -> None:

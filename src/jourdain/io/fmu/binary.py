@@ -31,6 +31,8 @@ if TYPE_CHECKING:
 FMI_HEADERS = ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h")
 #: the compiled sources, in the order of buildDescription.xml
 SOURCES = ("jd_local.c", "jd_engine.c", "fmi2.c")
+#: those of a closed system: the loop kernel (closed.c) besides
+CLOSED_SOURCES = ("jd_local.c", "jd_engine.c", "jd_loop.c", "fmi2.c")
 #: flags of the FMU's binary: only the fmi2 functions are exported (FMI2_Export)
 CFLAGS = ("-O2", "-fPIC", "-std=c99", "-fno-math-errno", "-fvisibility=hidden")
 
@@ -63,7 +65,8 @@ def platform_folder() -> tuple[str, str]:
                         "binary=False (jourdain fmu --sources-only) for an FMU of sources only")
 
 
-def _binary(sources: Mapping[str, bytes], name: str) -> bytes:
+def _binary(sources: Mapping[str, bytes], name: str,
+            order: tuple[str, ...] = SOURCES) -> bytes:
     """The compiled binary of the FMU's sources: from jourdain's cache of compiled code
     (:func:`jourdain.numeric.cache_dir`, keyed by the sources, the compiler and its flags) when
     it was built before, else compiled there by :func:`jourdain.numeric.toolchain.compile_shared`
@@ -76,7 +79,7 @@ def _binary(sources: Mapping[str, bytes], name: str) -> bytes:
     cache = library_dir() / f"{key}{Path(name).suffix}"
     if not (cache.is_file() and not_private(cache) is None):
         try:
-            compile_shared({k.split("/", 1)[1]: v for k, v in sources.items()}, SOURCES, cache,
+            compile_shared({k.split("/", 1)[1]: v for k, v in sources.items()}, order, cache,
                            CFLAGS)
         except CompilerError as exc:
             raise CompilerError(f"the FMU's binary: {exc}") from None

@@ -13,7 +13,12 @@ f+1 … 2f              rates ``<y>_d``               output, continuous, exact 
 then                  parameters                    parameter, tunable, exact
 then                  inputs                        input, continuous (start 0)
 then                  reaction components g         output, continuous, calculated
+then                  a closed system's outputs     output, continuous, calculated
 ====================  ============================  =========================================
+
+A closed system (closing joints) has its independent coordinates as ``y`` (f of the tree's n);
+its outputs after the reactions are the dependent coordinates, their rates ``<d>_d`` and the
+closure residuals ``Phi.<row>`` (one per constraint row of the closing joints).
 """
 
 from __future__ import annotations
@@ -52,6 +57,8 @@ class Layout:
     n_p: int
     n_u: int
     reactions: tuple[str, ...]
+    #: a closed system's outputs after the reactions (dependent coordinates, rates, Φ)
+    n_out: int = 0
 
     def index(self, name: str) -> int:
         """1-based index of a variable in ModelVariables."""
@@ -73,9 +80,11 @@ def reaction_unit(name: str) -> str | None:
 
 def layout(coordinates: Sequence[str], parameters: Mapping[str, float], inputs: Sequence[str],
            reactions: Sequence[str], y0: Sequence[float], yd0: Sequence[float],
-           units: Mapping[str, str], descriptions: Mapping[str, str]) -> Layout:
+           units: Mapping[str, str], descriptions: Mapping[str, str],
+           outputs: Sequence[tuple[str, str | None, str]] = ()) -> Layout:
     """The variables of the FMU in value-reference order (see the module docstring).
 
+    ``outputs``: (name, unit, description) of further outputs (a closed system's).
     Reaction components get N and N·m where the model's units are coherent SI ones (every
     coordinate in m or rad and every parameter unit of factor 1), since jourdain does not
     convert units and the forces come out in the units the model's numbers imply.
@@ -112,7 +121,9 @@ def layout(coordinates: Sequence[str], parameters: Mapping[str, float], inputs: 
         vs.append(Variable(g, "output", "continuous", "calculated", None,
                            reaction_unit(g) if si else None,
                            f"reaction component {g} (child frame at the joint point)"))
-    return Layout(tuple(vs), f, len(parameters), len(inputs), tuple(reactions))
+    for name, unit, text in outputs:
+        vs.append(Variable(name, "output", "continuous", "calculated", None, unit, text))
+    return Layout(tuple(vs), f, len(parameters), len(inputs), tuple(reactions), len(outputs))
 
 
 def _g(x: float) -> str:

@@ -13,7 +13,13 @@
    A reaction component g of a joint with constrained directions E (6×n) solves
    EᵀE·g = Eᵀ·W, W the wrench the joint transmits (for orthonormal directions g = Eᵀ·W).
    Co-simulation integrates with the Dormand–Prince 5(4) pair (rk_tables.h) under error control,
-   the inputs held, or extrapolated linearly where their derivatives are set. */
+   the inputs held, or extrapolated linearly where their derivatives are set.
+
+   A closed system (model.h defines JD_CLOSED; closed.c): the states are the independent
+   coordinates y and their rates in the partition fixed at export, ÿ comes from
+   jd_closed_dynamics (Newton on Φ = 0 for the dependent coordinates, the velocity map, M, k, q
+   in y), and the dependent coordinates, their rates and Φ are outputs (JD_NOUT of them after
+   the reactions). A singular Φ_d or a failed Newton solve is fmi2Error with a logged message. */
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -39,7 +45,12 @@
 #define JD_VR_P (JD_VR_YDD + JD_NY)
 #define JD_VR_U (JD_VR_P + JD_NP)
 #define JD_VR_G (JD_VR_U + JD_NU)
-#define JD_NVR (JD_VR_G + JD_NG)
+#define JD_VR_OUT (JD_VR_G + JD_NG)  /* a closed system's outputs (closed.c) */
+#define JD_NVR (JD_VR_OUT + JD_NOUT)
+#define JD_NOUT1 (JD_NOUT > 0 ? JD_NOUT : 1)
+#ifdef JD_CLOSED
+#define JD_NDEP1 (JD_NDEP > 0 ? JD_NDEP : 1)
+#endif
 
 /* the states of the FMI 2.0 state machines, as bits */
 enum { JD_INSTANTIATED = 1, JD_INIT = 2, JD_EVENT = 4, JD_CONT = 8, JD_STEP = 16,
@@ -50,7 +61,10 @@ enum { JD_INSTANTIATED = 1, JD_INIT = 2, JD_EVENT = 4, JD_CONT = 8, JD_STEP = 16
 typedef struct {
     double time, start_time, tolerance, h_next, du_time;
     double x[JD_NX], p[JD_NP1], u[JD_NU1], du[JD_NU1];
-    double ydd[JD_NY], g[JD_NG1];
+    double ydd[JD_NY], g[JD_NG1], out[JD_NOUT1];
+#ifdef JD_CLOSED
+    double z[JD_NZ], y_last[JD_NY], info[8];  /* the loop kernel's state (closed.c) */
+#endif
     int mode, valid;
 } jd_data;
 
@@ -60,6 +74,10 @@ typedef struct {
     int logging;
     char *name;
     fmi2CallbackFunctions cb;
+#ifdef JD_CLOSED
+    double *work;           /* the loop kernel's work array (jd_closed_work doubles) */
+    long piv[JD_NDEP1];
+#endif
 } jd_instance;
 
 #define JD_STATE_MAGIC 0x6a644d55u /* "jdMU" */
@@ -101,12 +119,36 @@ static void jd_defaults(jd_data *d) {
 #endif
     d->tolerance = JD_DEFAULT_TOLERANCE;
     d->mode = JD_INSTANTIATED;
+#ifdef JD_CLOSED
+    memcpy(d->z, jd_z_start, sizeof(double) * JD_NZ);
+#endif
+}
+
+/* ÿ (and the joint wrenches W of a tree, the outputs of a closed system) at a state */
+static int jd_eval(jd_instance *c, const double *y, const double *yd, double t, const double *u,
+                   double *ydd, double *W) {
+#ifdef JD_CLOSED
+    (void)W;
+    return jd_closed_dynamics(c->d.z, c->d.y_last, c->d.info, c->work, c->piv, y, yd, t,
+                              c->d.p, u, ydd, c->d.out);
+#else
+    return jd_dynamics(y, yd, t, c->d.p, u, ydd, W);
+#endif
 }
 
 static const char *jd_status_text(int status) {
     if (status == 1) return "the mass matrix M is not positive definite";
     if (status == 2) return "the accelerations are not finite (NaN or inf in the model's terms)";
     if (status == 3) return "the reaction equations of a joint are singular";
+    if (status == 11) return "Newton found no configuration of the dependent coordinates on "
+                             "the closure Phi = 0 (Phi_d singular, or divergence)";
+    if (status == 12) return "Phi_d is singular here: its condition number passed the limit "
+                             "of the partition fixed at export (a singular position of the "
+                             "mechanism, or one the independent coordinates cannot describe)";
+    if (status == 13) return "M in the independent coordinates is not positive definite";
+    if (status == 14) return "Newton's solution of the dependent coordinates left the branch "
+                             "of the motion (a correction far beyond the first-order "
+                             "prediction: near a singular position, or a step too large)";
     return "the model could not be evaluated";
 }
 
@@ -166,10 +208,19 @@ static int jd_update(jd_instance *c) {
     double W[6 * JD_NB1];
     int status;
     if (c->d.valid) return 0;
-    status = jd_dynamics(c->d.x, c->d.x + JD_NY, c->d.time, c->d.p, c->d.u, c->d.ydd, W);
+    status = jd_eval(c, c->d.x, c->d.x + JD_NY, c->d.time, c->d.u, c->d.ydd, W);
     if (status == 0)
         status = jd_reactions(c->d.x, c->d.x + JD_NY, c->d.time, c->d.p, c->d.u, W, c->d.g);
     if (status) {
+#ifdef JD_CLOSED
+        if (status > 10) {
+            jd_log(c, fmi2Error, "logStatusError", "at t = %.17g: %s (condition number of "
+                   "Phi_d %.3g, limit %.3g; |Phi| %.3g after %.0f Newton steps)", c->d.time,
+                   jd_status_text(status), c->d.info[0], (double)JD_COND_LIMIT, c->d.info[3],
+                   c->d.info[1]);
+            return status;
+        }
+#endif
         jd_log(c, fmi2Error, "logStatusError", "at t = %.17g: %s", c->d.time,
                jd_status_text(status));
         return status;
@@ -231,6 +282,14 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
         return NULL;
     }
     strcpy(c->name, instanceName);
+#ifdef JD_CLOSED
+    c->work = (double *)functions->allocateMemory((size_t)jd_closed_work(), sizeof(double));
+    if (!c->work) {
+        functions->freeMemory(c->name);
+        functions->freeMemory(c);
+        return NULL;
+    }
+#endif
     c->cb = *functions;
     c->type = fmuType;
     c->logging = loggingOn ? 1 : 0;
@@ -243,6 +302,9 @@ void fmi2FreeInstance(fmi2Component c_) {
     fmi2CallbackFreeMemory free_memory;
     if (!c) return;
     free_memory = c->cb.freeMemory;
+#ifdef JD_CLOSED
+    free_memory(c->work);
+#endif
     free_memory(c->name);
     free_memory(c);
 }
@@ -308,6 +370,9 @@ fmi2Status fmi2GetReal(fmi2Component c_, const fmi2ValueReference vr[], size_t n
         if (r >= JD_VR_YDD && r < JD_VR_P) {
             if (jd_update(c)) return fmi2Error;
             value[i] = c->d.ydd[r - JD_VR_YDD];
+        } else if (r >= JD_VR_OUT) {
+            if (jd_update(c)) return fmi2Error;
+            value[i] = c->d.out[r - JD_VR_OUT];
         } else if (r >= JD_VR_G) {
             if (jd_update(c)) return fmi2Error;
             value[i] = c->d.g[r - JD_VR_G];
@@ -417,6 +482,9 @@ fmi2Status fmi2SetFMUstate(fmi2Component c_, fmi2FMUstate state) {
     if (jd_refuse(c, JD_ANY, "fmi2SetFMUstate")) return fmi2Error;
     if (!state) return jd_fail(c, "fmi2SetFMUstate", "NULL state");
     c->d = *(const jd_data *)state;
+#ifdef JD_CLOSED
+    c->d.info[4] = 0.0;  /* the kernel's prediction (J_z in its work array) is not saved */
+#endif
     return fmi2OK;
 }
 
@@ -612,11 +680,11 @@ fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c_, const fmi2ValueReferen
 }
 
 /* ẋ = [ẏ; ÿ] with the inputs u0 + du·(t − t0) */
-static int jd_rhs(const jd_instance *c, double t, const double *x, double t0, double *dx) {
+static int jd_rhs(jd_instance *c, double t, const double *x, double t0, double *dx) {
     double u[JD_NU1] = {0.0}, W[6 * JD_NB1];
     for (int i = 0; i < JD_NU; ++i) u[i] = c->d.u[i] + c->d.du[i] * (t - t0);
     memcpy(dx, x + JD_NY, sizeof(double) * JD_NY);
-    return jd_dynamics(x, x + JD_NY, t, c->d.p, u, dx + JD_NY, W);
+    return jd_eval(c, x, x + JD_NY, t, u, dx + JD_NY, W);
 }
 
 /* from t0 to t1 by Dormand–Prince 5(4) steps under error control: the weighted RMS of the

@@ -122,7 +122,25 @@ def _array(ctype: str, name: str, values: Sequence[Any]) -> str:
     return f"static const {ctype} {name}[{max(len(values), 1)}] = {{{body or '0'}}};\n"
 
 
-def _model_header(lay: Layout, guid: str, tolerance: float, n_bodies: int, tables: str) -> str:
+def _closed_header(n: int, m: int, independent: Sequence[int], dependent: Sequence[int],
+                   rows: Sequence[int], z_start: Sequence[float], newton_tol: float,
+                   max_newton: int, cond_limit: float) -> str:
+    """model.h's part for a closed system: the partition fixed at export, Newton's start
+    (the assembled configuration) and the kernel's settings (closed.c)."""
+    return (f"#define JD_CLOSED 1\n#define JD_NZ {n}\n#define JD_NDEP {len(dependent)}\n"
+            f"#define JD_NPHI {m}\n#define JD_NEWTON_TOL {float(newton_tol)!r}\n"
+            f"#define JD_MAX_NEWTON {int(max_newton)}\n#define JD_COND_LIMIT {float(cond_limit)!r}\n"
+            + _array("long", "jd_ind", independent) + _array("long", "jd_dep", dependent)
+            + _array("long", "jd_rows", rows) + _array("double", "jd_z_start", z_start)
+            + "long jd_closed_work(void);\n"
+              "int jd_closed_dynamics(double *z, double *y_last, double *info, double *work,\n"
+              "                       long *piv, const double *y, const double *yd, double t,\n"
+              "                       const double *p, const double *u, double *ydd,\n"
+              "                       double *out);\n")
+
+
+def _model_header(lay: Layout, guid: str, tolerance: float, n_bodies: int, tables: str,
+                  closed: str = "") -> str:
     vs = lay.variables
     f = lay.f
     x_start = [v.start for v in vs[1:1 + 2 * f]]
@@ -133,12 +151,13 @@ def _model_header(lay: Layout, guid: str, tolerance: float, n_bodies: int, table
             f'#define JD_GUID "{guid}"\n'
             f"#define JD_NY {f}\n#define JD_NP {lay.n_p}\n#define JD_NU {lay.n_u}\n"
             f"#define JD_NG {len(lay.reactions)}\n#define JD_NB {n_bodies}\n"
+            f"#define JD_NOUT {lay.n_out}\n"
             f"#define JD_DEFAULT_TOLERANCE {tolerance!r}\n"
             + _array("double", "jd_x_start", x_start)
             + _array("double", "jd_p_start", p_start)
             + _array("double", "jd_u_start", u_start)
             + "int jd_dynamics(const double *y, const double *yd, double t, const double *p,\n"
               "                const double *u, double *ydd, double *wrench);\n"
-            + tables + "#endif\n")
+            + tables + closed + "#endif\n")
 
 
