@@ -118,16 +118,6 @@ def load(path: str) -> Any:
     return load_model(path)
 
 
-def tree_only(model: Any, command: str) -> None:
-    """Refuse a command that would treat a loop model as its open tree."""
-    if model.system.closing:
-        names = ", ".join(c.name for c in model.system.closing)
-        raise ModelError(f"{model.path}: the model closes kinematic loops (closing joints "
-                         f"{names}); jourdain {command} works on trees and would ignore them: "
-                         "use jourdain check and jourdain run, or jourdain.loops in Python "
-                         "(evaluate, simulate_loop, linearize_loop)")
-
-
 def suggest(name: str, names: Sequence[str]) -> str:
     close = difflib.get_close_matches(name, list(names), n=1)
     return f' (did you mean "{close[0]}"?)' if close else ""

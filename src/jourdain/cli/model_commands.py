@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import json
+from typing import Any
 
 from ..analysis.reactions import check_reactions
 from ..errors import JourdainError
@@ -71,31 +72,82 @@ _TITLES = {
     "q_c": "q̄^c (Coriolis, centrifugal and gyroscopic forces, 6p)",
     "q_e": "q̄^e (applied forces and torques, 6p)", "M": "M (mass matrix, f×f)",
     "k": "k (generalized gyroscopic forces, f)", "q": "q (generalized applied forces, f)",
+    "Q_bar_c": "Q̄_c (the closing rows' constrained directions, 6p×r; J̄ᵀ·Q̄_c = Φ_yᵀ)",
+    "Phi": "Φ (constraint rows of the closing joints, r)",
+    "Phi_y": "Φ_y (their Jacobian ∂Φ/∂y, r×f)",
+    "M_tree": "M_tree (the open tree's mass matrix, f×f)",
+    "k_tree": "k_tree (the open tree's generalized gyroscopic forces, f)",
+    "q_tree": "q_tree (the open tree's generalized applied forces, f)",
 }
+_LATEX = {"M_bar": r"\bar{M}", "J_bar": r"\bar{J}", "q_c": r"\bar{q}^{c}",
+          "q_e": r"\bar{q}^{e}", "M": "M", "k": "k", "q": "q", "Q_bar_c": r"\bar{Q}_{c}",
+          "Phi": r"\Phi", "Phi_y": r"\Phi_{y}", "M_tree": r"M_{\mathrm{tree}}",
+          "k_tree": r"k_{\mathrm{tree}}", "q_tree": r"q_{\mathrm{tree}}"}
+
+
+def closed_lines(system: Any) -> list[str]:
+    """What the symbolic matrices of a closed system mean and how its equations of motion in
+    the independent coordinates follow from them (in numbers: ``jourdain eval``)."""
+    names = ", ".join(c.name for c in system.closing)
+    ind = closure_independent(system)
+    return [
+        f"{system.name}: closed by the closing joint(s) {names}; the open tree's Newton–Euler "
+        "equations M̄·J̄·ÿ + q̄^c = q̄^e + Q̄·g (Q̄ = [Q̄_tree, Q̄_c]: the tree joints' and the "
+        "closing rows' constrained directions)",
+        "  constraints Φ(y, t) = 0 with Φ_y; projected with J̄ of the tree: "
+        "M_tree·ÿ + k_tree = q_tree + Φ_yᵀ·λ (λ: the multipliers, the closing rows' reactions)",
+        f"  equations of motion in the independent coordinates {', '.join(ind)}: M·ÿ_i + k = q "
+        "with ẏ = L·ẏ_i + l, ÿ = L·ÿ_i + γ, L = [E; −Φ_d⁻¹Φ_i], M = Lᵀ·M_tree·L, "
+        "k = Lᵀ·(k_tree + M_tree·γ), q = Lᵀ·q_tree",
+        "  M, k, q exist in numbers only (the dependent coordinates are implicit functions of "
+        "the independent ones): jourdain eval gives them, with L, l, γ, λ and the reactions",
+    ]
+
+
+def closure_independent(system: Any) -> list[str]:
+    """The independent coordinates of a closed system at its initial configuration."""
+    try:
+        return list(system.independent)
+    except JourdainError:
+        return []
 
 
 def cmd_eom(args: argparse.Namespace) -> int:
     model = load(args.model)
     system = model.system
     mats = eom_matrices(system)
+    closed = bool(system.closing)
+    # the expressions are in the tree's coordinates, rates and parameters
+    symbols = system.tree if closed else system
+    title = "Newton–Euler equations and equations of motion"
+    if closed:
+        title = "Newton–Euler equations of the tree, constraints and projected equations"
     if args.format == "json":
         data = {"format": "jourdain-eom/1", "model": system.name,
                 "coordinates": system.coordinate_names,
                 "rates": [f"{c}_d" for c in system.coordinate_names],
                 "parameters": system.parameter_values, "inputs": system.input_names}
-        data.update(export.matrices_json(mats, system))
+        if closed:
+            con = system.constraints()
+            data.update({"closing_joints": [c.name for c in system.closing],
+                         "independent": closure_independent(system),
+                         "constraint_labels": con.labels,
+                         "equations": closed_lines(system)})
+        data.update(export.matrices_json(mats, symbols))
         print(json.dumps(data, indent=1))
         return EXIT_OK
     if args.format == "latex":
-        names = {"M_bar": r"\bar{M}", "J_bar": r"\bar{J}", "q_c": r"\bar{q}^{c}",
-                 "q_e": r"\bar{q}^{e}", "M": "M", "k": "k", "q": "q"}
-        print(export.latex_fragment(
-            mats, names, system, f"{system.name}: Newton-Euler equations and equations of motion",
-            args.max_ops), end="")
+        text = export.latex_fragment(mats, _LATEX, symbols,
+                                     f"{system.name}: {title}".replace("–", "-"), args.max_ops)
+        if closed:
+            text = "".join(f"% {line}\n" for line in closed_lines(system)) + text
+        print(text, end="")
         return EXIT_OK
-    print(f"{system.name}: M̄·J̄·ÿ + q̄^c = q̄^e + Q̄·g  →  M·ÿ + k = q")
+    if closed:
+        print("\n".join(closed_lines(system)))
+    else:
+        print(f"{system.name}: M̄·J̄·ÿ + q̄^c = q̄^e + Q̄·g  →  M·ÿ + k = q")
     for k, m in mats.items():
         print(f"\n{_TITLES[k]} =")
-        print(export.matrix_text(m, system, args.max_ops))
+        print(export.matrix_text(m, symbols, args.max_ops))
     return EXIT_OK
-

@@ -21,14 +21,13 @@ from ..workflow import (
     reactions_at,
     require,
 )
-from .arguments import UsageError, load, overrides, period, state_at, suggest, tree_only
+from .arguments import UsageError, load, overrides, period, state_at, suggest
 
 EXIT_OK = 0
 
 
 def cmd_eval(args: argparse.Namespace) -> int:
     model = load(args.model)
-    tree_only(model, "eval")
     system = model.system
     params = overrides(system, args.set)
     y, yd, t, inputs = state_at(model, args.at)
@@ -39,7 +38,16 @@ def cmd_eval(args: argparse.Namespace) -> int:
         out = eval_document(model, y, yd, t, pv, inputs, values, extra, missing)
         print(json.dumps(out, indent=1))
         return EXIT_OK
+    if system.closing:  # the numbers are at the state assembled onto Φ = 0, Φ̇ = 0
+        y, yd = values["y"], values["yd"]
     print(f"{system.name} at {state_text(system, y, yd, t, inputs)}")
+    if system.closing:
+        res = extra["closure_residual"]
+        print(f"  closed by {', '.join(c.name for c in system.closing)}: M, k, q, J_bar in the "
+              f"independent coordinates {', '.join(extra['independent'])} (ẏ = L·ẏ_i + l); "
+              f"the state assembled onto the constraints, |Φ| = {res['Phi']:.3g}, "
+              f"|Φ̇| = {res['Phi_dot']:.3g}; constraint rows (λ, Phi): "
+              + ", ".join(extra["constraint_labels"]))
     if params:
         print("  parameters set: " + ", ".join(f"{k}={v:g}" for k, v in params.items()))
     print(f"  (round-off, below {ROUNDOFF_RTOL:g} of the largest entry of a matrix or vector, "
@@ -51,6 +59,13 @@ def cmd_eval(args: argparse.Namespace) -> int:
         print("\ng components: " + ", ".join(extra["g_names"]))
     if extra.get("joint_wrenches"):
         print(wrench_text(system, extra["joint_wrenches"]))
+    if extra.get("closing_wrenches"):
+        force, torque = reaction_units(system)
+        print(f"\nclosing joints' wrenches (force [{force}], torque [{torque}]; of body_b on "
+              "body_a at its joint point, in body_a's frame):")
+        for name, w in extra["closing_wrenches"].items():
+            print(f"  {name:<24} F = " + np.array2string(np.asarray(w["F"]), precision=6)
+                  + "  T = " + np.array2string(np.asarray(w["T"]), precision=6))
     if missing:
         print("\nnot available yet: " + ", ".join(missing))
     return EXIT_OK
@@ -77,7 +92,6 @@ def wrench_text(system: Any, wrenches: dict[str, Any]) -> str:
 
 def cmd_reactions(args: argparse.Namespace) -> int:
     model = load(args.model)
-    tree_only(model, "reactions")
     system = model.system
     params = overrides(system, args.set)
     y, yd, t, inputs = state_at(model, args.at)
@@ -152,11 +166,6 @@ def display_scales(values: dict[str, np.ndarray]) -> dict[str, Any]:
 
 def cmd_linearize(args: argparse.Namespace) -> int:
     model = load(args.model)
-    if model.system.closing:  # LOOPS-LINEARIZE (H2): independent coordinates
-        from ..loops.cli import linearize_command  # SciPy's linear algebra: loop models only
-
-        return linearize_command(model, overrides(model.system, args.set), args.json, args.about)
-    tree_only(model, "linearize")
     system = model.system
     require(system, "linearize", "the linearization")
 

@@ -64,8 +64,14 @@ def linearization_at(model: ModelFile, y: Any, yd: Any, t: float,
                      parameters: Mapping[str, float], inputs: Mapping[str, float]
                      ) -> dict[str, np.ndarray]:
     """``M_tilde, P, Q, h`` about the state (y, ẏ) at time t (nominal ÿ_s = 0), and ``D, G, K,
-    N``, the symmetric and skew parts of P and Q at that instant."""
+    N``, the symmetric and skew parts of P and Q at that instant. A closed system's in its
+    independent coordinates (:func:`jourdain.loops.linearization.linearize_loop` about the
+    state assembled from (y, ẏ), ÿ_s = 0)."""
     system = model.system
+    if system.closing:
+        from ..loops.cli import closed_linearization_at  # SciPy's linear algebra: loops only
+
+        return closed_linearization_at(system, y, yd, t, parameters, inputs)
     with warnings.catch_warnings():
         # any state, not a claimed equilibrium: h = M·ÿ there is expected
         warnings.simplefilter("ignore", NominalMotionWarning)
@@ -103,6 +109,10 @@ def linear_analysis(model: ModelFile, about: str | None,
     ``nominal_check`` and the stability verdict, which the text and the report show.
     """
     system = model.system
+    if system.closing:  # in the independent coordinates (jourdain.loops.cli)
+        from ..loops.cli import closed_linear_analysis
+
+        return closed_linear_analysis(model, about, parameters, t, period)
     nominal = model.nominal_motion(about)
     params = dict(parameters or {}) or None
     with warnings.catch_warnings():
@@ -187,6 +197,10 @@ def _constant_in_time(lin: Any, params: Mapping[str, float] | None,
 
 def jsonable(res: Mapping[str, Any]) -> dict[str, Any]:
     """The result of :func:`linear_analysis` as JSON-ready data."""
+    if res.get("closed"):
+        from ..loops.cli import closed_jsonable
+
+        return closed_jsonable(res)
     out: dict[str, Any] = {
         "nominal": res["nominal"].name,
         "nominal_y": [str(e) for e in res["nominal"].y],
@@ -234,6 +248,10 @@ def _finite_list(a: Any) -> list[float | None]:
 
 def linear_text(res: Mapping[str, Any]) -> str:
     """A plain-text account of :func:`linear_analysis`."""
+    if res.get("closed"):
+        from ..loops.cli import closed_linear_text
+
+        return closed_linear_text(res)
     lin = res["linearization"]
     num = res["numbers"]
     nominal = res["nominal"]
@@ -290,7 +308,9 @@ def simulate(model: ModelFile, parameters: Mapping[str, float] | None = None,
     those of :mod:`jourdain.simulation.simulate`; ``y0``, ``yd0`` (by coordinate name) and ``inputs`` (by
     input name: a number or an expression in t and the parameters) replace the model's values
     they name. ``progress`` and ``output`` (a results file written as the run goes) are passed
-    to :func:`jourdain.simulation.simulate.simulate`. The options are checked against the bounds of
+    to :func:`jourdain.simulation.simulate.simulate`; a closed system's run writes ``output``
+    at its end (:meth:`Results.save`) and takes no ``progress`` (a
+    :class:`~jourdain.errors.ClosedSystemError` where one is given). The options are checked against the bounds of
     :mod:`jourdain.simulation.simulate` before anything is computed (:class:`EvaluationError`).
     """
     system = model.system
@@ -314,13 +334,19 @@ def simulate(model: ModelFile, parameters: Mapping[str, float] | None = None,
             raise EvaluationError(f'inputs: "{name}" is not an input of the model; inputs are '
                                   f"{', '.join(system.input_names) or '(none)'}")
         laws[name] = v
-    return system.simulate((0.0, t1), [y[c] for c in coords], [yd[c] for c in coords],
-                           parameters=dict(parameters or {}) or None,
-                           inputs=laws or None, method=method or sim.method,
-                           rtol=sim.rtol if rtol is None else rtol,
-                           atol=sim.atol if atol is None else atol,
-                           t_eval=np.linspace(0.0, t1, n), progress=progress,
-                           output=None if output is None else str(output))
+    options: dict[str, Any] = {"progress": progress,
+                               "output": None if output is None else str(output)}
+    if system.closing:  # whole at the end; the options a closed run refuses only when asked
+        options = {k: v for k, v in options.items() if k != "output" and v}
+    res = system.simulate((0.0, t1), [y[c] for c in coords], [yd[c] for c in coords],
+                          parameters=dict(parameters or {}) or None,
+                          inputs=laws or None, method=method or sim.method,
+                          rtol=sim.rtol if rtol is None else rtol,
+                          atol=sim.atol if atol is None else atol,
+                          t_eval=np.linspace(0.0, t1, n), **options)
+    if system.closing and output is not None:
+        res.save(output)
+    return res
 
 
 def write_csv(results: Any, system: Any, path: Path) -> Path:

@@ -1,24 +1,25 @@
-"""``jourdain linearize`` on a loop model (the command line dispatches here for models with
-closing joints): the linearization in the independent coordinates about the equilibrium
-nearest the model file's initial configuration (:func:`jourdain.loops.linearization.equilibrium`;
+"""The linearization of a model with closing joints for ``jourdain linearize``, ``jourdain eval``
+and the report (:func:`jourdain.io.capabilities.linear_analysis` and ``linearization_at``
+dispatch here): in the independent coordinates, about a nominal state of the model file or
+the equilibrium nearest its initial configuration (:func:`jourdain.loops.linearization.equilibrium`;
 exact: :func:`~jourdain.loops.linearization.linearize_loop_exact`), or about the initial
 configuration at rest where no equilibrium is found nearby (finite differences).
 """
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 
-from ..errors import JourdainError
+from ..errors import ClosedSystemError, JourdainError
 from ..model import System
 from .linearization import (
     LoopLinearization,
     equilibrium,
+    linearize_closed,
     linearize_loop,
     linearize_loop_exact,
 )
@@ -37,15 +38,6 @@ def linearize_near(loop: System, z0: Any,
     # at an equilibrium the symbolic derivatives apply (the exact linearization)
     return (linearize_loop_exact(loop, z_s, parameters=parameters),
             "equilibrium nearest the initial configuration")
-
-
-def linearize_document(model: Any, parameters: Mapping[str, float] | None = None
-                       ) -> dict[str, Any]:
-    """The linearization of the loop model ``model`` (a model file's, with ``.loops`` and
-    ``.simulation``) as a JSON-able document."""
-    loop: System = model.system
-    lin, about = linearize_near(loop, model.simulation.y0, parameters)
-    return linearization_document(loop, lin, about)
 
 
 def linearization_document(loop: System, lin: LoopLinearization, about: str
@@ -72,37 +64,107 @@ def linearization_document(loop: System, lin: LoopLinearization, about: str
     }
 
 
-def linearize_text(doc: Mapping[str, Any]) -> str:
-    """The document of :func:`linearize_document` as text."""
-    names = doc["independent"]
-    lines = [f"{doc['model']}: linearization in the independent coordinates "
-             f"{', '.join(names)}", f"  about the {doc['about']}:",
-             "  " + ", ".join(f"{k} = {v:.6g}" for k, v in doc["z_s"].items())]
-    for key in ("M_tilde", "D", "G", "K", "N"):
-        rows = np.asarray(doc[key])
-        lines.append(f"  {key} =")
-        lines.extend("    [" + ", ".join(f"{x: .6g}" for x in r) + "]" for r in rows)
-    lines.append("  eigenvalues: " + ", ".join(f"{re:.6g}{im:+.6g}j"
-                                               for re, im in doc["eigenvalues"]))
+def closed_linearization_at(system: System, y: Any, yd: Any, t: float,
+                            parameters: Mapping[str, float], inputs: Mapping[str, float]
+                            ) -> dict[str, np.ndarray]:
+    """``M_tilde, P, Q, h, D, G, K, N`` of the closed ``system`` in its independent coordinates
+    about the state assembled from (y, ẏ) at time t with ÿ_s = 0 (what
+    :func:`jourdain.io.capabilities.linearization_at` gives a tree)."""
+    if any(float(v) != 0.0 for v in dict(inputs).values()):
+        raise ClosedSystemError(system, "the linearization of a closed system about nonzero "
+                                "inputs is not available yet")
+    lin = linearize_loop(system, np.asarray(y, dtype=float), np.asarray(yd, dtype=float),
+                         float(t), None, dict(parameters) or None)
+    return {k: np.asarray(getattr(lin, k), dtype=float)
+            for k in ("M_tilde", "P", "Q", "h", "D", "G", "K", "N")}
+
+
+def closed_linear_analysis(model: Any, about: str | None,
+                           parameters: Mapping[str, float] | None = None, t: float = 0.0,
+                           period: Any = None) -> dict[str, Any]:
+    """:func:`jourdain.io.capabilities.linear_analysis` of a model with closing joints: the
+    linearization in the independent coordinates about the nominal state ``about`` (constant
+    numbers) or, without it, about the equilibrium nearest the initial configuration
+    (:func:`linearize_near`); its numbers, modes and stability verdict (``closed``: True)."""
+    from ..analysis.modes import modes, stability
+
+    system: System = model.system
+    nominal = model.nominal_motion(about) if about is not None else None
+    if period is None and nominal is not None:
+        period = nominal.period
+    if period is not None:
+        raise ClosedSystemError(system, "periodic linearization (Floquet) of closed systems "
+                                "is not available yet")
+    params = dict(parameters or {}) or None
+    if nominal is not None:
+        mapping = dict(zip(system.coordinate_names, nominal.y, strict=True))
+        lin = linearize_closed(system, mapping, dict(nominal.inputs) or None, params)
+        where = f'nominal state "{nominal.name}"'
+    else:
+        lin, where = linearize_near(system, model.simulation.y0 or [0.0] * system.f, params)
+    num = {k: np.asarray(getattr(lin, k), dtype=float)
+           for k in ("M_tilde", "P", "Q", "h", "D", "G", "K", "N")}
+    ss = lin.state_space()
+    scale = max(1.0, *(float(np.abs(num[k]).max(initial=0.0)) for k in ("M_tilde", "P", "Q")))
+    conservative = bool(np.abs(num["D"]).max(initial=0.0) <= 1e-9 * scale
+                        and np.abs(num["N"]).max(initial=0.0) <= 1e-9 * scale
+                        and np.abs(num["h"]).max(initial=0.0) <= 1e-9 * scale)
+    return {"closed": True, "system": system, "linearization": lin, "about": where,
+            "nominal": nominal, "numbers": num, "time_invariant": True, "t": t,
+            "conservative": conservative, "h_norm": float(np.abs(num["h"]).max(initial=0.0)),
+            "cyclic": (), "modes": modes(ss), "stability": stability(ss, cyclic=()),
+            "floquet": None, "nominal_check": None}
+
+
+def closed_jsonable(res: Mapping[str, Any]) -> dict[str, Any]:
+    """:func:`closed_linear_analysis` as JSON-ready data: the keys of a tree's
+    (:func:`jourdain.io.capabilities.jsonable`: ``matrices``, ``eigenvalues``,
+    ``natural_frequencies_hz``, ``damping_ratios``, ``stability``, ...) and those of
+    :func:`linearization_document` (``independent``, ``about``, ``z_s``, ``M_tilde`` ...
+    ``N``, ``frequencies_hz``, ``stable``, ``method``)."""
+    m, s = res["modes"], res["stability"]
+
+    def finite(a: Any) -> list[float | None]:
+        return [float(x) if np.isfinite(x) else None for x in np.asarray(a, float)]
+    out: dict[str, Any] = {
+        "nominal": res["nominal"].name if res["nominal"] is not None else None,
+        "t": res["t"], "time_invariant": True, "conservative": res["conservative"],
+        "h_norm": res["h_norm"],
+        "matrices": {k: np.asarray(v, float).tolist() for k, v in res["numbers"].items()},
+        "cyclic_coordinates": [],
+        "natural_frequencies_hz": finite(m.frequencies_hz),
+        "damping_ratios": finite(m.damping_ratios),
+        "stability": {"verdict": s.verdict, "reason": s.reason,
+                      "max_real_part": float(s.max_real_part), "cyclic": list(s.cyclic)},
+    }
+    out.update(linearization_document(res["system"], res["linearization"], res["about"]))
+    return out
+
+
+def closed_linear_text(res: Mapping[str, Any]) -> str:
+    """A plain-text account of :func:`closed_linear_analysis`, in the order of a tree's
+    (:func:`jourdain.io.capabilities.linear_text`)."""
+    from ..io.export import format_array
+
+    doc = closed_jsonable(res)
+    num = res["numbers"]
+    lines = [f"{doc['model']}: linearized in the independent coordinates "
+             f"{', '.join(doc['independent'])} about the {doc['about']}",
+             "  y_s = " + ", ".join(f"{k} = {v:.6g}" for k, v in doc["z_s"].items()),
+             "  M̃·η̈ + P·η̇ + Q·η = h  (η: the independent coordinates; time-invariant: "
+             f"numbers at t = {res['t']:g})"]
+    scales = {"D": num["P"], "G": num["P"], "K": num["Q"], "N": num["Q"]}
+    for k in ("M_tilde", "P", "Q", "h", "D", "G", "K", "N"):
+        lines.append(f"\n{k} =\n{format_array(num[k], scales.get(k))}")
+    lines.append("\nconservative (D = 0, N = 0, h = 0): "
+                 + ("yes" if res["conservative"] else "no"))
+    lines.append("\neigenvalues of the state-space system:\n" + str(res["modes"]))
     if doc["frequencies_hz"]:
-        lines.append("  frequencies: " + ", ".join(f"{f:.6g} Hz"
-                                                   for f in doc["frequencies_hz"]))
-    lines.append("  asymptotically stable" if doc["stable"] else
-                 "  not asymptotically stable (an eigenvalue with real part ≥ 0)")
-    lines.append(f"  ({doc['method']})")
+        lines.append("frequencies: " + ", ".join(f"{f:.6g} Hz" for f in doc["frequencies_hz"]))
+    lines.append(f"\nstability: {res['stability']}")
+    lines.append(f"({doc['method']})")
     return "\n".join(lines)
 
 
-def linearize_command(model: Any, parameters: Mapping[str, float], as_json: bool,
-                      about: str | None = None) -> int:
-    """``jourdain linearize`` for a loop model; prints and returns the exit status 0."""
-    if about is not None:
-        raise JourdainError(f"{model.path}: --about: a loop model is linearized about its "
-                            "equilibrium nearest the initial configuration (nominal motions "
-                            "of loop models are not supported)")
-    doc = linearize_document(model, parameters or None)
-    print(json.dumps(doc, indent=1) if as_json else linearize_text(doc))
-    return 0
-
-
-__all__ = ["linearization_document", "linearize_command", "linearize_document", "linearize_near", "linearize_text"]
+__all__ = ["closed_jsonable", "closed_linear_analysis", "closed_linear_text",
+           "closed_linearization_at", "linearization_document", "linearize_near"]

@@ -30,11 +30,29 @@ LINEARIZATION_NAMES = ("M_tilde", "P", "Q", "h", "D", "G", "K", "N")
 
 def eom_matrices(system: Any) -> dict[str, Any]:
     """The symbolic Newton–Euler matrices M̄, J̄, q̄^c, q̄^e and the equations of motion M, k, q
-    by the method's names."""
+    by the method's names; for a closed system those of :func:`closed_eom_matrices`."""
+    if system.closing:
+        return closed_eom_matrices(system)
     eom = system.equations_of_motion()
     ne = eom.newton_euler
     return {"M_bar": ne.M_bar, "J_bar": ne.J_bar, "q_c": ne.q_c, "q_e": ne.q_e,
             "M": eom.M, "k": eom.k, "q": eom.q}
+
+
+def closed_eom_matrices(system: Any) -> dict[str, Any]:
+    """The symbolic equations of a closed system (METHOD §7): the tree's Newton–Euler matrices
+    M̄, J̄, q̄^c, q̄^e of ``M̄·J̄·ÿ + q̄^c = q̄^e + Q̄·g``, the closing rows' constrained
+    directions ``Q_bar_c`` (6p×r, ``J̄ᵀ·Q̄_c = Φ_yᵀ``), the constraint rows ``Phi`` (r) and
+    ``Phi_y`` (r×f), and the tree's projected ``M_tree, k_tree, q_tree`` of
+    ``M_tree·ÿ + k_tree = q_tree + Φ_yᵀ·λ``. The projection onto the independent coordinates
+    (``ẏ = L·ẏ_i + l``, ``L = [E; −Φ_d⁻¹Φ_i]``) exists in numbers only (:func:`evaluate_all`):
+    the dependent coordinates are implicit functions of the independent ones."""
+    eom = system.tree.equations_of_motion()
+    ne = eom.newton_euler
+    con = system.constraints()
+    return {"M_bar": ne.M_bar, "J_bar": ne.J_bar, "q_c": ne.q_c, "q_e": ne.q_e,
+            "Q_bar_c": con.Q_bar, "Phi": con.Phi, "Phi_y": con.Phi_y,
+            "M_tree": eom.M, "k_tree": eom.k, "q_tree": eom.q}
 
 
 def evaluate_all(model: Any, y: np.ndarray, yd: np.ndarray, t: float,
@@ -51,6 +69,8 @@ def evaluate_all(model: Any, y: np.ndarray, yd: np.ndarray, t: float,
         out = dict(system.evaluate(y, yd, t=t, parameters=parameters or None,
                                    inputs=inputs or None))
     except JourdainError as exc:
+        if system.closing:  # no open-tree fallback: its numbers are not the closed system's
+            raise
         # the equations of motion alone, when a later stage (the reactions) cannot be formed
         out = dict(evaluate(system, y, yd, t=t, parameters=parameters or None,
                             inputs=inputs or None))
@@ -107,7 +127,7 @@ def eval_document(model: Any, y: np.ndarray, yd: np.ndarray, t: float,
     joint wrenches and the units of every quantity."""
     system = model.system
     g_names = list(extra.get("g_names", []))
-    return {
+    doc = {
         "format": EVAL_FORMAT, "model": system.name, "file": model.path,
         "coordinates": system.coordinate_names, "t": t, "y": np.asarray(y).tolist(),
         "yd": np.asarray(yd).tolist(), "parameters": parameters, "inputs": inputs,
@@ -117,3 +137,18 @@ def eval_document(model: Any, y: np.ndarray, yd: np.ndarray, t: float,
         "joint_wrenches": {k: w.as_dict() for k, w in extra.get("joint_wrenches", {}).items()},
         "units": value_units(system, g_names),
     }
+    if system.closing:  # the closed system's: its state assembled onto Φ = 0, Φ̇ = 0
+        ind = list(extra.get("independent", []))
+        units = dict(doc["units"])
+        gen = dict(zip(system.coordinate_names, units["k"], strict=True))
+        units["k"] = units["q"] = [gen[c] for c in ind]
+        doc.update({
+            "y": np.asarray(values.get("y", y)).tolist(),
+            "yd": np.asarray(values.get("yd", yd)).tolist(),
+            "units": units, "independent": ind,
+            "constraint_labels": list(extra.get("constraint_labels", [])),
+            "closure_residual": dict(extra.get("closure_residual", {})),
+            "orthogonality": extra.get("orthogonality"),
+            "closing_wrenches": {k: {n: json_array(v) for n, v in w.items()}
+                                 for k, w in extra.get("closing_wrenches", {}).items()}})
+    return doc
