@@ -58,18 +58,20 @@ def test_linearize_without_isolated_equilibrium_falls_back(capsys: pytest.Captur
 
 
 def test_run_report_has_the_closing_joint_wrench(tmp_path: Path) -> None:
+    """The one report (io.report) of a closed system: the closing joint's wrench file and
+    its plot in section 6, the residuals and multipliers by row in loops.csv."""
     out = tmp_path / "rep"
     assert main(["run", str(EXAMPLES / "four_bar.toml"), "--out", str(out), "--t-end",
                  "0.5"]) == 0
-    header = (out / "motion.csv").read_text().splitlines()[0].split(",")
-    assert [h for h in header if h.startswith("closure.")] == [
-        "closure.Fx", "closure.Fy", "closure.Fz", "closure.Tx", "closure.Ty", "closure.Tz"]
-    assert (out / "closing_joint_wrenches.png").stat().st_size > 0
-    # the motion's figures and the wrenches' are drawn apart; the page shows them in order
-    page = (out / "index.html").read_text()
-    assert [f.split('"')[0] for f in page.split('<img src="')[1:]] == [
-        "coordinates.png", "constraint_residual.png", "reactions.png",
-        "closing_joint_wrenches.png", "energy.png"]
+    header = (out / "wrench-closure.csv").read_text().splitlines()[0].split(",")
+    assert header[1:7] == ["closure.F_x", "closure.F_y", "closure.F_z", "closure.T_x",
+                           "closure.T_y", "closure.T_z"]
+    lhead = (out / "loops.csv").read_text().splitlines()[0].split(",")
+    assert "lambda[closure.Fx]" in lhead and "Phi[closure.Fy]" in lhead
+    page = (out / "report.html").read_text()
+    assert "<h2>6. Closed loops</h2>" in page
+    assert "closing joints&#x27; wrenches along the motion" in page or \
+        "closing joints' wrenches along the motion" in page
 
 
 def test_run_report_files_like_the_tree_report(tmp_path: Path) -> None:
@@ -84,12 +86,12 @@ def test_run_report_files_like_the_tree_report(tmp_path: Path) -> None:
         assert (out / f).stat().st_size > 0
     assert "linearization-equilibrium.json" in run["files"]
     lin = json.loads((out / "linearization-equilibrium.json").read_text())
-    assert lin["method"].startswith("symbolic")
+    assert lin["about"].startswith("equilibrium")
     w = np.loadtxt(out / "wrench-closure.csv", delimiter=",", skiprows=1)
     head = (out / "wrench-closure.csv").read_text().splitlines()[0].split(",")
     assert head[:4] == ["t", "closure.F_x", "closure.F_y", "closure.F_z"]
-    motion = np.loadtxt(out / "motion.csv", delimiter=",", skiprows=1)
-    mhead = (out / "motion.csv").read_text().splitlines()[0].split(",")
+    motion = np.loadtxt(out / "loops.csv", delimiter=",", skiprows=1)
+    mhead = (out / "loops.csv").read_text().splitlines()[0].split(",")
     lam = motion[:, [mhead.index("lambda[closure.Fx]"), mhead.index("lambda[closure.Fy]")]]
     Fin = w[:, [head.index("closure.F_x_inertial"), head.index("closure.F_y_inertial")]]
     assert np.max(np.abs(Fin - lam)) <= 1e3 * EPS * (1 + np.max(np.abs(lam)))

@@ -1,7 +1,6 @@
-"""Worker processes of the reports (``jourdain run``): the report's symbolic display and its
-figures, and a loop report's figures (:class:`jourdain.loops.figures.Painter`), are computed
-in a process forked from the command's while it computes the numbers (where the machine has
-two cores or more)."""
+"""Worker processes of the report (``jourdain run``, trees and closed systems alike): the
+report's symbolic display and its figures are computed in a process forked from the
+command's while it computes the numbers (where the machine has two cores or more)."""
 
 from __future__ import annotations
 

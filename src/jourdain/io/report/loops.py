@@ -14,7 +14,7 @@ as a tree's, with the closed system's numbers, plus section 6, "Closed loops".
 * section 6: the closing joints, the constraint rows, the degrees of freedom by Grübler's
   count and by the rank of Φ_y, the partitions used along the run, the closure residuals
   max|Φ| and max|Φ̇| along the motion and the closing joints' reactions
-  (``wrench-<closing joint>.csv``, ``loops.json``).
+  (``wrench-<closing joint>.csv``, ``loops.csv``: Φ, Φ̇ and λ by row, ``loops.json``).
 """
 
 from __future__ import annotations
@@ -141,6 +141,8 @@ def linearization_section(run: Run) -> str:
     from ...loops.cli import linearization_document
 
     doc = linearization_document(system, lin, about)
+    doc["method"] = ("System.linearize: central differences of the compiled M, k, q in the "
+                     "independent coordinates on the manifold")
     fn = out / "linearization-equilibrium.json"
     fn.write_text(json.dumps(doc, indent=1), encoding="utf-8")
     info.files.append(fn)
@@ -214,6 +216,14 @@ def loops_section(run: Run, res: Any) -> str:
                     "status": res.status, "message": res.message})
         lam = res.multipliers
         labels = list(res.constraint_labels)
+        cols = ["t", *[f"Phi[{r}]" for r in labels], *[f"Phi_d[{r}]" for r in labels],
+                *[f"lambda[{r}]" for r in labels]]
+        fn_csv = out / "loops.csv"
+        np.savetxt(fn_csv, np.column_stack([res.t, res.Phi, res.Phi_dot, lam]),
+                   delimiter=",", header=",".join(cols), comments="", fmt="%.17g")
+        info.files.append(fn_csv)
+        s.append("<p class='meta'>The residuals Φ, Φ̇ and the multipliers λ of every "
+                 "constraint row at every sample: loops.csv.</p>")
         if lam.shape[1]:
             s.append(run.figures.add(time_plot, res.t,
                                      {r: lam[:, i]

@@ -41,7 +41,7 @@ def report_files(model: ModelFile) -> list[str]:
     return ["report.html", "run.json", model_copy(model), "equations.tex", "equations.json",
             "values.json", *(f"linearization-{n.name}.json" for n in model.nominal),
             "simulation.csv", *(f"wrench-{b.joint.name}.csv" for b in model.system.bodies),
-            *((["loops.json", "linearization-equilibrium.json",
+            *((["loops.json", "loops.csv", "linearization-equilibrium.json",
                 *(f"wrench-{c.name}.csv" for c in model.system.closing)])
               if model.system.closing else [])]
 

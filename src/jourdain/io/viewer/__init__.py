@@ -16,6 +16,13 @@ What is drawn
 * a triad at each body frame (x red, y green, z blue) and a fainter one at each joint frame,
   fixed in the parent body's frame (or the inertial one);
 * spring-dampers as lines between their two points;
+* a closed system's closing joints (``system.closing``): red lines from each body's origin to
+  its point of the joint, the two points joined, and a marker at the joint (the scene's
+  ``"closing"``; :func:`closing_ends` gives both points along the frames). The bodies of a
+  closed system move as its tree's at the same coordinates (:func:`body_poses` composes the
+  joints of ``system.tree``'s bodies), which are on the manifold Φ = 0: the loop drawn closed;
+* ``jd.view(system, y=...)``: one configuration at rest (:func:`at_rest`; a closed system's
+  assembled onto its loops);
 * the visuals of a body where given (:class:`Visual`, the ``visuals`` hook: per body a list
   of meshes — file, scale — and boxes, cylinders, spheres, each with its origin in the body
   frame; a URDF model's ``<visual>`` elements, :attr:`jourdain.io.urdf.UrdfModel.visuals`, are
@@ -41,9 +48,9 @@ the npm versions pinned in ``tools/viewer/package-lock.json`` and inlined into e
 from __future__ import annotations
 
 from .meshes import Mesh, read_mesh
-from .page import View, embed, model_visuals, report_section, view
-from .poses import body_poses, frame_times, pose_function, quaternions
-from .scene import decode_poses
+from .page import View, at_rest, embed, model_visuals, report_section, view
+from .poses import body_poses, closing_points, frame_times, pose_function, quaternions
+from .scene import closing_ends, decode_poses
 from .visuals import (
     FRAMES_PER_SECOND,
     MAX_FRAMES,
@@ -62,6 +69,6 @@ from .visuals import (
 
 __all__ = ["FRAMES_PER_SECOND", "MAX_FRAMES", "MAX_POSES", "MAX_TRIANGLES", "MIN_THICKNESS",
            "SCENE_FORMAT", "SHAPES", "VISUAL_KINDS", "Mesh", "MeshVisual", "View", "Visual",
-           "body_poses", "decode_poses", "embed", "equivalent_shape", "frame_times",
+           "at_rest", "body_poses", "closing_ends", "closing_points", "decode_poses", "embed", "equivalent_shape", "frame_times",
            "model_visuals", "pose_function", "quaternions", "read_mesh",
            "report_section", "rpy_matrix", "view", "visuals_by_body"]

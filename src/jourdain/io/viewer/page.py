@@ -13,7 +13,9 @@ from importlib import resources
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ...errors import JourdainError
+import numpy as np
+
+from ...errors import JourdainError, ModelError
 
 if TYPE_CHECKING:
     from ...simulation.results import Results
@@ -107,13 +109,57 @@ def embed(page_html: str, height: int = 480) -> str:
             "border:1px solid #ccc'></iframe>")
 
 
-def view(results: Results, *, visuals: Any = None,
-         shape: str = "box", max_frames: int | None = None, height: int = 480) -> View:
-    """The 3-D view of a simulation's motion (``jd.view(results)``).
+def at_rest(system: Any, y: Any = None, parameters: Any = None) -> Results:
+    """One sample at rest of ``system`` at the configuration ``y`` (the tree's coordinates, in
+    order or by name; default all zero) as :class:`Results`: what :func:`view` draws of a
+    system. A closed system's configuration is assembled onto Φ = 0 (the independent
+    coordinates held, :meth:`jourdain.System.evaluate`): the mechanism drawn closed."""
+    from ...simulation.results import Results
+
+    names = system.coordinate_names
+    if y is None:
+        y0 = np.zeros(system.f)
+    elif hasattr(y, "items"):
+        unknown = [k for k in y if str(k) not in names]
+        if unknown:
+            raise ModelError(f"3-D view: {', '.join(map(str, unknown))} not a coordinate of "
+                             f"{system.name!r}; coordinates are {', '.join(names)}")
+        given = {str(k): float(v) for k, v in y.items()}
+        y0 = np.array([given.get(c, 0.0) for c in names])
+    else:
+        y0 = np.asarray(y, float).reshape(-1)
+        if y0.size != system.f:
+            raise ModelError(f"3-D view: y has {y0.size} values, {system.name!r} has "
+                             f"{system.f} coordinates")
+    values = dict(system.parameter_values)
+    values.update(parameters or {})
+    if system.closing:  # onto the manifold; the bodies then move as the tree's at this y
+        try:
+            y0 = np.asarray(system.evaluate(y0, np.zeros(system.f), parameters=values)["y"],
+                            float)
+        except JourdainError as exc:
+            raise ModelError(f"3-D view: {system.name!r} could not be assembled at y = "
+                             f"{y0.tolist()} ({exc}); give y=... near a configuration of "
+                             "the closed mechanism") from exc
+    z = np.zeros((1, system.f))
+    return Results(system, np.zeros(1), y0[None, :], z, z, np.zeros((1, len(system.inputs))),
+                   np.zeros(1), values, status="finished", message="a configuration at rest")
+
+
+def view(results: Results | Any, *, visuals: Any = None,
+         shape: str = "box", max_frames: int | None = None, height: int = 480,
+         y: Any = None) -> View:
+    """The 3-D view of a simulation's motion (``jd.view(results)``), or of a system at one
+    configuration (``jd.view(system, y=...)``; a closed system's assembled onto its loops).
+    A closed system's closing joints are drawn: red lines from each body's origin to its point
+    of the joint, and a marker at the joint (the loops drawn closed).
 
     Parameters
     ----------
-    results : the :class:`~jourdain.simulation.results.Results` of a simulation (with its system)
+    results : the :class:`~jourdain.simulation.results.Results` of a simulation (with its
+        system), or a :class:`jourdain.System`
+    y : with a system: its configuration (the tree's coordinates, in order or by name;
+        default zero); with results: not used
     visuals : per body name a list of :class:`Visual` (meshes, boxes, cylinders, spheres), or
         a URDF model's ``visuals`` (``view(res, visuals=model.visuals)``); default: the
         system's ``visuals`` attribute where it has one, else none
@@ -121,6 +167,10 @@ def view(results: Results, *, visuals: Any = None,
     max_frames : at most this many frames (default :data:`MAX_FRAMES`)
     height : pixels of the view in a notebook
     """
+    from ...model.system import System
+
+    if isinstance(results, System):  # a system: one configuration at rest
+        results = at_rest(results, y)
     if visuals is None:
         visuals = getattr(_system(results), "visuals", None)
     sc = scene(results, visuals, shape, max_frames)

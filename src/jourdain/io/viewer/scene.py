@@ -193,14 +193,51 @@ def scene(results: Results, visuals: Any = None,
                                             ).tolist(),
                             "point_b": _vec(f.point_b, values, f'spring "{f.name}" point_b'
                                             ).tolist()})
+    closing = []  # a closed system's closing joints (their points in the bodies' frames)
+    for c in getattr(system, "closing", ()):
+        if c.point_a is None or c.point_b is None:
+            continue  # a general constraint of expressions: no points to draw
+        closing.append({"name": c.name, "type": c.type, "body_a": c.body_a,
+                        "body_b": c.body_b,
+                        "point_a": _vec(c.point_a, values, f'closing joint "{c.name}" point_a'
+                                        ).tolist(),
+                        "point_b": _vec(c.point_b, values, f'closing joint "{c.name}" point_b'
+                                        ).tolist()})
     poses = np.concatenate([r, quaternions(S)], axis=-1)  # (n, p, 7)
     return {"format": SCENE_FORMAT, "name": system.name, "n_frames": int(len(times)),
             "times": _b64(times, "<f8"), "poses": _b64(poses.reshape(-1), "<f4"),
             "bodies": bodies, "world_visuals": world_visuals, "springs": springs,
+            "closing": closing,
             "up": up.tolist(),
             "center": center.tolist(), "extent": float(L), "view_dir": view_dir.tolist(),
             "distance": float(distance), "ground": ground.tolist(), "notes": notes,
             "shape": shape, "status": results.status}
+
+
+def closing_ends(sc: Mapping[str, Any]) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Per closing joint of a scene dict, the inertial positions (n, 3) of its point on body
+    A and on body B at the scene's frames (from the poses as the page draws them: float32)."""
+    _, poses = decode_poses(sc)
+    poses = poses.astype(float)
+    index = {b["name"]: i for i, b in enumerate(sc["bodies"])}
+    out = {}
+    for c in sc.get("closing", []):
+        ends = []
+        for body, point in ((c["body_a"], c["point_a"]), (c["body_b"], c["point_b"])):
+            p = np.asarray(point, float)
+            if body == "world":
+                ends.append(np.broadcast_to(p, (len(poses), 3)).copy())
+                continue
+            pose = poses[:, index[body]]
+            x, y, z, w = (pose[:, k] for k in range(3, 7))
+            R = np.stack([
+                np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], -1),
+                np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], -1),
+                np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], -1),
+            ], axis=1)
+            ends.append(pose[:, :3] + R @ p)
+        out[c["name"]] = (ends[0], ends[1])
+    return out
 
 
 def decode_poses(sc: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray]:

@@ -4,7 +4,8 @@
  * three.js (the global JD3 of three_bundle.js): one group per body, placed at each time by the
  * body frame's inertial position r_O and orientation S (as a quaternion), with the body's
  * equivalent box or ellipsoid (or its visuals) and a triad of the body frame inside it, a triad of
- * each joint frame fixed to the parent, and the spring-dampers as lines between their points.
+ * each joint frame fixed to the parent, and the spring-dampers as lines between their points;
+ * a closed system's closing joints: red lines from each body's origin to its point, a marker.
  *
  * Poses: a Float32Array (base64) of n_frames × n_bodies × 7 numbers (x, y, z, qx, qy, qz, qw);
  * between two frames positions are interpolated linearly and orientations by slerp.
@@ -162,6 +163,23 @@
   if (scene.springs.length) world.add(springs);
   var pa = new T.Vector3();
 
+  // closing joints (a closed system's): each body's origin to its point, the two points
+  // joined (of zero length where the loop is closed), and a marker at the joint
+  var closing = scene.closing || [];
+  var closeGeo = new T.BufferGeometry();
+  var closePos = new Float32Array(18 * Math.max(closing.length, 1));
+  closeGeo.setAttribute("position", new T.BufferAttribute(closePos, 3));
+  var closeLines = new T.LineSegments(closeGeo, new T.LineBasicMaterial({ color: 0xd62728 }));
+  closeLines.frustumCulled = false;
+  var closeMarks = closing.map(function () {
+    var m = new T.Mesh(new T.SphereGeometry(0.018 * L, 16, 8),
+                       new T.MeshBasicMaterial({ color: 0xd62728 }));
+    world.add(m);
+    return m;
+  });
+  if (closing.length) world.add(closeLines);
+  var ZERO = [0, 0, 0];
+
   function springPoint(body, p, out, k) {
     pa.fromArray(p);
     if (body !== "world") pa.applyMatrix4(groups[body].matrixWorld);
@@ -207,6 +225,17 @@
       springPoint(s.body_b, s.point_b, springPos, 6 * n + 3);
     });
     springGeo.attributes.position.needsUpdate = true;
+    closing.forEach(function (c, n) {
+      var o = 18 * n;
+      springPoint(c.body_a, ZERO, closePos, o);
+      springPoint(c.body_a, c.point_a, closePos, o + 3);
+      springPoint(c.body_b, ZERO, closePos, o + 6);
+      springPoint(c.body_b, c.point_b, closePos, o + 9);
+      springPoint(c.body_a, c.point_a, closePos, o + 12);
+      springPoint(c.body_b, c.point_b, closePos, o + 15);
+      closeMarks[n].position.set(closePos[o + 3], closePos[o + 4], closePos[o + 5]);
+    });
+    closeGeo.attributes.position.needsUpdate = true;
     slider.value = String(current);
     label.textContent = "t = " + current.toFixed(3) + " s";
     dirty = true;
