@@ -139,9 +139,11 @@ def cmd_fmu(args: argparse.Namespace) -> int:
     info = export_fmu(model, out, reactions="all" if names == ["all"] else names,
                       parameters=params, model_identifier=args.identifier,
                       binary=not args.sources_only)
-    f = model.system.f
+    closed = (f" (independent {', '.join(info.independent)}; the dependent coordinates and "
+              "the closure residuals are outputs)") if info.independent else ""
     print(f"{info.path}: FMI 2.0 model exchange and co-simulation, modelIdentifier "
-          f"{info.model_identifier}; {2 * f} states, {len(model.system.parameters)} parameters, "
+          f"{info.model_identifier}; {info.states} states{closed}, "
+          f"{len(model.system.parameters)} parameters, "
           f"{len(model.system.inputs)} inputs, {len(info.reactions)} reaction outputs; "
           + (f"binary {info.binary}" if info.binary else "sources only"))
     return EXIT_OK
