@@ -43,10 +43,13 @@ from .analysis.state_space import state_space
 from .analysis.sweep import sweep
 from .equilibrium import Equilibrium, NoEquilibrium, find_equilibria, find_equilibrium
 from .errors import (
+    AssemblyError,
+    ClosedSystemError,
     EvaluationError,
     JourdainError,
     JourdainWarning,
     ModelError,
+    SingularConfiguration,
     SingularMassMatrix,
 )
 from .io import ModelFile, ModelFileError, load_model
@@ -107,6 +110,8 @@ from .numeric.linearization import (  # the stage's results with their numbers (
 from .pipeline import System
 from .simulation.results import Results
 from .simulation.simulate import Event, IntegrationError, simulate
+from .model.closing import ClosingJoint
+from .stages.constraints import ConstraintRow, Constraints, constraints
 from .stages.kinematics import BodyKinematics, Kinematics, kinematics
 from .stages.linearization import NominalCheck, NominalMotionWarning, TimeVariantError
 from .stages.newton_euler import NewtonEuler, newton_euler
@@ -126,12 +131,14 @@ __all__ = [
     "Gravity", "Force", "Torque", "SpringDamper", "GeneralizedForce", "RotationalSpringDamper",
     "Bushing", "rate", "acceleration", "elongation", "elongation_d", "deflection",
     "deflection_d",
+    "ClosingJoint",
     "Quantity", "position", "velocity", "point_acceleration", "angular_velocity",
     "relative_position", "relative_velocity", "distance", "distance_rate",
     # functions for expressions in models (SymEngine's)
     "sin", "cos", "tan", "atan2", "exp", "log", "sqrt", "pi",
     # the stages of the method (jourdain.stages)
     "kinematics", "Kinematics", "BodyKinematics",
+    "constraints", "Constraints", "ConstraintRow",
     "newton_euler", "NewtonEuler",
     "projection", "EquationsOfMotion", "SymMatrix",
     "reactions", "Reactions", "JointReactions", "evaluate_reactions", "joint_reactions",
@@ -151,4 +158,5 @@ __all__ = [
     "load_model", "ModelFile", "ModelFileError", "load_urdf", "view", "View", "MeshVisual",
     # errors (jourdain.errors)
     "JourdainError", "ModelError", "EvaluationError", "SingularMassMatrix", "JourdainWarning",
+    "ClosedSystemError", "AssemblyError", "SingularConfiguration",
 ]

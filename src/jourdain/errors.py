@@ -44,6 +44,26 @@ def refuse_closed(system: object, capability: str, hint: str = "") -> None:
         raise ClosedSystemError(system, capability, hint)
 
 
+class SingularConfiguration(JourdainError, ArithmeticError):
+    """The dependent coordinates of a closed system cannot be solved: ``Φ_d`` is singular or
+    too ill-conditioned at the time and state given (a change of the partition may help where
+    the constraint Jacobian ``Φ_y`` itself keeps full rank). Attributes ``t``, ``z``, ``zd``
+    (the tree's coordinates and rates there), ``cond``, ``rank`` (of Φ_y), ``suggestion`` (a
+    partition that is well-conditioned there, or None)."""
+
+    def __init__(self, message: str, t: float = float("nan"), z: object = None,
+                 zd: object = None, cond: float = float("inf"), rank: int | None = None,
+                 suggestion: tuple[str, ...] | None = None) -> None:
+        super().__init__(message)
+        self.t, self.z, self.zd, self.cond, self.rank = t, z, zd, cond, rank
+        self.suggestion = suggestion
+
+
+class AssemblyError(JourdainError, ValueError):
+    """Newton's method found no configuration of a closed system on its constraint manifold
+    near the one given."""
+
+
 class JourdainWarning(UserWarning):
     """Base class of the warnings of jourdain: a result that is computed but may not mean what
     it seems to (``warnings.simplefilter("error", JourdainWarning)`` turns them into errors)."""

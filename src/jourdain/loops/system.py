@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 
 from ..analysis.energy import energy
-from ..errors import JourdainError, ModelError
+from ..errors import AssemblyError, ModelError, SingularConfiguration
 from ..model import System
 from ..numeric import CompiledFunction, lambdify
 from ..stages.kinematics import kinematics  # the model has no stage methods (issue 16)
@@ -21,25 +21,6 @@ from ..stages.constraints import constraints as constraint_stage
 from ..symbolic import SymMatrix
 
 EPS = float(np.finfo(float).eps)
-
-
-class SingularConfiguration(JourdainError, ArithmeticError):
-    """The dependent coordinates cannot be solved: ``Φ_d`` is singular or too ill-conditioned
-    at the time and state given (a change of the partition may help where the constraint
-    Jacobian ``Φ_z`` itself keeps full rank). Attributes ``t``, ``z``, ``zd``, ``cond``,
-    ``rank`` (of Φ_z), ``suggestion`` (a partition that is well-conditioned there, or None)."""
-
-    def __init__(self, message: str, t: float = float("nan"), z: Any = None, zd: Any = None,
-                 cond: float = float("inf"), rank: int | None = None,
-                 suggestion: tuple[str, ...] | None = None) -> None:
-        super().__init__(message)
-        self.t, self.z, self.zd, self.cond, self.rank = t, z, zd, cond, rank
-        self.suggestion = suggestion
-
-
-class AssemblyError(JourdainError, ValueError):
-    """Newton's method found no configuration on the manifold near the one given."""
-
 
 
 def constraints(loop: System) -> Constraints:

@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 
 import symengine as se
 
-from ..errors import JourdainError
+from ..errors import JourdainError, refuse_closed
 from ..graph import count_nodes
 from ..stages.kinematics import kinematics  # the model has no stage methods (issue 16)
 from ..stages.newton_euler import newton_euler
@@ -196,9 +196,17 @@ def _recursive(system: System, full: bool, extra_source: str = "",
 
 
 @lru_cache(maxsize=32)
+def _refuse_closed(system: System) -> None:
+    """The tree's M, k, q of a closed system would leave its loops open: refused by name."""
+    refuse_closed(system, "the compiled equations of the tree would leave the loops open",
+                  "use the system's methods (evaluate, simulate, linearize), or system.tree "
+                  "for the open tree")
+
+
 def _eom_function(system: System) -> CompiledFunction:
     """M̄, J̄, q̄^c, q̄^e, M, k, q and, where the joints' constrained directions can be formed,
     Q̄ (:func:`jourdain.stages.reactions.joint_directions`), compiled by the recursion."""
+    _refuse_closed(system)
     try:
         directions = tuple(jr.wrenches for jr in joint_directions(system))
     except JourdainError:  # the equations of motion exist; the reactions report the reason
@@ -260,6 +268,7 @@ def dynamics_function(system: System) -> CompiledFunction:
     joint wrench for a batch of states) and the integrator's ``jd_accel`` (articulated bodies
     where they apply, O(f), else LDLᵀ of M), memoized per system: one library serves
     :func:`mkq_function` where it takes the recursion."""
+    _refuse_closed(system)
     return _recursive(system, full=False, accel=True)
 
 
