@@ -50,13 +50,15 @@ FLOORS: tuple[tuple[str, ...], ...] = (
     ("jourdain.measures", "jourdain.stages"),
     # 3 numbers: generated and compiled code, evaluation
     ("jourdain.numeric",),
-    # 4 simulation and analysis of the equations
-    ("jourdain.simulation", "jourdain.analysis", "jourdain.equilibrium", "jourdain.wrenches"),
+    # 4 simulation and analysis of the equations, and the numbers of closed systems (the
+    #   constraint stage's partition, assembly, M, k, q, reactions and motion on the manifold)
+    ("jourdain.simulation", "jourdain.analysis", "jourdain.equilibrium", "jourdain.wrenches",
+     "jourdain.loops"),
     # 5 the pipeline: jourdain.System with the stages as cached methods
     ("jourdain.pipeline",),
-    # 6 builders of systems and what works on whole models: example models, closed loops,
-    #   studies, model files, URDF, export, viewer, FMU
-    ("jourdain.models", "jourdain.loops", "jourdain.study", "jourdain.io"),
+    # 6 builders of systems and what works on whole models: example models, studies, model
+    #   files, URDF, export, viewer, FMU
+    ("jourdain.models", "jourdain.study", "jourdain.io"),
     # 7 the workflow shared by the report and the command line
     ("jourdain.workflow",),
     # 8 the report and the command line

@@ -18,7 +18,7 @@ import numpy as np
 from ..errors import EvaluationError
 from ..numeric import mkq_function
 from ..simulation.problem import address
-from ..simulation.simulate import check_t_span
+from ..simulation.options import check_t_span
 from .c_run import C_METHODS, FAILED, Segment
 from ..model import System
 from .closed_loop import LoopEvaluator

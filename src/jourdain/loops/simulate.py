@@ -51,7 +51,7 @@ import numpy as np
 
 from ..errors import EvaluationError
 from ..numeric import CompiledFunction, mkq_function, parameter_vector
-from ..simulation.simulate import check_t_span
+from ..simulation.options import check_t_span
 from .c_run import C_METHODS, FAILED, Segment
 from .charts import decide
 from ..model import System
