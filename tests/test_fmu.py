@@ -375,15 +375,6 @@ def test_unsupported_reactions_named(tmp_path: Path) -> None:
         export_fmu(mf, tmp_path / "t.fmu", binary=False, reactions="all")
 
 
-def test_closed_loops_refused(tmp_path: Path) -> None:
-    mf = load_model(str(ROOT / "examples" / "four_bar.toml"))
-    with pytest.raises(ModelError, match="closing joints"):
-        export_fmu(mf, tmp_path / "fb.fmu", binary=False)
-    with pytest.raises(ModelError, match="closing joints"):
-        export_fmu(mf.loops, tmp_path / "fb.fmu", binary=False)
-    assert not (tmp_path / "fb.fmu").exists()
-
-
 def test_cli(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     model = str(ROOT / "examples" / "quarter_car.toml")
     out = tmp_path / "qc.fmu"
