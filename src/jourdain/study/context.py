@@ -106,6 +106,8 @@ def _build(spec: StudySpec) -> Context:
     p0 = np.array([v for _, v in system.parameters], dtype=float)
     ctx = Context(spec, model, system, p0, y0, yd0, spec.cases(), {})
     comp = spec.compute
+    if system.is_closed:
+        _refuse_closed(spec, system)
     if "evaluate" in comp:
         from ..numeric import dynamics_function
 
@@ -158,6 +160,22 @@ def _build(spec: StudySpec) -> Context:
 EQUILIBRIUM = "equilibrium"
 
 
+def _refuse_closed(spec: StudySpec, system: Any) -> None:
+    """What a study cannot compute for a closed system: a ClosedSystemError naming it."""
+    from ..errors import ClosedSystemError
+
+    for what, capability in (
+            ("evaluate", "the study's [compute.evaluate] (M, k, q, ÿ and joint wrenches of a "
+             "block in one C call of the open tree's equations)"),
+            ("frequency_response", "the study's [compute.frequency_response] (frequency "
+             "responses of the linearization in the independent coordinates)")):
+        if what in spec.compute:
+            raise ClosedSystemError(system, f"{capability} is not available for closed "
+                                    "systems yet", "compute [compute.linearize], "
+                                    "[compute.critical] or [compute.simulate], or call "
+                                    "system.evaluate per case")
+
+
 def _closed(ctx: Context, about: str | None) -> None:
     """A closed system's context: no batched C evaluation (its M, k, q come from the
     manifold, per case); what the study cannot do for it raises ClosedSystemError naming the
@@ -165,17 +183,8 @@ def _closed(ctx: Context, about: str | None) -> None:
     from ..errors import ClosedSystemError
     from ..loops.closed_loop import LoopEvaluator
 
-    system, comp = ctx.system, ctx.spec.compute
+    system = ctx.system
     ctx.closed = True
-    for what, capability in (
-            ("evaluate", "the study's [compute.evaluate] (M, k, q, ÿ and joint wrenches of a "
-             "block in one C call of the open tree's equations)"),
-            ("frequency_response", "the study's [compute.frequency_response] (frequency "
-             "responses of the linearization in the independent coordinates)")):
-        if what in comp:
-            raise ClosedSystemError(system, f"{capability} is not available for closed "
-                                    "systems yet", "compute [compute.linearize] or "
-                                    "[compute.simulate], or call system.evaluate per case")
     # the partition at the initial configuration: the linearization's coordinates
     ev = LoopEvaluator(system, ctx.y0, 0.0, None)
     ctx.independent = tuple(ev.independent_names)
