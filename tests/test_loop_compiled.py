@@ -14,8 +14,8 @@ import pytest
 from jourdain.io.modelfile import loads_model
 from jourdain.loops import LoopEvaluator
 from jourdain.loops.compiled import LoopKernel
-from jourdain.models.loops import four_bar, n_four_bar, slider_crank
 from jourdain.loops.simulate import simulate_loop
+from jourdain.models.loops import four_bar, n_four_bar, slider_crank
 from tests.tolerance import EPS, cond, solve_tol
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"

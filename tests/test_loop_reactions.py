@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from jourdain.loops import evaluate
-from jourdain.models.loops import four_bar
 from jourdain.loops.reactions import closing_reactions
 from jourdain.loops.simulate import simulate_loop
+from jourdain.models.loops import four_bar
 from tests.test_loops import slider_tree
 from tests.tolerance import solve_tol
 

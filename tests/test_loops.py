@@ -3,12 +3,11 @@ an independent Lagrange-multiplier formulation, energy, singular positions, mode
 
 from __future__ import annotations
 
-from typing import Any
-
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -18,8 +17,8 @@ from scipy.integrate import solve_ivp
 from jourdain.errors import ModelError
 from jourdain.io.modelfile import ModelFileError, loads_model
 from jourdain.loops import ClosingJoint, LoopEvaluator, evaluate
-from jourdain.models.loops import four_bar, slider_crank
 from jourdain.loops.simulate import simulate_loop
+from jourdain.models.loops import four_bar, slider_crank
 from tests.tolerance import EPS, cond, solve_tol
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -545,8 +544,8 @@ def test_n_four_bar_through_its_singular_flat_positions() -> None:
     augmented-Lagrangian form; the crank angle follows the exact one-degree-of-freedom motion
     of the parallelogram chain (benchmarks/n_four_bar.py runs N = 5, 10, 40 over 20 s)."""
     from benchmarks.n_four_bar import initial_state, reference
-    from jourdain.models.loops import n_four_bar
     from jourdain.loops.simulate import simulate_penalty
+    from jourdain.models.loops import n_four_bar
 
     n = 3
     loop = n_four_bar(n)

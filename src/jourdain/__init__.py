@@ -100,6 +100,7 @@ from .model import (
     t,
     velocity,
 )
+from .model.closing import ClosingJoint
 from .numeric.linearization import (  # the stage's results with their numbers (issue 16)
     CompiledLinearization,
     GeneralLinearization,
@@ -110,7 +111,6 @@ from .numeric.linearization import (  # the stage's results with their numbers (
 from .pipeline import System
 from .simulation.results import Results
 from .simulation.simulate import Event, IntegrationError, simulate
-from .model.closing import ClosingJoint
 from .stages.constraints import ConstraintRow, Constraints, constraints
 from .stages.kinematics import BodyKinematics, Kinematics, kinematics
 from .stages.linearization import NominalCheck, NominalMotionWarning, TimeVariantError

@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import symengine as se
 
-from ..errors import EvaluationError
+from ..errors import EvaluationError, refuse_closed
 from ..stages.linearization import Linearization
 from ..stages.linearization.nominal import _nominal
 from .state_space import AnyLinearization, StateSpace, state_space
@@ -112,6 +112,9 @@ def state_feedback(system: System, K: Any, nominal: Mapping[Any, Any] | Any,
     ModelError
         A nominal motion that names unknown coordinates or leaves some out.
     """
+    refuse_closed(system, "a state feedback in the tree's states [y; ẏ] would act on the "
+                  "dependent coordinates too; closed systems have no feedback law yet (their "
+                  "linearization's states are the independent coordinates)")
 
     f, names = system.f, system.input_names
     try:

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import EvaluationError
+from ..errors import EvaluationError, refuse_closed
 from ..numeric.linearization import CompiledLinearization
 from ..stages.linearization import Linearization
 from .modes import ASYMPTOTICALLY_STABLE, UNSTABLE, _cyclic_of, stability
@@ -63,6 +63,9 @@ def sweep(lin: Linearization | CompiledLinearization, parameter: str,
     """Eigenvalues and stability verdicts over ``values`` of ``parameter`` (other parameters at
     their defaults, overridden by ``parameters``); the verdicts in Routh's sense where the
     system has cyclic coordinates (:func:`jourdain.analysis.stability`)."""
+    refuse_closed(getattr(lin, "system", None), "sweeps need the symbolic linearization, which "
+                  "closed systems do not have: linearize the closed system at each value "
+                  "(System.linearize with parameters) or use a study (jourdain study)")
     base = _linearization_of(lin)
     _check_parameter(base, parameter)
     vals = np.asarray(values, dtype=float).reshape(-1)
@@ -94,6 +97,8 @@ def stability_boundary(lin: Linearization | CompiledLinearization, parameter: st
     """
     from scipy.optimize import brentq
 
+    refuse_closed(getattr(lin, "system", None), "the stability boundary needs the symbolic "
+                  "linearization, which closed systems do not have")
     base = _linearization_of(lin)
     _check_parameter(base, parameter)
 

@@ -44,7 +44,6 @@ from .system import (
     constraints,
 )
 
-
 __all__ = ["Assembly", "AssemblyError", "Constraints", "LoopEvaluator", "Partition",
            "SingularConfiguration", "constraint_function", "constraints", "evaluate",
            "partition"]

@@ -24,12 +24,12 @@ import numpy as np
 import symengine as se
 
 from ..errors import EvaluationError
+from ..model import System
 from ..numeric import CompiledFunction, lambdify, mkq_function
 from ..numeric.ccode import HEADER, argument_names, function_source
 from ..numeric.toolchain import build, build_lock, build_soon, content_key
 from ..simulation.problem import address
 from ..symbolic import SymMatrix
-from ..model import System
 from .closed_loop import LoopEvaluator, Partition, constraints
 
 _VERSION = "loop-c4"

@@ -23,13 +23,13 @@ import numpy as np
 import symengine as se
 
 from ..errors import EvaluationError
+from ..model import System
 from ..model.forces import rate
 from ..numeric import CompiledFunction, lambdify
 from ..stages.kinematics import kinematics
 from ..stages.newton_euler import newton_euler
 from ..stages.projection import projection
 from ..symbolic import SymMatrix
-from ..model import System
 from .closed_loop import AssemblyError, LoopEvaluator, constraints
 
 

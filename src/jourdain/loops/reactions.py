@@ -26,13 +26,13 @@ from typing import Any
 import numpy as np
 import symengine as se
 
+from ..model import System
+from ..model.closing import ZERO3
 from ..model.expressions import Mat3, Vec3
 from ..numeric import CompiledFunction, lambdify, parameter_vector
 from ..stages.kinematics import _cross, _mv, kinematics
 from ..symbolic import SymMatrix
-from ..model import System
 from .closed_loop import constraints
-from ..model.closing import ZERO3
 
 _IDENT = ((se.Integer(1), se.Integer(0), se.Integer(0)),
           (se.Integer(0), se.Integer(1), se.Integer(0)),

@@ -16,11 +16,11 @@ from typing import Any
 import numpy as np
 
 from ..errors import EvaluationError
-from ..numeric import mkq_function
-from ..simulation.problem import address
-from ..simulation.options import check_t_span
-from .c_run import C_METHODS, FAILED, Segment
 from ..model import System
+from ..numeric import mkq_function
+from ..simulation.options import check_t_span
+from ..simulation.problem import address
+from .c_run import C_METHODS, FAILED, Segment
 from .closed_loop import LoopEvaluator
 from .compiled import loop_library
 from .results import LoopResults

@@ -50,11 +50,11 @@ from typing import Any
 import numpy as np
 
 from ..errors import EvaluationError
+from ..model import System
 from ..numeric import CompiledFunction, mkq_function, parameter_vector
 from ..simulation.options import check_t_span
 from .c_run import C_METHODS, FAILED, Segment
 from .charts import decide
-from ..model import System
 from .closed_loop import (
     LoopEvaluator,
     SingularConfiguration,

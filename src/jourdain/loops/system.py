@@ -7,7 +7,6 @@ described in :mod:`jourdain.loops.closed_loop`."""
 from __future__ import annotations
 
 from functools import lru_cache
-from typing import Any
 
 import numpy as np
 
@@ -15,9 +14,9 @@ from ..analysis.energy import energy
 from ..errors import AssemblyError, ModelError, SingularConfiguration
 from ..model import System
 from ..numeric import CompiledFunction, lambdify
-from ..stages.kinematics import kinematics  # the model has no stage methods (issue 16)
 from ..stages.constraints import Constraints
 from ..stages.constraints import constraints as constraint_stage
+from ..stages.kinematics import kinematics  # the model has no stage methods (issue 16)
 from ..symbolic import SymMatrix
 
 EPS = float(np.finfo(float).eps)
