@@ -19,6 +19,7 @@ from ...workflow import has_capability, summary
 from .. import export
 from ..modelfile import ModelFile
 from ..workers import fork_workers, ignore_interrupt
+from . import loops
 from .equations import (
     Display,
     cached,
@@ -47,8 +48,6 @@ def compute_sections(run: Run, sections: list[str], display: Future[Display] | N
     ``display``, else computed here in turn."""
     sections.append(model_section(run))
     if run.model.system.closing:  # a closed system: its numbers, and the loops' section
-        from . import loops
-
         sections.append(loops.equations_section(run))
         sections.append(numbers_section(run))
         sections.append(loops.linearization_section(run))

@@ -25,7 +25,8 @@ from typing import Any
 import numpy as np
 
 from ...errors import JourdainError
-from .figures import time_plot
+from ...numeric import parameter_vector
+from .figures import eigen_plot, time_plot
 from .html import SYM, esc, html_table, mathml, matrix_table, note, numstr, snap
 from .state import Run
 
@@ -127,8 +128,6 @@ def linearization_section(run: Run) -> str:
         rows.append((numstr(lam.real), numstr(lam.imag), numstr(w / (2 * np.pi)),
                      numstr(-lam.real / w) if w > 0 else "—"))
     s.append(html_table(rows, ["Re λ / (1/s)", "Im λ / (rad/s)", "f<sub>n</sub> / Hz", "ζ"]))
-    from .figures import eigen_plot
-
     s.append(run.figures.add(eigen_plot, lams, "eigenvalues about the equilibrium"))
     stable = bool(np.all(ev.real < -1e-9))
     marginal = bool(np.all(ev.real < 1e-9))
@@ -230,6 +229,9 @@ def loops_section(run: Run, res: Any) -> str:
                                       for i, r in enumerate(labels[:12])},
                                      "λ", "closing joints' multipliers λ along the motion"))
         s.append(closing_wrenches(run, res))
+    lin = out / "linearization-equilibrium.json"
+    if lin in info.files:  # section 4's eigenvalues, with the loops' numbers
+        doc["eigenvalues"] = json.loads(lin.read_text(encoding="utf-8"))["eigenvalues"]
     fn = out / "loops.json"
     fn.write_text(json.dumps(doc, indent=1), encoding="utf-8")
     info.files.append(fn)
@@ -240,8 +242,6 @@ def closing_wrenches(run: Run, res: Any) -> str:
     """The closing joints' force and torque along the motion (B on A at A's joint point, in
     A's axes and inertial): a plot of the magnitudes and ``wrench-<closing joint>.csv``."""
     from ...loops.reactions import closing_reactions
-    from ...numeric import parameter_vector
-
     system = run.model.system
     try:
         pv = parameter_vector(system.tree, dict(res.parameters))

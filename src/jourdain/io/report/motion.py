@@ -11,6 +11,7 @@ import numpy as np
 import symengine as se
 
 from ..modelfile import ModelFile
+from ..viewer.poses import body_poses, closing_points
 from .html import esc
 
 
@@ -63,8 +64,6 @@ def motion_of(model: ModelFile, res: Any, parameters: Mapping[str, float]) -> Mo
             mass[b.name] = 1.0
     closing: dict[str, tuple[np.ndarray, ...]] = {}
     if system.closing:  # the closing joints' points, from the tree's poses at the same y
-        from ..viewer.poses import body_poses, closing_points
-
         r, S = body_poses(res, np.asarray(res.t, float))
         zero = np.zeros((len(res.t), 3))
         for c in system.closing:

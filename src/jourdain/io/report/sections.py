@@ -18,6 +18,7 @@ from ...workflow.evaluation import LINEARIZATION_NAMES
 from .. import export
 from ..capabilities import T
 from .html import SYM, esc, html_table, mathml, matrix_table, note, numstr
+from .loops import numbers_rows
 from .state import Run, model_copy
 
 
@@ -106,8 +107,6 @@ def numbers_section(run: Run) -> str:
     try:
         values, extra, missing = evaluate_all(model, y0, yd0, 0.0, run.params, u0)
         if system.closing:  # the closed system's numbers, in its independent coordinates
-            from .loops import numbers_rows
-
             # the tree's linearization is no closed system's (section 4 has the closed one)
             missing = {k: v for k, v in missing.items() if k not in LINEARIZATION_NAMES}
             s += numbers_rows(run, values, extra)
