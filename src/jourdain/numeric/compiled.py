@@ -195,7 +195,6 @@ def _recursive(system: System, full: bool, extra_source: str = "",
     return _load(system, names, shapes, units, n_bodies=p)
 
 
-@lru_cache(maxsize=32)
 def _refuse_closed(system: System) -> None:
     """The tree's M, k, q of a closed system would leave its loops open: refused by name."""
     refuse_closed(system, "the compiled equations of the tree would leave the loops open",
@@ -203,6 +202,7 @@ def _refuse_closed(system: System) -> None:
                   "for the open tree")
 
 
+@lru_cache(maxsize=32)
 def _eom_function(system: System) -> CompiledFunction:
     """M̄, J̄, q̄^c, q̄^e, M, k, q and, where the joints' constrained directions can be formed,
     Q̄ (:func:`jourdain.stages.reactions.joint_directions`), compiled by the recursion."""
