@@ -31,10 +31,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     params = overrides(system, args.set)
     opts = sim_options(model, args)
     out = output_file(args.out, args.force, OUTPUT_SUFFIXES) if args.out else None
-    # a closed system's run (jourdain.loops) reports no progress: asked for, its
-    # ClosedSystemError says so; not asked for, none is passed
-    progress = (progress_printer(args.progress, f"simulating {system.name}")
-                if args.progress or not system.closing else None)
+    progress = progress_printer(args.progress, f"simulating {system.name}")
     failure: JourdainError | None = None
     try:
         # with --out the results are written as the run goes (a closed system's: at its end),

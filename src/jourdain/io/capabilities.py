@@ -309,8 +309,8 @@ def simulate(model: ModelFile, parameters: Mapping[str, float] | None = None,
     input name: a number or an expression in t and the parameters) replace the model's values
     they name. ``progress`` and ``output`` (a results file written as the run goes) are passed
     to :func:`jourdain.simulation.simulate.simulate`; a closed system's run writes ``output``
-    at its end (:meth:`Results.save`) and takes no ``progress`` (a
-    :class:`~jourdain.errors.ClosedSystemError` where one is given). The options are checked against the bounds of
+    whole at its end (:meth:`Results.save`; the motion up to a singular position or an
+    interruption included). The options are checked against the bounds of
     :mod:`jourdain.simulation.simulate` before anything is computed (:class:`EvaluationError`).
     """
     system = model.system
@@ -336,7 +336,7 @@ def simulate(model: ModelFile, parameters: Mapping[str, float] | None = None,
         laws[name] = v
     options: dict[str, Any] = {"progress": progress,
                                "output": None if output is None else str(output)}
-    if system.closing:  # whole at the end; the options a closed run refuses only when asked
+    if system.closing:  # the file whole at the end; no progress passed where none is shown
         options = {k: v for k, v in options.items() if k != "output" and v}
     res = system.simulate((0.0, t1), [y[c] for c in coords], [yd[c] for c in coords],
                           parameters=dict(parameters or {}) or None,
