@@ -22,8 +22,8 @@ from .partitioning import Partition, _cond, _rank_tol, partition
 from .system import (
     EPS,
     AssemblyError,
-    System,
     SingularConfiguration,
+    System,
     constraint_function,
     constraints,
 )
@@ -40,6 +40,49 @@ class Assembly:
     Phi_dot: float
     iterations: int
     independent: tuple[str, ...]
+
+
+#: Newton's plateau exit (:func:`_newton_stop`): sqrt(eps), the largest scaled residual at
+#: which a residual that stopped decreasing is taken as rounding
+_PLATEAU = math.sqrt(EPS)
+
+
+def _newton_stop(Phi: np.ndarray, Phi_z: np.ndarray, Phi_t: np.ndarray, z: np.ndarray,
+                 t: float, tol: float, last: float) -> tuple[int, float, float]:
+    """Newton's stop for :meth:`LoopEvaluator.solve_positions`, the same test as
+    ``jdl_converged`` in ``loop_c.h`` (keep them equal; the reasoning is set out there).
+    ``Phi``, ``Phi_z``, ``Phi_t``: the kept rows at ``z``; ``tol``: the relative tolerance
+    (``newton_tol``); ``last``: the plateau measure of the previous iterate. Returns 1 (z
+    solves Φ = 0 to rounding), 0 (go on) or -1 (Φ not finite), ``|Φ|∞`` and the next ``last``.
+
+    Why: Φ's rows carry the closing joints' units and z mixes radians and metres, so an
+    absolute bound (the former ``|Φ| ≤ 1e-13·(1 + max|z|)``) is loose for a small mechanism
+    and out of reach for a large one. Row i is scaled by ``w_i = Σ_j |∂Φ_i/∂z_j|·|z_j| +
+    |∂Φ_i/∂t|·|t|``, the change of Φ_i when every coordinate moves by its own relative amount,
+    in the row's units whatever the coordinates' units: ``|Φ_i| ≤ tol·w_i`` for all rows makes
+    z the exact solution for coordinates perturbed by at most ``tol`` relative (a componentwise
+    backward error), the same test in metres or micrometres, and a row keeps its scale where
+    some of its coordinates are 0. Where rounding in Φ_i exceeds that (terms that do not move
+    with z: a mechanism far from the origin, or all the row's coordinates near 0) Newton
+    reaches a plateau: an iterate whose residual relative to ``w_i + Σ_j |∂Φ_i/∂z_j|`` (a
+    coordinate counted at least 1, a radian for an angle) did not decrease and is below
+    √eps is at rounding level. A Newton that does not converge does not stop there: its
+    residual is larger by orders, or still decreasing near a singular position, and the
+    caller raises :class:`SingularConfiguration` after ``max_newton`` steps."""
+    a = np.abs(Phi)
+    res = float(np.max(a)) if a.size else 0.0
+    if not math.isfinite(res):
+        return -1, res, last
+    G = np.abs(Phi_z)
+    w = G @ np.abs(z) + np.abs(Phi_t * t)
+    if np.all(a <= tol * w):
+        return 1, res, last
+    with np.errstate(divide="ignore", invalid="ignore"):
+        q = np.where(a > 0, a / (w + G.sum(axis=1)), 0.0)
+    rel = float(np.max(q)) if q.size else 0.0
+    if last <= rel <= _PLATEAU:
+        return 1, res, last
+    return 0, res, rel
 
 
 class LoopEvaluator:
@@ -94,6 +137,12 @@ class LoopEvaluator:
         """Newton on ``Φ(y, d, t) = 0`` for d, y held: the configuration z, the constraint
         data there (``Phi_z`` at the converged z) and the iterations. Raises
         :class:`SingularConfiguration` when ``Φ_d`` is singular or Newton does not converge.
+
+        Converged means a componentwise backward error of at most ``newton_tol`` (relative,
+        free of units: each row's residual against the change of that row when every
+        coordinate moves by its own relative amount), or a residual at the rounding plateau
+        (:func:`_newton_stop`, the test of the C kernel too), so that a mechanism in
+        micrometres is solved to the same digits as in metres.
         """
         part = self.part
         ind, dep, rows = list(part.independent), list(part.dependent), list(part.rows)
@@ -107,15 +156,15 @@ class LoopEvaluator:
             z = z_guess.copy()
         z[ind] = y
         zero = np.zeros(self.n)
-        scale = 1.0 + float(np.max(np.abs(z))) if self.n else 1.0
         last = math.inf
         for it in range(self.max_newton + 1):
             cd = self._con(z, zero, t)
             Phi = cd["Phi"][rows, 0]
-            res = float(np.max(np.abs(Phi))) if Phi.size else 0.0
-            if res <= self.newton_tol * scale or (res >= last and res <= 1e-10 * scale):
+            stop, res, last = _newton_stop(Phi, cd["Phi_z"][rows], cd["Phi_t"][rows, 0], z, t,
+                                           self.newton_tol, last)
+            if stop > 0:
                 return z, cd, it
-            if it == self.max_newton:
+            if stop < 0 or it == self.max_newton:
                 break
             Pd = cd["Phi_z"][np.ix_(rows, dep)]
             lu, piv, info = getrf(Pd)
@@ -124,7 +173,6 @@ class LoopEvaluator:
                 break
             step, _ = getrs(lu, piv, Phi)
             z[dep] -= step
-            last = res
         raise SingularConfiguration(
             f"{self.loop.name}: no configuration on the manifold with the independent "
             f"coordinates {self._named(y)} at t = {t:.6g} (|Φ| = {res:.3g} after "

@@ -22,7 +22,7 @@ typedef struct {
     long *piv;             /* r */
     double *info;          /* [cond_1(Phi_d), Newton steps, reason, |Phi|, J_z and y_last
                             * valid (the prediction), failures, y_last valid] */
-    double newton_tol, cond_limit;
+    double newton_tol, cond_limit;  /* newton_tol: relative, see jdl_converged */
     long max_newton;
     jd_tree_fn uexpr;      /* the inputs as functions of t and the parameters, or NULL */
     double *u_buf;         /* their values */
@@ -42,6 +42,7 @@ static const double *jdl_inputs(const jd_loop *L, double t, const double *u) {
 #define JD_LOOP_MASS 3     /* M not positive definite */
 #define JD_LOOP_BRANCH 4   /* Newton's correction far beyond the prediction: a branch jump */
 #define JD_LOOP_DY 0.05    /* the largest step in y of a continuation between samples */
+#define JD_NEWTON_PLATEAU 1.4901161193847656e-08  /* sqrt(DBL_EPSILON): jdl_converged */
 
 long jd_loop_work(long n, long m, long f) {
     return (2 * m + m * n) + m + (n * n + 2 * n) + n * n + 2 * n * f + 3 * n + f * f + 2 * f
@@ -109,6 +110,62 @@ static double jdl_inv_norm1(long r, const double *A, const long *piv, double *x,
     return est;
 }
 
+/* Newton's stop, the same test as jourdain.loops.evaluator._newton_stop (keep them equal).
+ * Returns 1 when z solves Phi = 0 to rounding, 0 to go on, -1 when Phi is not finite; *res is
+ * |Phi|_inf over the kept rows (for the report), *last the plateau measure of the previous
+ * iterate.
+ *
+ * Why a scaled residual: the rows of Phi carry the units of the closing joints (metres for a
+ * point, none for an orientation) and z mixes radians and metres, so no absolute bound on
+ * |Phi| (or on the step) fits every mechanism: the former |Phi| <= 1e-13 (1 + max|z|) let a
+ * four-bar of 10 um links stop at residuals of 5e-8 of its lengths, and its integrator took
+ * 50 times the right-hand sides of the same four-bar in metres. Row i is scaled by
+ *     w_i = sum_j |dPhi_i/dz_j| |z_j| + |dPhi_i/dt| |t|,
+ * the change of Phi_i when every coordinate (and t) moves by its own relative amount: w_i has
+ * the units of row i whatever the units of the z_j, and |Phi_i| <= tol w_i for every row says
+ * that z is the exact solution for coordinates perturbed by at most tol relative (a
+ * componentwise backward error, Oettli-Prager), so the test is the same for a mechanism in
+ * metres or micrometres. newton_tol is that relative tolerance (1e-13, about 450 eps: above
+ * the evaluation rounding of rows whose terms exceed w_i a hundredfold, so that the plateau
+ * exit below stays rare; Newton's quadratic convergence usually leaves far less). A row
+ * keeps a scale where some coordinates are 0, as long as one of its coordinates is not.
+ *
+ * Why a plateau exit: rounding in Phi_i is relative to the magnitude of the terms it is summed
+ * from, which w_i does not see where they do not move with z (a mechanism far from the origin,
+ * or all the row's coordinates near 0): there the test above can be out of reach. Newton
+ * then stops reducing the residual; an iterate whose residual, relative to
+ * w_i + sum_j |dPhi_i/dz_j| (a coordinate counted at least 1: a radian for an angle), did
+ * not decrease and is below sqrt(eps) is at rounding level and taken. Non-convergence does
+ * not stop there: a residual that is not decreasing is larger by orders (a diverging or
+ * cycling Newton), and near a singular position Newton still decreases it (linearly), so it
+ * ends at max_newton with JD_LOOP_NEWTON. The floor of 1 (for a length, 1 of its unit) only
+ * widens this rejection bound, never the accuracy, which is that of the plateau itself. */
+static int jdl_converged(const jd_loop *L, const double *z, double t, const double *Phi,
+                         const double *Pz, const double *Pt, double *res, double *last) {
+    long n = L->n;
+    int ok = 1;
+    double a_max = 0.0, rel = 0.0;
+    for (long k = 0; k < L->r; ++k) {
+        long i = L->rows[k];
+        double a = fabs(Phi[i]), w = fabs(Pt[i] * t), lever = 0.0;
+        for (long j = 0; j < n; ++j) {
+            double g = fabs(Pz[i * n + j]);
+            w += g * fabs(z[j]);
+            lever += g;
+        }
+        if (!(a <= a_max)) a_max = a;  /* NaN propagates */
+        if (!(a <= L->newton_tol * w)) ok = 0;
+        double q = a > 0.0 ? a / (w + lever) : 0.0;
+        if (!(q <= rel)) rel = q;
+    }
+    *res = a_max;
+    if (!isfinite(a_max)) return -1;
+    if (ok) return 1;
+    if (rel >= *last && rel <= JD_NEWTON_PLATEAU) return 1;
+    *last = rel;
+    return 0;
+}
+
 /* the work array, carved */
 typedef struct { double *con, *gam, *tr, *A, *Jz, *MJ, *zd, *g, *h, *Mf, *b, *v1, *v2, *v3, *v4; } jdl_parts;
 
@@ -160,20 +217,15 @@ static int jdl_manifold(const jd_loop *L, const double *y, const double *yd, dou
     long it = 0;
     for (;; ++it) {
         jd_con(z, s->zd, t, L->p, u, s->con);
-        res = 0.0;
-        for (long i = 0; i < r; ++i) {
-            double a = fabs(Phi[L->rows[i]]);
-            if (!(a <= res)) res = a;  /* NaN propagates */
-        }
-        if (res <= L->newton_tol * scale || (res >= last && res <= 1e-10 * scale)) break;
-        if (it == L->max_newton || !isfinite(res)) { info[1] = (double)it; info[3] = res; return JD_LOOP_NEWTON; }
+        int stop = jdl_converged(L, z, t, Phi, Pz, Pt, &res, &last);
+        if (stop > 0) break;
+        if (stop < 0 || it == L->max_newton) { info[1] = (double)it; info[3] = res; return JD_LOOP_NEWTON; }
         for (long i = 0; i < r; ++i)
             for (long j = 0; j < r; ++j) s->A[i * r + j] = Pz[L->rows[i] * n + L->dep[j]];
         if (jdl_lu(r, s->A, L->piv)) { info[1] = (double)it; info[3] = res; return JD_LOOP_NEWTON; }
         for (long i = 0; i < r; ++i) s->v1[i] = Phi[L->rows[i]];
         jdl_solve(r, s->A, L->piv, s->v1);
         for (long i = 0; i < r; ++i) z[L->dep[i]] -= s->v1[i];
-        last = res;
     }
     info[1] = (double)it;
     info[3] = res;
