@@ -138,3 +138,32 @@ def test_closed_system_is_data_equal_hashable_and_pickles() -> None:
     assert slider_crank().closing[0].name == "wrist"
     with pytest.raises(jd.ModelError, match="unknown body"):
         a.tree.closed_by([jd.ClosingJoint("x", "spherical", "coupler", "nope")])
+
+
+def test_closed_run_shows_progress_and_keeps_its_motion_on_ctrl_c(tmp_path: Path) -> None:
+    """Ctrl-C during a closed system's run (SIGINT sent from the progress callback, as a user
+    would press it) stops it between two calls of the step loop: the results say
+    "interrupted", hold the motion up to there on the manifold, and the output file has it."""
+    import os
+    import signal
+
+    system = four_bar()
+    seen: list[float] = []
+
+    def progress(t: float, t1: float) -> None:
+        seen.append(t)
+        if len(seen) == 2:
+            os.kill(os.getpid(), signal.SIGINT)
+
+    out = tmp_path / "run.csv"
+    res = system.simulate((0.0, 5000.0), [0.5, 0, 0], [1.0, 0, 0], progress=progress,
+                          output=str(out), t_eval=np.linspace(0.0, 5000.0, 100001))
+    assert res.status == "interrupted" and "Ctrl-C" in res.message
+    assert 0 < res.t[-1] < 5000.0 and len(seen) >= 2 and all(np.diff(seen) > 0)
+    assert res.closure_residual[0] <= 1e-9
+    kept = jd.Results.load(out)
+    assert len(kept.t) == len(res.t)
+    assert np.allclose(kept.y[-1], res.y[-1], rtol=1e-15, atol=0)
+    with pytest.raises(ClosedSystemError, match="events"):
+        system.simulate((0.0, 1.0), [0.5, 0, 0], [1.0, 0, 0],
+                        events=[jd.Event("theta1 - 1")])

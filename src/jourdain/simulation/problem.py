@@ -161,7 +161,11 @@ class Segment:
         self.ev_i, self.n_ev = np.empty(1, dtype=np.int_), np.zeros(1, dtype=np.int_)
         self.fail = np.zeros(n + 1)
 
-    def run(self, t1: float) -> int:
+    def run(self, t1: float, steps: int = 1 << 20,
+            on_chunk: Callable[[float], None] | None = None) -> int:
+        """Integrate to ``t1`` in calls of at most ``steps`` steps; ``on_chunk(t)`` between
+        calls (progress, a Ctrl-C looked at there: an exception it raises leaves the state,
+        the counters and the samples so far consistent)."""
         lib = integrator_library()
         while True:
             code = int(lib.jd_integrate(
@@ -169,10 +173,12 @@ class Segment:
                 address(self.k0), address(self.g_old), address(self.cnt), address(self.te),
                 self.te.size, address(self.i_eval), address(self.out_t), address(self.out_x),
                 address(self.out_dx), self.out_t.size, address(self.n_out), address(self.ev_t),
-                address(self.ev_x), address(self.ev_i), 1, address(self.n_ev), 1 << 20,
+                address(self.ev_x), address(self.ev_i), 1, address(self.n_ev), steps,
                 address(self.fail)))
             if code != _CONTINUE:  # else the step budget of one call used
                 return code
+            if on_chunk is not None:
+                on_chunk(float(self.st[0]))
 
 
 @overload
