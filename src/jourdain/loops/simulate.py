@@ -1,8 +1,12 @@
-"""Simulation of closed-loop systems on the constraint manifold (coordinate partitioning).
+"""Simulation of closed systems on the constraint manifold (coordinate partitioning):
+:func:`simulate_closed` is what :meth:`jourdain.System.simulate` and :func:`jourdain.simulate`
+call for a system with closing joints; it returns the one :class:`jourdain.Results`.
 
-The state is the independent ``(y, ẏ)``; at every evaluation the dependent coordinates are
-solved by Newton on ``Φ(y, d, t) = 0`` (to ``|Φ| ≲ 1e-13·scale``, warm-started from the last
-solution plus the first-order prediction along the manifold) and the dependent rates from
+The state is the independent ``(y, ẏ)`` (here ``z`` names the tree's coordinates, ``y`` the
+independent ones); at every evaluation the dependent coordinates are solved by Newton on
+``Φ(y, d, t) = 0`` (stopped by a backward error per row, independent of the units of length:
+:meth:`LoopEvaluator.solve_positions`; warm-started from the last solution plus the
+first-order prediction along the manifold) and the dependent rates from
 ``Φ̇ = 0`` by a linear solve with ``Φ_d``, so every reported state lies on the manifold to
 rounding, whatever the integrator's error: the error of the integration is an error *along*
 the manifold (in y), never a drift off it. ``ÿ`` comes from ``M(y, ẏ, t)·ÿ = q − k`` in the
