@@ -14,6 +14,7 @@ import pytest
 import symengine as se
 from scipy.integrate import solve_ivp
 
+import jourdain as jd
 from jourdain.errors import ModelError
 from jourdain.io.modelfile import ModelFileError, loads_model
 from jourdain.loops import ClosingJoint, LoopEvaluator, evaluate
@@ -454,9 +455,16 @@ def test_cli_check_and_run_on_the_four_bar(tmp_path: Path, capsys: pytest.Captur
     # the one report of trees and closed systems (io.report; tests/test_closed_report.py)
     for f in ("report.html", "simulation.csv", "loops.csv", "wrench-closure.csv"):
         assert (out / f).stat().st_size > 0
-    # the tree-only commands refuse a loop model instead of ignoring its closing joints
-    assert main(["simulate", str(EXAMPLES / "four_bar.toml")]) != 0
-    assert "closing joints closure" in capsys.readouterr().err
+    # jourdain simulate integrates the closed system, not its open tree
+    csv = tmp_path / "fb.csv"
+    assert main(["simulate", str(EXAMPLES / "four_bar.toml"), "--t-end", "0.5", "--out",
+                 str(csv)]) == 0
+    capsys.readouterr()
+    mf = jd.load_model(EXAMPLES / "four_bar.toml")
+    ref = mf.system.simulate((0.0, 0.5), list(mf.simulation.y0), list(mf.simulation.yd0),
+                             t_eval=np.linspace(0.0, 0.5, mf.simulation.samples))
+    kept = jd.Results.load(csv)
+    assert np.allclose(kept.y[-1], ref.y[-1], rtol=1e-12, atol=1e-12)
 
 
 def test_spatial_rssr_with_a_spherical_closing_joint() -> None:

@@ -16,6 +16,7 @@ from scipy.linalg.lapack import dgetrs as getrs
 from scipy.linalg.lapack import dpotrf as potrf
 from scipy.linalg.lapack import dpotrs as potrs
 
+from ..errors import warn
 from ..numeric import _vector, mkq_function, parameter_vector, time_value
 from ..numeric import evaluate as tree_evaluate
 from .partitioning import Partition, _cond, _rank_tol, partition
@@ -300,8 +301,8 @@ class LoopEvaluator:
         ``Φ = 0`` with the independent coordinates of ``z0`` held, then ``ż`` from the
         independent rates of ``zd0`` (``Φ̇ = 0``). The residuals left are reported."""
         names = self.loop.coordinate_names
-        z0 = _vector(z0, self.n, "z0", names)
-        zd0 = np.zeros(self.n) if zd0 is None else _vector(zd0, self.n, "zd0",
+        z0 = _vector(z0, self.n, "y", names)
+        zd0 = np.zeros(self.n) if zd0 is None else _vector(zd0, self.n, "yd",
                                                             [f"{c}_d" for c in names])
         ind = list(self.part.independent)
         self.z_guess = z0.copy()
@@ -313,6 +314,7 @@ class LoopEvaluator:
         self.z_guess = z
         J_z, zd_r, _ = self.velocity_map(cd["Phi_z"], cd["Phi_t"])
         zd = J_z @ zd0[ind] + zd_r
+        _warn_dropped_rates(self, zd0, zd)
         c2 = self._con(z, zd, t)
         Phi = float(np.max(np.abs(c2["Phi"])))
         Phi_dot = float(np.max(np.abs(c2["Phi_z"] @ zd + c2["Phi_t"][:, 0])))
@@ -323,6 +325,24 @@ class LoopEvaluator:
         Pz = self._con(np.asarray(z, dtype=float), np.zeros(self.n), t)["Phi_z"]
         s = np.linalg.svd(Pz, compute_uv=False)
         return int(np.sum(s > _rank_tol(Pz) * 1e3))
+
+
+def _warn_dropped_rates(ev: LoopEvaluator, given: np.ndarray, assembled: np.ndarray) -> None:
+    """A warning where rates given for dependent coordinates are not those of the assembled
+    motion: they follow from the independent rates (held), so a different value the user gave
+    would otherwise be dropped without a word (zeros are taken as "not given")."""
+    dep = list(ev.part.dependent)
+    scale = float(np.max(np.abs(assembled), initial=0.0)) + float(
+        np.max(np.abs(given), initial=0.0))
+    off = [j for j in dep if given[j] != 0.0
+           and abs(given[j] - assembled[j]) > math.sqrt(EPS) * max(scale, 1e-300)]
+    if off:
+        names = ev.loop.coordinate_names
+        pairs = ", ".join(f"{names[j]}_d = {given[j]:.6g} (assembled {assembled[j]:.6g})"
+                          for j in off)
+        warn(f"{ev.loop.name}: the rates of the dependent coordinates follow from those of the "
+             f"independent ones ({', '.join(ev.independent_names)}), held as given: {pairs}; "
+             "choose the independent coordinates ([loops] independent) to hold others")
 
 
 def evaluate(loop: System, z: Any, zd: Any = None, t: float = 0.0,
