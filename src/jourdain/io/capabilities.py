@@ -309,9 +309,8 @@ def simulate(model: ModelFile, parameters: Mapping[str, float] | None = None,
     input name: a number or an expression in t and the parameters) replace the model's values
     they name. ``progress`` and ``output`` (a results file written as the run goes) are passed
     to :func:`jourdain.simulation.simulate.simulate`; a closed system's run writes ``output``
-    whole at its end (:meth:`Results.save`; the motion up to a singular position or an
-    interruption included). The options are checked against the bounds of
-    :mod:`jourdain.simulation.simulate` before anything is computed (:class:`EvaluationError`).
+    whole at its end or on an interruption (:func:`jourdain.loops.simulate.simulate_closed`).
+    The options are checked against the bounds of :mod:`jourdain.simulation.simulate` before anything is computed (:class:`EvaluationError`).
     """
     system = model.system
     sim = model.simulation
@@ -334,19 +333,13 @@ def simulate(model: ModelFile, parameters: Mapping[str, float] | None = None,
             raise EvaluationError(f'inputs: "{name}" is not an input of the model; inputs are '
                                   f"{', '.join(system.input_names) or '(none)'}")
         laws[name] = v
-    options: dict[str, Any] = {"progress": progress,
-                               "output": None if output is None else str(output)}
-    if system.closing:  # the file whole at the end; no progress passed where none is shown
-        options = {k: v for k, v in options.items() if k != "output" and v}
-    res = system.simulate((0.0, t1), [y[c] for c in coords], [yd[c] for c in coords],
-                          parameters=dict(parameters or {}) or None,
-                          inputs=laws or None, method=method or sim.method,
-                          rtol=sim.rtol if rtol is None else rtol,
-                          atol=sim.atol if atol is None else atol,
-                          t_eval=np.linspace(0.0, t1, n), **options)
-    if system.closing and output is not None:
-        res.save(output)
-    return res
+    return system.simulate((0.0, t1), [y[c] for c in coords], [yd[c] for c in coords],
+                           parameters=dict(parameters or {}) or None,
+                           inputs=laws or None, method=method or sim.method,
+                           rtol=sim.rtol if rtol is None else rtol,
+                           atol=sim.atol if atol is None else atol,
+                           t_eval=np.linspace(0.0, t1, n), progress=progress,
+                           output=None if output is None else str(output))
 
 
 def write_csv(results: Any, system: Any, path: Path) -> Path:
