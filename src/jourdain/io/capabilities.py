@@ -310,7 +310,8 @@ def simulate(model: ModelFile, parameters: Mapping[str, float] | None = None,
     they name. ``progress`` and ``output`` (a results file written as the run goes) are passed
     to :func:`jourdain.simulation.simulate.simulate`; a closed system's run writes ``output``
     whole at its end or on an interruption (:func:`jourdain.loops.simulate.simulate_closed`).
-    The options are checked against the bounds of :mod:`jourdain.simulation.simulate` before anything is computed (:class:`EvaluationError`).
+    The options are checked against the bounds of :mod:`jourdain.simulation.simulate` before
+    anything is computed (:class:`EvaluationError`).
     """
     system = model.system
     sim = model.simulation
