@@ -83,10 +83,10 @@ def simulation_section(run: Run) -> str:
                 driven = prescribed_joints(system)
                 why = (f" (with the work W_drive of the prescribed motion of "
                        f"{', '.join(driven)})" if driven else "")
-                if system.closing:  # the run's W_nc: ∫ẏᵀq dt over the output samples
-                    why += (" (a closed system's W_nc is integrated over the output samples "
-                            "by the trapezoidal rule, which bounds this balance; total "
-                            f"energy drift {res.energy_drift:.2e})")
+                if system.closing:  # the run's W: ∫ẏᵀq dt over the interpolated samples
+                    why += (" (a closed system's work of the applied forces is integrated "
+                            "over the output samples' quintic interpolation, three Gauss "
+                            "points per step)")
                 s.append(f"<p class='meta'>energy balance error (relative): "
                          f"{res.energy_balance_error:.2e}{esc(why)}</p>")
                 info.summary_lines.append(
