@@ -159,12 +159,14 @@ def floquet(lin: Linearization | CompiledLinearization, period: float, t0: float
 
     from ..errors import refuse_closed
 
+    own = getattr(lin, "floquet", None)
+    if callable(own):  # a closed system's linearization about a nominal motion
+        return own(period, t0, parameters, rtol, cyclic)
     refuse_closed(getattr(lin, "system", None) or getattr(getattr(lin, "linearization", None),
                                                           "system", None),
-                  "Floquet analysis needs the linearization about a periodic nominal motion, "
-                  "which closed systems do not give yet (their linearization is about one "
-                  "state)")
-
+                  "Floquet analysis needs the linearization about a periodic nominal motion: "
+                  "linearize the closed system about expressions of t for its independent "
+                  "coordinates (its linearization about a state has no period)")
 
     T = float(period)
     if not np.isfinite(T) or T <= 0:
