@@ -223,8 +223,13 @@ def test_linearize_eigenvalues_equal_system_linearize(capsys: pytest.CaptureFixt
     code, out, err = run(capsys, "linearize", path)
     assert code == 0, err
     assert "M_tilde" in out and "stability:" in out and "eigenvalues" in out
-    code, out, err = run(capsys, "linearize", path, "--periodic", "2")
-    assert code == 1 and "periodic linearization (Floquet) of closed systems" in err
+    # --periodic: the Floquet analysis about the same equilibrium, whose multipliers are the
+    # exponentials of the eigenvalues over the period (a time-invariant system)
+    code, out, err = run(capsys, "linearize", path, "--periodic", "2", "--json")
+    assert code == 0, err
+    fl = json.loads(out)["floquet"]
+    mu = np.sort_complex(np.array([complex(*m) for m in fl["multipliers"]]))
+    assert np.max(np.abs(mu - np.sort_complex(np.exp(2.0 * got)))) <= 10 * fl["tolerance"]
     assert "Traceback" not in err
 
 

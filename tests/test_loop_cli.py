@@ -1,4 +1,4 @@
-"""``jourdain linearize`` and ``jourdain run`` on loop models (jourdain.loops.cli, report):
+"""``jourdain linearize`` and ``jourdain run`` on loop models (jourdain.io.closed_linear, report):
 the linearization in the independent coordinates with the parameters of --set, the fallback
 where the model has no isolated equilibrium, the closing joint's wrench in the report."""
 

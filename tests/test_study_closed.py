@@ -14,7 +14,8 @@ pytest.importorskip("h5netcdf")
 import jourdain as jd  # noqa: E402
 from jourdain.analysis.modes import ZERO_RTOL, _verdict  # noqa: E402
 from jourdain.errors import ClosedSystemError  # noqa: E402
-from jourdain.loops.linearization import equilibrium, linearize_closed  # noqa: E402
+from jourdain.loops.linearization import equilibrium  # noqa: E402
+from jourdain.loops.nominal import linearize_closed  # noqa: E402
 from jourdain.study import load_study, loads_study, run_study  # noqa: E402
 from jourdain.study.linear import VERDICTS  # noqa: E402
 

@@ -36,7 +36,8 @@ def _loop_api():
     numbers used below: the evaluation at an assembled state and the two linearizations (the
     central differences System.linearize uses, and the exact one)."""
     import jourdain as jd
-    from jourdain.loops.linearization import linearize_closed, linearize_loop_exact
+    from jourdain.loops.linearization import linearize_loop_exact
+    from jourdain.loops.nominal import linearize_closed
 
     x, y = jd.symbols("x y")
     m, g, l = jd.symbols("m g l")

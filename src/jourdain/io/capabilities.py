@@ -69,7 +69,7 @@ def linearization_at(model: ModelFile, y: Any, yd: Any, t: float,
     state assembled from (y, ẏ), ÿ_s = 0)."""
     system = model.system
     if system.closing:
-        from ..loops.cli import closed_linearization_at  # SciPy's linear algebra: loops only
+        from .closed_linear import closed_linearization_at  # SciPy's linear algebra: loops only
 
         return closed_linearization_at(system, y, yd, t, parameters, inputs)
     with warnings.catch_warnings():
@@ -109,8 +109,8 @@ def linear_analysis(model: ModelFile, about: str | None,
     ``nominal_check`` and the stability verdict, which the text and the report show.
     """
     system = model.system
-    if system.closing:  # in the independent coordinates (jourdain.loops.cli)
-        from ..loops.cli import closed_linear_analysis
+    if system.closing:  # in the independent coordinates (jourdain.io.closed_linear)
+        from .closed_linear import closed_linear_analysis
 
         return closed_linear_analysis(model, about, parameters, t, period)
     nominal = model.nominal_motion(about)
@@ -198,7 +198,7 @@ def _constant_in_time(lin: Any, params: Mapping[str, float] | None,
 def jsonable(res: Mapping[str, Any]) -> dict[str, Any]:
     """The result of :func:`linear_analysis` as JSON-ready data."""
     if res.get("closed"):
-        from ..loops.cli import closed_jsonable
+        from .closed_linear import closed_jsonable
 
         return closed_jsonable(res)
     out: dict[str, Any] = {
@@ -249,7 +249,7 @@ def _finite_list(a: Any) -> list[float | None]:
 def linear_text(res: Mapping[str, Any]) -> str:
     """A plain-text account of :func:`linear_analysis`."""
     if res.get("closed"):
-        from ..loops.cli import closed_linear_text
+        from .closed_linear import closed_linear_text
 
         return closed_linear_text(res)
     lin = res["linearization"]

@@ -15,7 +15,7 @@ functions of y, which exist only implicitly.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from functools import lru_cache
 from typing import Any
 
@@ -211,89 +211,3 @@ def equilibrium(loop: System, z_guess: Any, t: float = 0.0,
 
 
 __all__ = ["LoopLinearization", "equilibrium", "linearize_loop", "linearize_loop_exact"]
-
-
-def _time_variant(system: System, lin: LoopLinearization, y: np.ndarray, yd: np.ndarray,
-                  ydd: Any, parameters: Mapping[str, float] | None) -> bool:
-    """Whether M̃, P, Q change with t at the state held (tested at two more times, as the
-    numeric linearization of trees does where t appears)."""
-    for t in (0.318309886, 1.2732395447):
-        other = linearize_loop(system, lin.z_s, yd, t, ydd, parameters)
-        for a, b in ((lin.M_tilde, other.M_tilde), (lin.P, other.P), (lin.Q, other.Q)):
-            if a.shape != b.shape:
-                return True
-            scale = max(1.0, float(np.abs(a).max(initial=0.0)))
-            if np.abs(a - b).max(initial=0.0) > 1e-8 * scale:
-                return True
-    return False
-
-
-def _is_motion(v: Any) -> bool:
-    """A nominal value that is an expression (of t and the parameters), not a number."""
-    if isinstance(v, se.Basic):
-        return not v.is_Number
-    return False
-
-
-def linearize_closed(system: System, nominal: Any, inputs: Mapping[str, float] | None = None,
-                     parameters: Mapping[str, float] | None = None) -> LoopLinearization:
-    """:meth:`jourdain.System.linearize` of a closed system about the state ``nominal``: a
-    mapping ``{coordinate: value, "<coordinate>_d": rate, "<coordinate>_dd": acceleration}``
-    (constant numbers; coordinates left out are 0 and assembled) or the f tree coordinates.
-    Expressions of t and the parameters for the independent coordinates give the
-    linearization about that nominal motion
-    (:class:`jourdain.loops.periodic.ClosedLinearization`, with its Floquet analysis)."""
-    from ..errors import ClosedSystemError
-
-    if inputs:
-        raise ClosedSystemError(system, "a linearization with nominal inputs is not available "
-                                "for closed systems yet")
-    names = system.coordinate_names
-    f = system.f
-    y, yd = np.zeros(f), np.zeros(f)
-    ydd: Any = None
-    if isinstance(nominal, Mapping) and any(_is_motion(v) for v in nominal.values()):
-        from .periodic import linearize_along  # a nominal motion, expressions of t
-
-        return linearize_along(system, nominal, parameters)  # type: ignore[return-value]
-    if isinstance(nominal, Mapping):
-        acc: dict[str, float] = {}
-        for k, v in nominal.items():
-            key = str(k)
-            try:
-                val = float(v)
-            except (TypeError, ValueError):
-                raise ClosedSystemError(system, f"the nominal value of {key} is {v!r}: closed "
-                                        "systems are linearized about a state (numbers), not "
-                                        "a motion given by expressions, yet") from None
-            if key in names:
-                y[names.index(key)] = val
-            elif key.endswith("_dd") and key[:-3] in names:
-                acc[key[:-3]] = val
-            elif key.endswith("_d") and key[:-2] in names:
-                yd[names.index(key[:-2])] = val
-            else:
-                raise EvaluationError(f'nominal: unknown coordinate "{key}"; coordinates are '
-                                      f"{', '.join(names)}")
-        if acc:
-            ydd = acc
-    else:
-        y = np.asarray(nominal, dtype=float).reshape(-1)
-        if y.size != f:
-            raise EvaluationError(f"nominal: {f} coordinates expected ({', '.join(names)}), "
-                                  f"got {y.size}")
-    if isinstance(ydd, dict):  # accelerations of the independent coordinates, by name
-        ev = LoopEvaluator(system, y, 0.0, parameters)
-        ydd = np.array([ydd.get(c, 0.0) for c in ev.independent_names])
-    lin = linearize_loop(system, y, yd, 0.0, ydd, parameters)
-    if isinstance(nominal, Mapping) and not any(k.endswith("_d") for k in map(str, nominal)) \
-            and _time_variant(system, lin, y, yd, ydd, parameters):
-        # a rheonomic system (a prescribed motion, an excitation in t): the matrices change
-        # along the nominal state held, a linear time-variant system (its Floquet analysis)
-        from .periodic import linearize_along
-
-        held = {c: se.Float(float(v)) for c, v in zip(names, lin.z_s, strict=True)}
-        return linearize_along(system, held, parameters)  # type: ignore[return-value]
-    pars = system.parameter_values
-    pars.update(dict(parameters or {}))
-    return replace(lin, system=system, parameters=pars)

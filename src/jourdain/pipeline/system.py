@@ -117,7 +117,7 @@ class System(Model):
         G, K, N``, the state matrix ``A`` and its ``eigenvalues`` (central differences of the
         compiled M, k, q on the manifold)."""
         if self.closing:
-            from ..loops.linearization import linearize_closed
+            from ..loops.nominal import linearize_closed
 
             return linearize_closed(self, nominal, inputs)
         return linearization(self.equations_of_motion(), nominal, inputs)

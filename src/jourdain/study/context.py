@@ -49,7 +49,7 @@ class Context:
     #: bodies and joints use ("" where the values passed the checks)
     checked: dict[tuple[float, ...], str] = field(default_factory=dict)
     #: a closed system (closing joints): linearized per case by
-    #: :func:`jourdain.loops.linearization.linearize_closed`, simulated per case by its own
+    #: :func:`jourdain.loops.nominal.linearize_closed`, simulated per case by its own
     #: ``simulate`` (never the open tree)
     closed: bool = False
     #: the independent coordinates of a closed system's linearization (its modes: 2 per name)

@@ -47,7 +47,7 @@ def linearization_numbers(ctx: Context, P: np.ndarray, Y: np.ndarray | None = No
 def closed_linearizations(ctx: Context, P: np.ndarray, Y: np.ndarray | None = None
                           ) -> dict[str, Any]:
     """A closed system's linearization at each row of ``P``, one case at a time, exactly as
-    :func:`jourdain.loops.linearization.linearize_closed` (what ``System.linearize`` calls)
+    :func:`jourdain.loops.nominal.linearize_closed` (what ``System.linearize`` calls)
     gives it for that case's parameters: about the model's nominal state (evaluated at the
     case's parameters), or, with ``about = "equilibrium"``, about the equilibrium
     :func:`jourdain.loops.linearization.equilibrium` finds nearest the case's initial
@@ -55,7 +55,8 @@ def closed_linearizations(ctx: Context, P: np.ndarray, Y: np.ndarray | None = No
     ``Q`` (n, f, f) and the state matrix ``A`` (n, 2f, 2f) in the independent coordinates,
     ``y_s`` (n, tree coordinates: the configuration linearized about) and ``errors`` (row ->
     message; those rows NaN)."""
-    from ..loops.linearization import equilibrium, linearize_closed
+    from ..loops.linearization import equilibrium
+    from ..loops.nominal import linearize_closed
     from .context import FAILURES
 
     n, f, ft = len(P), ctx.f_linear, ctx.system.f

@@ -86,7 +86,8 @@ def linearization_section(run: Run) -> str:
     """Section 4 of a closed system: M̃, P, Q, h, D, G, K, N and the eigenvalues in the
     independent coordinates about the equilibrium nearest the initial configuration (else the
     initial configuration at rest)."""
-    from ...loops.linearization import equilibrium, linearize_closed
+    from ...loops.linearization import equilibrium
+    from ...loops.nominal import linearize_closed
 
     model, out, info = run.model, run.out, run.info
     system = model.system
@@ -137,7 +138,7 @@ def linearization_section(run: Run) -> str:
     s.append(f"<p>Stability: <span class='{'ok' if stable else 'bad'}'>{esc(verdict)}</span>"
              "</p>")
     info.summary_lines.append(f"  linearized about the {about.split(' (')[0]}: {verdict}")
-    from ...loops.cli import linearization_document
+    from ..closed_linear import linearization_document
 
     doc = linearization_document(system, lin, about)
     doc["method"] = ("System.linearize: central differences of the compiled M, k, q in the "

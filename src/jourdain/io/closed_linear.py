@@ -3,7 +3,8 @@ and the report (:func:`jourdain.io.capabilities.linear_analysis` and ``lineariza
 dispatch here): in the independent coordinates, about a nominal state of the model file or
 the equilibrium nearest its initial configuration (:func:`jourdain.loops.linearization.equilibrium`;
 exact: :func:`~jourdain.loops.linearization.linearize_loop_exact`), or about the initial
-configuration at rest where no equilibrium is found nearby (finite differences).
+configuration at rest where no equilibrium is found nearby (finite differences); about a
+periodic nominal motion, its Floquet analysis (:mod:`jourdain.loops.periodic`).
 """
 
 from __future__ import annotations
@@ -14,15 +15,15 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ClosedSystemError, JourdainError
-from ..model import System
-from .linearization import (
+from ..errors import ClosedSystemError, EvaluationError, JourdainError
+from ..loops.linearization import (
     LoopLinearization,
     equilibrium,
-    linearize_closed,
     linearize_loop,
     linearize_loop_exact,
 )
+from ..loops.nominal import linearize_closed
+from ..model import System
 
 
 def linearize_near(loop: System, z0: Any,
@@ -92,13 +93,17 @@ def closed_linear_analysis(model: Any, about: str | None,
     nominal = model.nominal_motion(about) if about is not None else None
     if period is None and nominal is not None:
         period = nominal.period
-    if period is not None:
-        raise ClosedSystemError(system, "periodic linearization (Floquet) of closed systems "
-                                "is not available yet")
     params = dict(parameters or {}) or None
+    if period is not None:
+        return _periodic(system, nominal, model.simulation.y0 or [0.0] * system.f, params, t,
+                         period)
     if nominal is not None:
         mapping = dict(zip(system.coordinate_names, nominal.y, strict=True))
         lin = linearize_closed(system, mapping, dict(nominal.inputs) or None, params)
+        if not isinstance(lin, LoopLinearization):  # time-variant: a periodic analysis only
+            raise ClosedSystemError(system, f'the linearization about "{nominal.name}" changes '
+                                    "with t: give its period (--periodic T, or period = in "
+                                    "the nominal motion) for the Floquet analysis")
         where = f'nominal state "{nominal.name}"'
     else:
         lin, where = linearize_near(system, model.simulation.y0 or [0.0] * system.f, params)
@@ -116,16 +121,66 @@ def closed_linear_analysis(model: Any, about: str | None,
             "floquet": None, "nominal_check": None}
 
 
+def _periodic(system: System, nominal: Any, y0: Any, params: Mapping[str, float] | None,
+              t: float, period: Any) -> dict[str, Any]:
+    """The Floquet analysis of the closed ``system`` about the ``nominal`` motion (None: the
+    equilibrium nearest ``y0``) over ``period`` (a number, or an expression in the parameters)
+    from ``t``."""
+    import symengine as se
+
+    from ..analysis.floquet import floquet
+    from ..loops.periodic import ClosedLinearization
+
+    values = {**system.parameter_values, **dict(params or {})}
+    try:
+        T = float(se.sympify(period).subs({se.Symbol(k): v for k, v in values.items()}))
+    except (RuntimeError, TypeError, ValueError) as exc:
+        raise EvaluationError(f"the period {period} has no numeric value: {exc}") from None
+    if nominal is not None:
+        mapping = dict(zip(system.coordinate_names, nominal.y, strict=True))
+        lin = linearize_closed(system, mapping, dict(nominal.inputs) or None, params)
+        where = f'nominal motion "{nominal.name}"'
+    else:  # the equilibrium nearest the initial configuration, as without --periodic
+        lin, where = linearize_near(system, y0, params)
+    if not isinstance(lin, ClosedLinearization):
+        from ..loops.periodic import linearize_along
+
+        lin = linearize_along(system, {c: se.Float(float(v)) for c, v in
+                                       zip(system.coordinate_names, lin.z_s, strict=True)},
+                              params)
+    fl = floquet(lin, T, t0=t)
+    num = lin.evaluate(t)
+    return {"closed": True, "periodic": True, "system": system, "linearization": lin,
+            "about": where, "nominal": nominal,
+            "numbers": {k: num[k] for k in ("M_tilde", "P", "Q", "h")},
+            "time_invariant": False, "t": t, "conservative": None,
+            "h_norm": float(np.abs(num["h"]).max(initial=0.0)), "cyclic": (), "modes": None,
+            "stability": None, "floquet": fl, "nominal_check": None, "period": T}
+
+
 def closed_jsonable(res: Mapping[str, Any]) -> dict[str, Any]:
     """:func:`closed_linear_analysis` as JSON-ready data: the keys of a tree's
     (:func:`jourdain.io.capabilities.jsonable`: ``matrices``, ``eigenvalues``,
     ``natural_frequencies_hz``, ``damping_ratios``, ``stability``, ...) and those of
     :func:`linearization_document` (``independent``, ``about``, ``z_s``, ``M_tilde`` ...
     ``N``, ``frequencies_hz``, ``stable``, ``method``)."""
-    m, s = res["modes"], res["stability"]
-
     def finite(a: Any) -> list[float | None]:
         return [float(x) if np.isfinite(x) else None for x in np.asarray(a, float)]
+    if res.get("periodic"):
+        fl = res["floquet"]
+        lin = res["linearization"]
+        return {
+            "model": res["system"].name, "about": res["about"], "independent": list(lin.names),
+            "nominal": res["nominal"].name if res["nominal"] is not None else None,
+            "t": res["t"], "time_invariant": False,
+            "h_norm": res["h_norm"], "period": res["period"],
+            "matrices": {k: np.asarray(v, float).tolist() for k, v in res["numbers"].items()},
+            "floquet": {"multipliers": [[float(v.real), float(v.imag)]
+                                        for v in fl.multipliers],
+                        "verdict": fl.verdict, "reason": fl.reason,
+                        "tolerance": fl.tolerance, "state_names": list(fl.state_names)},
+        }
+    m, s = res["modes"], res["stability"]
     out: dict[str, Any] = {
         "nominal": res["nominal"].name if res["nominal"] is not None else None,
         "t": res["t"], "time_invariant": True, "conservative": res["conservative"],
@@ -144,10 +199,18 @@ def closed_jsonable(res: Mapping[str, Any]) -> dict[str, Any]:
 def closed_linear_text(res: Mapping[str, Any]) -> str:
     """A plain-text account of :func:`closed_linear_analysis`, in the order of a tree's
     (:func:`jourdain.io.capabilities.linear_text`)."""
-    from ..io.export import format_array
+    from .export import format_array
 
     doc = closed_jsonable(res)
     num = res["numbers"]
+    if res.get("periodic"):
+        head = [f"{doc['model']}: linearized in the independent coordinates "
+                f"{', '.join(doc['independent'])} about the {doc['about']} (time-variant; "
+                f"numbers at t = {res['t']:g})"]
+        for k in ("M_tilde", "P", "Q", "h"):
+            head.append(f"\n{k} =\n{format_array(num[k])}")
+        head.append(f"\nFloquet analysis over T = {res['period']:.6g}:\n{res['floquet']}")
+        return "\n".join(head)
     lines = [f"{doc['model']}: linearized in the independent coordinates "
              f"{', '.join(doc['independent'])} about the {doc['about']}",
              "  y_s = " + ", ".join(f"{k} = {v:.6g}" for k, v in doc["z_s"].items()),

@@ -1,0 +1,106 @@
+"""The linearization of a closed system about the nominal state or motion its user gives
+(:meth:`jourdain.System.linearize` of a system with closing joints): about a state, a
+:class:`jourdain.loops.linearization.LoopLinearization` in the independent coordinates
+(time-invariant); about a motion (expressions of t) or a state held in a rheonomic system, a
+time-variant :class:`jourdain.loops.periodic.ClosedLinearization` with its Floquet analysis."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+import symengine as se
+
+from ..errors import EvaluationError
+from ..model import System
+from .closed_loop import LoopEvaluator
+from .linearization import LoopLinearization, linearize_loop
+from .periodic import ClosedLinearization, linearize_along
+
+
+def _time_variant(system: System, lin: LoopLinearization, y: np.ndarray, yd: np.ndarray,
+                  ydd: Any, parameters: Mapping[str, float] | None) -> bool:
+    """Whether M̃, P, Q change with t at the state held (tested at two more times, as the
+    numeric linearization of trees does where t appears)."""
+    for t in (0.318309886, 1.2732395447):
+        other = linearize_loop(system, lin.z_s, yd, t, ydd, parameters)
+        for a, b in ((lin.M_tilde, other.M_tilde), (lin.P, other.P), (lin.Q, other.Q)):
+            if a.shape != b.shape:
+                return True
+            scale = max(1.0, float(np.abs(a).max(initial=0.0)))
+            if np.abs(a - b).max(initial=0.0) > 1e-8 * scale:
+                return True
+    return False
+
+
+def _is_motion(v: Any) -> bool:
+    """A nominal value that is an expression (of t and the parameters), not a number."""
+    if isinstance(v, se.Basic):
+        return not v.is_Number
+    return False
+
+
+def linearize_closed(system: System, nominal: Any, inputs: Mapping[str, float] | None = None,
+                     parameters: Mapping[str, float] | None = None
+                     ) -> LoopLinearization | ClosedLinearization:
+    """:meth:`jourdain.System.linearize` of a closed system about the state ``nominal``: a
+    mapping ``{coordinate: value, "<coordinate>_d": rate, "<coordinate>_dd": acceleration}``
+    (constant numbers; coordinates left out are 0 and assembled) or the f tree coordinates.
+    Expressions of t and the parameters for the independent coordinates give the
+    linearization about that nominal motion
+    (:class:`jourdain.loops.periodic.ClosedLinearization`, with its Floquet analysis)."""
+    from ..errors import ClosedSystemError
+
+    if inputs:
+        raise ClosedSystemError(system, "a linearization with nominal inputs is not available "
+                                "for closed systems yet")
+    names = system.coordinate_names
+    f = system.f
+    y, yd = np.zeros(f), np.zeros(f)
+    ydd: Any = None
+    if isinstance(nominal, Mapping) and any(_is_motion(v) for v in nominal.values()):
+        return linearize_along(system, nominal, parameters)  # a motion: expressions of t
+    if isinstance(nominal, Mapping):
+        acc: dict[str, float] = {}
+        for k, v in nominal.items():
+            key = str(k)
+            try:
+                val = float(v)
+            except (TypeError, ValueError):
+                raise ClosedSystemError(system, f"the nominal value of {key} is {v!r}: closed "
+                                        "systems are linearized about a state (numbers), not "
+                                        "a motion given by expressions, yet") from None
+            if key in names:
+                y[names.index(key)] = val
+            elif key.endswith("_dd") and key[:-3] in names:
+                acc[key[:-3]] = val
+            elif key.endswith("_d") and key[:-2] in names:
+                yd[names.index(key[:-2])] = val
+            else:
+                raise EvaluationError(f'nominal: unknown coordinate "{key}"; coordinates are '
+                                      f"{', '.join(names)}")
+        if acc:
+            ydd = acc
+    else:
+        y = np.asarray(nominal, dtype=float).reshape(-1)
+        if y.size != f:
+            raise EvaluationError(f"nominal: {f} coordinates expected ({', '.join(names)}), "
+                                  f"got {y.size}")
+    if isinstance(ydd, dict):  # accelerations of the independent coordinates, by name
+        ev = LoopEvaluator(system, y, 0.0, parameters)
+        ydd = np.array([ydd.get(c, 0.0) for c in ev.independent_names])
+    lin = linearize_loop(system, y, yd, 0.0, ydd, parameters)
+    if isinstance(nominal, Mapping) and not any(k.endswith("_d") for k in map(str, nominal)) \
+            and _time_variant(system, lin, y, yd, ydd, parameters):
+        # a rheonomic system (a prescribed motion, an excitation in t): the matrices change
+        # along the nominal state held, a linear time-variant system (its Floquet analysis)
+        held = {c: se.Float(float(v)) for c, v in zip(names, lin.z_s, strict=True)}
+        return linearize_along(system, held, parameters)
+    pars = system.parameter_values
+    pars.update(dict(parameters or {}))
+    return replace(lin, system=system, parameters=pars)
+
+
+__all__ = ["linearize_closed"]
