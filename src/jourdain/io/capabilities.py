@@ -19,6 +19,7 @@ from ..analysis.cyclic import cyclic_coordinates
 from ..analysis.floquet import floquet
 from ..analysis.numeric_linearization import linearize_numeric
 from ..errors import EvaluationError
+from ..pipeline.system import tree_linearization
 from ..simulation.simulate import check_samples, check_t_end
 from ..stages.linearization import NominalMotionWarning
 from .export import format_array
@@ -117,7 +118,7 @@ def linear_analysis(model: ModelFile, about: str | None,
     params = dict(parameters or {}) or None
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", NominalMotionWarning)
-        lin = system.linearize(nominal_mapping(system, nominal))
+        lin = tree_linearization(system.linearize(nominal_mapping(system, nominal)))
         num = lin.evaluate(t=t, parameters=params)
         check = lin.check_nominal(t, params)
         res = _analyse(lin, num, check, params, t)

@@ -148,7 +148,7 @@ def _periodic(system: System, nominal: Any, y0: Any, params: Mapping[str, float]
         lin = linearize_along(system, {c: se.Float(float(v)) for c, v in
                                        zip(system.coordinate_names, lin.z_s, strict=True)},
                               params)
-    fl = floquet(lin, T, t0=t)
+    fl = floquet(lin, T, t0=t)  # type: ignore[arg-type]  # its own floquet method
     num = lin.evaluate(t)
     return {"closed": True, "periodic": True, "system": system, "linearization": lin,
             "about": where, "nominal": nominal,

@@ -58,7 +58,7 @@ def closed_reactions(system: System, s: Mapping[str, Any], lam: np.ndarray | Non
     q0 = Qt.shape[1]
     if keep:
         args = state_vectors(system.tree, s["z"], s["zd"], t, parameters,
-                             u if len(system.inputs) else None)
+                             list(u) if len(system.inputs) else None)
         Qc = np.asarray(fn(*args)["Q_c"]).reshape(Qt.shape[0], len(keep))
     else:
         Qc = np.zeros((Qt.shape[0], 0))
@@ -111,7 +111,7 @@ def evaluate_closed(system: System, y: Any, yd: Any, t: float = 0.0,
     ind = list(ev.part.independent)
     s = ev.accelerations(asm.z[ind], asm.zd[ind], tv)
     lam = ev.multipliers(s)
-    tree = tree_evaluate(tree_sys, s["z"], s["zd"], tv, parameters, uv if names else None)
+    tree = tree_evaluate(tree_sys, s["z"], s["zd"], tv, parameters, list(uv) if names else None)
     L = s["J_z"]
     con = ev._con(s["z"], s["zd"], tv)
     out: dict[str, Any] = {
@@ -161,7 +161,7 @@ def closed_reactions_along(system: System, res: Any) -> tuple[np.ndarray, list[s
     for i in range(n):
         u = res.u[i] if res.u.shape[1] else np.zeros(0)
         tree = tree_evaluate(tree_sys, res.y[i], res.yd[i], float(res.t[i]), params,
-                             u if len(system.inputs) else None)
+                             list(u) if len(system.inputs) else None)
         s = {"z": res.y[i], "zd": res.yd[i], "zdd": res.ydd[i]}
         r = closed_reactions(system, s, lam[i], float(res.t[i]), params, u, tree)
         names = r["g_names"]

@@ -7,11 +7,13 @@ errors name the file, line and key like every other section). The syntax is docu
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, TypeVar
 
 from ..errors import ModelError
 from ..model import System
 from ..model.closing import KINDS, ClosingJoint
+
+_S = TypeVar("_S", bound=System)
 
 #: keys of a [closing_joints.<name>] table, by its type
 _KEYS: dict[str, set[str]] = {
@@ -25,7 +27,7 @@ _KEYS: dict[str, set[str]] = {
 }
 
 
-def read_loops(loader: Any, data: dict, system: System) -> System:
+def read_loops(loader: Any, data: dict, system: _S) -> _S:
     """The tree ``system`` closed by the file's closing joints (itself without any).
 
     ``loader`` is :class:`jourdain.io.modelfile._Loader` (its typed accessors locate errors).

@@ -103,4 +103,20 @@ def linearize_closed(system: System, nominal: Any, inputs: Mapping[str, float] |
     return replace(lin, system=system, parameters=pars)
 
 
-__all__ = ["linearize_closed"]
+
+def linearize_state(system: System, nominal: Any,
+                    parameters: Mapping[str, float] | None = None) -> LoopLinearization:
+    """:func:`linearize_closed` about a state, where a time-invariant result is needed (a
+    stability map, the report's eigenvalues): ClosedSystemError when the closed system's
+    linearization there changes with t (judge it by its Floquet analysis instead)."""
+    from ..errors import ClosedSystemError
+
+    lin = linearize_closed(system, nominal, None, parameters)
+    if not isinstance(lin, LoopLinearization):
+        raise ClosedSystemError(system, "its linearization changes with t (a prescribed motion "
+                                "or an excitation): eigenvalues at one instant decide nothing; "
+                                "use the Floquet analysis over a period")
+    return lin
+
+
+__all__ = ["linearize_closed", "linearize_state"]

@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, fields
+from typing import Self
 
 import symengine as se
 
@@ -162,7 +163,7 @@ class System:
         return bool(self.closing)
 
     @property
-    def tree(self) -> System:
+    def tree(self) -> Self:
         """The open tree: the same bodies, joints, forces and parameters without the closing
         joints (the system itself when it has none), of the same class."""
         if not self.closing:
@@ -175,7 +176,7 @@ class System:
         return tree
 
     def closed_by(self, closing: Sequence[ClosingJoint], independent: Sequence[str] | None = None,
-                  name: str | None = None) -> System:
+                  name: str | None = None) -> Self:
         """This tree closed by the ``closing`` joints (a new system of the same class), with
         the ``independent`` coordinates chosen (else by the partition at the initial
         configuration)."""

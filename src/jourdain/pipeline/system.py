@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import threading
 from collections.abc import Callable, Mapping, Sequence
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 
@@ -29,6 +29,10 @@ from ..stages.kinematics import Kinematics, kinematics
 from ..stages.newton_euler import NewtonEuler, newton_euler
 from ..stages.projection import EquationsOfMotion, projection
 from ..stages.reactions import Reactions, reactions
+
+if TYPE_CHECKING:  # a closed system's linearizations (jourdain.loops loads SciPy: not here)
+    from ..loops.linearization import LoopLinearization
+    from ..loops.periodic import ClosedLinearization
 
 _T = TypeVar("_T")
 _LOCKS = threading.Lock()  # guards the creation of the per-system locks
@@ -103,7 +107,8 @@ class System(Model):
         return self._stage("_reactions", lambda: reactions(self.newton_euler()))
 
     def linearize(self, nominal: Mapping[Any, Any] | Any,
-                  inputs: Mapping[Any, Any] | None = None) -> Linearization:
+                  inputs: Mapping[Any, Any] | None = None
+                  ) -> Linearization | LoopLinearization | ClosedLinearization:
         """Linearization M̃·η̈ + P·η̇ + Q·η = h + B·Δu about a nominal motion (METHOD §5), with
         nominal ``inputs`` ``{input: u_s}`` where given (zero otherwise); see
         :func:`jourdain.stages.linearization.linearization`. The result has its numbers as
@@ -170,3 +175,12 @@ class System(Model):
                         method=DEFAULT_METHOD if method is None else method,
                         rtol=DEFAULT_RTOL if rtol is None else rtol,
                         atol=DEFAULT_ATOL if atol is None else atol, t_eval=t_eval, **options)
+
+
+def tree_linearization(lin: Linearization | LoopLinearization | ClosedLinearization
+                       ) -> Linearization:
+    """``lin`` as the symbolic linearization of a tree (what :meth:`System.linearize` gives a
+    system without closing joints), for code on the tree's path after its closed branch."""
+    if not isinstance(lin, Linearization):
+        raise TypeError(f"expected a tree's Linearization, got {type(lin).__name__}")
+    return lin

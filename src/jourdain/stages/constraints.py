@@ -65,7 +65,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import symengine as se
 
@@ -146,7 +146,7 @@ def constraint_rows(kin: Kinematics, closing: Sequence[ClosingJoint]) -> list[Co
         rB, SB = frame(cj.body_b)
         pA = tuple(rA[i] + _mv(SA, cj.point_a)[i] for i in range(3))
         pB = tuple(rB[i] + _mv(SB, cj.point_b)[i] for i in range(3))
-        at = {"body_a": cj.body_a, "body_b": cj.body_b, "p_a": pA, "p_b": pB}
+        at: dict[str, Any] = {"body_a": cj.body_a, "body_b": cj.body_b, "p_a": pA, "p_b": pB}
         ex = _IDENT
         if cj.type in ("spherical", "revolute", "universal"):
             d = _sub(pA, pB)
@@ -250,7 +250,7 @@ def _wrench_columns(kin: Kinematics, rows: Sequence[ConstraintRow]) -> SymMatrix
                         col[3 * i + k] += sign * e[k]
                 else:
                     torque = e
-                tb = _mv(St, torque)
+                tb = _mv(St, torque)  # type: ignore[arg-type]  # 3×3
                 for k in range(3):
                     col[3 * p + 3 * i + k] += sign * tb[k]
         cols.append([se.expand(c) if c != 0 else zero for c in col])

@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import JourdainError
+from ..pipeline.system import tree_linearization
 from .spec import StudyError, StudySpec
 
 __all__ = ["EQUILIBRIUM", "FAILURES", "Context", "case_arrays", "context", "forget_contexts", "record_errors"]
@@ -124,7 +125,8 @@ def _build(spec: StudySpec) -> Context:
     elif about is not None:
         from ..analysis.modes import _cyclic_of
 
-        lin = system.linearize(nominal_mapping(system, model.nominal_motion(about)))
+        lin = tree_linearization(system.linearize(nominal_mapping(system,
+                                                                  model.nominal_motion(about))))
         if not lin.is_time_invariant:
             raise StudyError(f'{spec.filename}: the linearization about "{about}" is '
                              f"time-variant ({', '.join(lin.time_dependence)} depend on t): "

@@ -56,7 +56,7 @@ def closed_linearizations(ctx: Context, P: np.ndarray, Y: np.ndarray | None = No
     ``y_s`` (n, tree coordinates: the configuration linearized about) and ``errors`` (row ->
     message; those rows NaN)."""
     from ..loops.linearization import equilibrium
-    from ..loops.nominal import linearize_closed
+    from ..loops.nominal import linearize_state
     from .context import FAILURES
 
     n, f, ft = len(P), ctx.f_linear, ctx.system.f
@@ -76,7 +76,7 @@ def closed_linearizations(ctx: Context, P: np.ndarray, Y: np.ndarray | None = No
                 v = np.asarray(ctx.nominal_state(P[i]), dtype=float).reshape(-1)
                 nominal = {**dict(zip(coords, v[:ft].tolist(), strict=True)),
                            **{f"{c}_d": x for c, x in zip(coords, v[ft:].tolist(), strict=True)}}
-            lin = linearize_closed(ctx.system, nominal, parameters=params)
+            lin = linearize_state(ctx.system, nominal, parameters=params)
             if lin.A.shape != (2 * f, 2 * f):
                 raise ValueError(f"the linearization has {lin.A.shape[0] // 2} independent "
                                  f"coordinates ({', '.join(lin.names)}), the study's "

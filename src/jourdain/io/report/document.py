@@ -179,7 +179,7 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
                                  f"bodies, {summ['constraints']} constrained directions; "
                                  f"M·ÿ + k = q{count}"
                                  + (f"; closed by {', '.join(c.name for c in system.closing)}, "
-                                    f"independent {', '.join(system.independent)}"
+                                    f"independent {', '.join(system.independent or ('auto',))}"
                                     if system.closing else ""))
     for n in info.notes:
         info.summary_lines.append(f"  note: {n}")

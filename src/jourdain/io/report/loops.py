@@ -64,7 +64,7 @@ def assembled_state(run: Run) -> tuple[np.ndarray, np.ndarray]:
 def numbers_rows(run: Run, values: dict[str, np.ndarray], extra: dict[str, Any]) -> list[str]:
     """M, k, q in the independent coordinates, the velocity map L and the reactions."""
     system = run.model.system
-    ind = list(extra.get("independent", system.independent))
+    ind = list(extra.get("independent", system.independent or ()))
     coords = system.coordinate_names
     s = [f"<p>Assembled on Φ = 0, Φ̇ = 0 with the independent coordinates "
          f"{esc(', '.join(ind))} held: "
@@ -87,7 +87,7 @@ def linearization_section(run: Run) -> str:
     independent coordinates about the equilibrium nearest the initial configuration (else the
     initial configuration at rest)."""
     from ...loops.linearization import equilibrium
-    from ...loops.nominal import linearize_closed
+    from ...loops.nominal import linearize_state
 
     model, out, info = run.model, run.out, run.info
     system = model.system
@@ -107,8 +107,8 @@ def linearization_section(run: Run) -> str:
         except JourdainError as exc:
             z_s = y0
             about = f"initial configuration at rest (no equilibrium found nearby: {exc})"
-        lin = linearize_closed(system, dict(zip(system.coordinate_names, z_s, strict=True)),
-                               parameters=params)
+        lin = linearize_state(system, dict(zip(system.coordinate_names, z_s, strict=True)),
+                              parameters=params)
     except (JourdainError, np.linalg.LinAlgError) as exc:
         s.append(note(f"could not linearize: {exc}"))
         info.notes.append(f"linearization: {exc}")

@@ -50,7 +50,8 @@ def model_section(run: Run) -> str:
         s.append(f"<p>Closed by the closing joint(s) {esc(', '.join(c.name for c in system.closing))}"
                  f" (section 6): the {system.f} coordinates of the open tree are bound by "
                  "the loops' constraint equations Φ = 0; independent coordinates: "
-                 f"{esc(', '.join(system.independent))}. The joints below are the tree's; "
+                 f"{esc(', '.join(system.independent or ('chosen at the initial configuration',)))}"
+                 ". The joints below are the tree's; "
                  "the reaction forces of the closing joints are in sections 3, 5 and 6.</p>")
     s.append("<h3>Coordinates</h3>" + html_table(
         [(sym(c), esc(c), esc(units.get(c, "")), esc(desc.get(c, ""))) for c in
@@ -132,7 +133,7 @@ def numbers_section(run: Run) -> str:
                            + next(iter(missing.values()))))
         vj = eval_document(model, y0, yd0, 0.0, pv, u0, values, extra, missing)
         if system.closing:  # the closed system's: M, k, q in these coordinates
-            vj["independent"] = list(extra.get("independent", system.independent))
+            vj["independent"] = list(extra.get("independent", system.independent or ()))
             vj["dependent"] = list(extra.get("dependent", []))
             vj["constraint_labels"] = list(extra.get("constraint_labels", []))
             vj["closure_residual"] = extra.get("closure_residual")

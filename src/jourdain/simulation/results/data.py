@@ -222,8 +222,8 @@ class TimeHistories:
         if system.closing:  # every joint's, the closing joints' included (METHOD.md §7)
             from ...loops.evaluation import closed_reactions_along
 
-            g, names = closed_reactions_along(system, self)
-            self._energies["g"], self._energies["g_names"] = g, names
+            g_closed, names_closed = closed_reactions_along(system, self)
+            self._energies["g"], self._energies["g_names"] = g_closed, names_closed
             return
         from ...analysis.reactions import _reactions_function, projected_reactions, solve_g
 
