@@ -9,9 +9,9 @@ Simulation of the four-bar over ``T`` seconds from the same consistent state, ea
 error measured against a reference (jourdain at rtol 1e-13) at the end, each the best of
 ``--repeat`` runs (IDA one):
 
-* jourdain: coordinate partitioning (``jourdain.loops.simulate.simulate_loop``, DOP853), the
+* jourdain: coordinate partitioning (``System.simulate``, the default formulation, DOP853), the
   compiled right-hand side in jourdain's C integrator, and the same
-  method stepped by SciPy from Python (``engine="scipy"``, "jd+scipy");
+  method stepped by SciPy from Python (``method="scipy:DOP853"``, "jd+scipy");
 * sympy + SciPy: Kane's ``mass_matrix_full`` and ``forcing_full`` lambdified (NumPy) and
   integrated by ``solve_ivp`` (DOP853) in q, u with the dependent speeds from the velocity
   constraints (the standard sympy route; Φ drifts with the integration error);
@@ -36,7 +36,6 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from jourdain.loops import LoopEvaluator, constraints  # noqa: E402
 from jourdain.models.loops import four_bar, slider_crank  # noqa: E402
-from jourdain.loops.simulate import simulate_loop  # noqa: E402
 
 
 def derive_jourdain(make) -> float:  # noqa: ANN001
@@ -124,23 +123,24 @@ def main() -> None:
     t_sym, _ = derive_sympy()
     out["derivation_s"]["sympy_kane_four_bar"] = t_sym
     loop = four_bar()
-    ref = simulate_loop(loop, (0, T), [0.5, 0.8, 1.9], [1.0, 0, 0], samples=2, rtol=1e-13,
+    ref = loop.simulate((0, T), [0.5, 0.8, 1.9], [1.0, 0, 0], samples=2, rtol=1e-13,
                         atol=1e-14)
-    z0, zd0, zT = ref.z[0], ref.zd[0], ref.z[-1]
+    z0, zd0, zT = ref.y[0], ref.yd[0], ref.y[-1]
     rows = []
     fns = kane_full_four_bar()
-    simulate_loop(loop, (0, 0.1), z0, zd0, samples=2)  # compiled and loaded before timing
+    loop.simulate((0, 0.1), z0, zd0, samples=2, rtol=1e-10, atol=1e-12)  # compiled and loaded before timing
     for rtol in (1e-8, 1e-10):
-        for engine, route in (("c", "jourdain"), ("scipy", "jd+scipy")):
+        for method, route in (("DOP853", "jourdain"), ("scipy:DOP853", "jd+scipy")):
             best = np.inf
             for _ in range(args.repeat):
                 t0 = time.perf_counter()
-                r = simulate_loop(loop, (0, T), z0, zd0, samples=2, rtol=rtol,
-                                  atol=rtol * 1e-2, engine=engine)
+                r = loop.simulate((0, T), z0, zd0, samples=2, rtol=rtol, atol=rtol * 1e-2,
+                                  method=method)
                 best = min(best, time.perf_counter() - t0)
             rows.append({"route": route, "rtol": rtol, "wall_s": best, "nfev": r.nfev,
-                         "error": float(np.max(np.abs(r.z[-1] - zT))), "max_Phi": r.max_Phi,
-                         "max_Phi_dot": r.max_Phi_dot})
+                         "error": float(np.max(np.abs(r.y[-1] - zT))),
+                         "max_Phi": r.closure_residual[0],
+                         "max_Phi_dot": r.closure_residual[1]})
         wall, zs, nfev = min(simulate_sympy(fns, z0, zd0, T, rtol) for _ in range(args.repeat))
         rows.append({"route": "sympy+scipy", "rtol": rtol, "wall_s": wall, "nfev": nfev,
                      "error": float(np.max(np.abs(zs - zT)))})

@@ -18,7 +18,6 @@ import jourdain as jd
 from jourdain.errors import ModelError
 from jourdain.io.modelfile import ModelFileError, loads_model
 from jourdain.loops import ClosingJoint, LoopEvaluator, evaluate
-from jourdain.loops.simulate import simulate_loop
 from jourdain.models.loops import four_bar, slider_crank
 from tests.tolerance import EPS, cond, solve_tol
 
@@ -299,28 +298,28 @@ def _lagrange_four_bar(t_end: float, alpha0: np.ndarray, alphad0: np.ndarray,
 def test_four_bar_trajectory_equals_lagrange_multiplier_formulation() -> None:
     loop = four_bar()
     t_end = 2.0
-    res = simulate_loop(loop, (0.0, t_end), [0.5, 0.8, 1.9], [2.0, 0, 0], samples=41,
+    res = loop.simulate((0.0, t_end), [0.5, 0.8, 1.9], [2.0, 0, 0], samples=41,
                         rtol=1e-12, atol=1e-12)
     assert res.status == "finished"
-    z, zd = res.z[0], res.zd[0]
+    z, zd = res.y[0], res.yd[0]
     alpha0 = np.array([z[0], z[0] + z[1], z[2]])
     alphad0 = np.array([zd[0], zd[0] + zd[1], zd[2]])
     ref = _lagrange_four_bar(t_end, alpha0, alphad0, res.t)
-    ours = np.column_stack([res.z[:, 0], res.z[:, 0] + res.z[:, 1], res.z[:, 2]])
+    ours = np.column_stack([res.y[:, 0], res.y[:, 0] + res.y[:, 1], res.y[:, 2]])
     assert np.max(np.abs(ours - ref)) <= 1e-8
     # on the manifold along the motion
-    assert res.max_Phi <= 1e-10 and res.max_Phi_dot <= 1e-10
+    assert res.closure_residual[0] <= 1e-10 and res.closure_residual[1] <= 1e-10
 
 
 def test_conservative_four_bar_energy_over_10_s() -> None:
-    res = simulate_loop(four_bar(), (0.0, 10.0), [0.5, 0.8, 1.9], [1.0, 0, 0], samples=201,
+    res = four_bar().simulate((0.0, 10.0), [0.5, 0.8, 1.9], [1.0, 0, 0], samples=201,
                         rtol=1e-10, atol=1e-12)
     assert res.status == "finished"
     E = res.total_energy
-    assert np.max(np.abs(E - E[0])) <= 1e-9 * max(abs(E[0]), float(np.max(res.T)))
-    assert res.max_Phi <= 1e-10 and res.max_Phi_dot <= 1e-10
+    assert np.max(np.abs(E - E[0])) <= 1e-9 * max(abs(E[0]), float(np.max(res.kinetic_energy)))
+    assert res.closure_residual[0] <= 1e-10 and res.closure_residual[1] <= 1e-10
     # multipliers: the tree's equations hold with the closing force Φ_zᵀλ
-    assert res.lam.shape == (201, 2) and np.all(np.isfinite(res.lam))
+    assert res.multipliers.shape == (201, 2) and np.all(np.isfinite(res.multipliers))
 
 
 def test_multipliers_equal_redundant_form_and_are_the_pin_force() -> None:
@@ -350,18 +349,19 @@ def test_singular_position_reported_or_repartitioned() -> None:
     passes cond_limit, naming the time and state; with it, the run switches to a
     well-conditioned partition well before and goes on, on the manifold, conserving energy."""
     loop = four_bar(("theta3",))
-    stop = simulate_loop(loop, (0.0, 3.0), [0.5, 0.8, 1.9], [0.0, 0.0, 1.5], samples=61,
+    stop = loop.simulate((0.0, 3.0), [0.5, 0.8, 1.9], [0.0, 0.0, 1.5], samples=61,
                          rtol=1e-10, atol=1e-12, repartition=False, cond_limit=1e3)
     assert stop.status == "singular"
-    assert stop.singular is not None and 0 < stop.singular.t < 3.0
+    singular = stop.constraints.singular
+    assert singular is not None and 0 < singular.t < 3.0
     assert "singular configuration at t =" in stop.message and "theta3" in stop.message
-    assert stop.singular.suggestion and "theta3" not in stop.singular.suggestion
-    go = simulate_loop(loop, (0.0, 3.0), [0.5, 0.8, 1.9], [0.0, 0.0, 1.5], samples=61,
+    assert singular.suggestion and "theta3" not in singular.suggestion
+    go = loop.simulate((0.0, 3.0), [0.5, 0.8, 1.9], [0.0, 0.0, 1.5], samples=61,
                        rtol=1e-10, atol=1e-12)
-    assert go.status == "finished" and len(go.partitions) >= 2
-    assert go.max_Phi <= 1e-10 and go.max_Phi_dot <= 1e-10
+    assert go.status == "finished" and len(go.constraints.partitions) >= 2
+    assert go.closure_residual[0] <= 1e-10 and go.closure_residual[1] <= 1e-10
     E = go.total_energy
-    assert np.max(np.abs(E - E[0])) <= 1e-8 * max(abs(E[0]), float(np.max(go.T)))
+    assert np.max(np.abs(E - E[0])) <= 1e-8 * max(abs(E[0]), float(np.max(go.kinetic_energy)))
 
 
 def test_partition_pivoting_and_grubler() -> None:
@@ -475,18 +475,18 @@ def test_spatial_rssr_with_a_spherical_closing_joint() -> None:
     loop = mf.system
     assert [r for r in loop.constraints().labels] == ["ball.Fx", "ball.Fy", "ball.Fz"]
     assert loop.grubler() == 2
-    res = simulate_loop(loop, (0.0, 2.0), mf.simulation.y0, mf.simulation.yd0, samples=41,
+    res = loop.simulate((0.0, 2.0), mf.simulation.y0, mf.simulation.yd0, samples=41,
                         rtol=1e-10, atol=1e-12)
     assert res.status == "finished"
     a, b, c, d = 0.3, 1.2, 0.6, 1.0
     th1, th3 = res.coordinate("theta1"), res.coordinate("theta3")
     cos3 = (a * a + d * d + c * c - b * b - 2 * a * d * np.cos(th1)) / (2 * a * c * np.sin(th1))
-    tol = 10 * (2 * b * math.sqrt(3) * res.max_Phi + 3 * EPS * (a + b + c + d) ** 2) / (
-        2 * a * c * np.abs(np.sin(th1)))
+    tol = 10 * (2 * b * math.sqrt(3) * res.closure_residual[0]
+                + 3 * EPS * (a + b + c + d) ** 2) / (2 * a * c * np.abs(np.sin(th1)))
     assert np.all(np.abs(np.cos(th3) - cos3) <= tol)
-    assert res.max_Phi <= 1e-10 and res.max_Phi_dot <= 1e-10
+    assert res.closure_residual[0] <= 1e-10 and res.closure_residual[1] <= 1e-10
     E = res.total_energy
-    assert np.max(np.abs(E - E[0])) <= 1e-9 * max(abs(E[0]), float(np.max(res.T)))
+    assert np.max(np.abs(E - E[0])) <= 1e-9 * max(abs(E[0]), float(np.max(res.kinetic_energy)))
 
 
 def test_general_constraint_and_prismatic_closing_joint_give_the_same_motion() -> None:
@@ -515,37 +515,36 @@ def test_general_constraint_and_prismatic_closing_joint_give_the_same_motion() -
     guide = ClosingJoint("guide", "prismatic", "world", "slider", axis="x")
     loop = tree.closed_by([guide], ("phi",))
     assert [row for row in loop.constraints().labels] == ["guide.N2", "guide.Mz"]
-    res = simulate_loop(loop, (0.0, 1.0), [0.5, -0.6, 0.1], [2.0, 0, 0], samples=11,
+    res = loop.simulate((0.0, 1.0), [0.5, -0.6, 0.1], [2.0, 0, 0], samples=11,
                         rtol=1e-10, atol=1e-12)
     ph = res.coordinate("phi")
     x = 0.3 * np.cos(ph) + np.sqrt(1.0 - (0.3 * np.sin(ph)) ** 2)
     x_ours = 0.3 * np.cos(ph) + np.cos(ph + res.coordinate("psi"))
-    assert np.max(np.abs(x_ours - x)) <= 10 * (res.max_Phi + 4 * EPS) * 10
+    assert np.max(np.abs(x_ours - x)) <= 10 * (res.closure_residual[0] + 4 * EPS) * 10
     # the slider does not turn: phi + psi + chi = 0
     assert np.max(np.abs(ph + res.coordinate("psi") + res.coordinate("chi"))) <= 10 * (
-        res.max_Phi + 4 * EPS) * 10
+        res.closure_residual[0] + 4 * EPS) * 10
     E = res.total_energy
-    assert np.max(np.abs(E - E[0])) <= 1e-9 * max(abs(E[0]), float(np.max(res.T)))
+    assert np.max(np.abs(E - E[0])) <= 1e-9 * max(abs(E[0]), float(np.max(res.kinetic_energy)))
 
 
 def test_redundant_form_side_by_side() -> None:
     """The Lagrange-multiplier form in all tree coordinates (index 1, with and without
     Baumgarte's terms) follows the partitioned motion to the integration tolerance; its Φ
     drifts with the integration error, where the partitioned run stays at rounding level."""
-    from jourdain.loops.simulate import simulate_redundant
-
     loop = four_bar()
-    ref = simulate_loop(loop, (0.0, 2.0), [0.5, 0.8, 1.9], [2.0, 0, 0], samples=21,
+    ref = loop.simulate((0.0, 2.0), [0.5, 0.8, 1.9], [2.0, 0, 0], samples=21,
                         rtol=1e-12, atol=1e-12)
     for ab in (0.0, 10.0):
-        red = simulate_redundant(loop, (0.0, 2.0), [0.5, 0.8, 1.9], [2.0, 0, 0], samples=21,
-                                 rtol=1e-12, atol=1e-12, alpha=ab, beta=ab)
+        red = loop.simulate((0.0, 2.0), [0.5, 0.8, 1.9], [2.0, 0, 0], samples=21,
+                            rtol=1e-12, atol=1e-12, formulation="redundant", alpha=ab,
+                            beta=ab)
         assert red.status == "finished"
-        assert np.max(np.abs(red.z - ref.z)) <= 1e-8
-        lam_scale = 1 + float(np.max(np.abs(ref.lam)))
-        assert np.max(np.abs(red.lam - ref.lam)) <= 1e-7 * lam_scale
-        assert red.max_Phi <= 1e-8
-    assert ref.max_Phi <= 1e-12 * 10
+        assert np.max(np.abs(red.y - ref.y)) <= 1e-8
+        lam_scale = 1 + float(np.max(np.abs(ref.multipliers)))
+        assert np.max(np.abs(red.multipliers - ref.multipliers)) <= 1e-7 * lam_scale
+        assert red.closure_residual[0] <= 1e-8
+    assert ref.closure_residual[0] <= 1e-12 * 10
 
 
 def test_n_four_bar_through_its_singular_flat_positions() -> None:
@@ -553,7 +552,6 @@ def test_n_four_bar_through_its_singular_flat_positions() -> None:
     augmented-Lagrangian form; the crank angle follows the exact one-degree-of-freedom motion
     of the parallelogram chain (benchmarks/n_four_bar.py runs N = 5, 10, 40 over 20 s)."""
     from benchmarks.n_four_bar import initial_state, reference
-    from jourdain.loops.simulate import simulate_penalty
     from jourdain.models.loops import n_four_bar
 
     n = 3
@@ -561,9 +559,10 @@ def test_n_four_bar_through_its_singular_flat_positions() -> None:
     z, zd = initial_state(n)
     ev = LoopEvaluator(loop, z)
     assert ev.rank([0.0, 0.0] * n + [0.0]) < 2 * n  # flat: rank lost
-    res = simulate_penalty(loop, (0.0, 4.0), z, zd, samples=41)
+    res = loop.simulate((0.0, 4.0), z, zd, samples=41, rtol=1e-10, atol=1e-12,
+                        formulation="penalty")
     assert res.status == "finished"
     th0 = res.coordinate("th0")
     assert th0[-1] - th0[0] > math.pi  # it went through the horizontal positions
     assert np.max(np.abs(th0 - reference(n, res.t))) <= 1e-5
-    assert res.max_Phi <= 1e-6
+    assert res.closure_residual[0] <= 1e-6

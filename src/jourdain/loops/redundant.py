@@ -1,15 +1,17 @@
-"""The redundant-coordinate forms of a closed-loop simulation, side by side with the
-coordinate partitioning of :func:`jourdain.loops.simulate.simulate_loop`: the index-1
-Lagrange-multiplier form (:func:`simulate_redundant`) and the augmented-Lagrangian (penalty)
-form (:func:`simulate_penalty`) that passes singular positions. Both integrate all tree
-coordinates with SciPy's DOP853 and report the constraint residuals as they are."""
+"""The redundant-coordinate formulations of a closed system's simulation, beside the
+coordinate partitioning of :mod:`jourdain.loops.simulate`: the index-1 Lagrange-multiplier
+form (``system.simulate(..., formulation="redundant")``, :func:`_simulate_redundant`) and the
+augmented-Lagrangian (penalty) form that passes singular positions
+(``formulation="penalty"``, :func:`_simulate_penalty`). Both integrate all tree coordinates
+and report the constraint residuals as they are; :func:`jourdain.loops.simulate.simulate_closed`
+calls them and returns the one :class:`jourdain.Results`."""
 
 from __future__ import annotations
 
 import ctypes
 import math
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from types import SimpleNamespace
 from typing import Any
 
@@ -23,19 +25,23 @@ from ..simulation.problem import address
 from .c_run import C_METHODS, FAILED, Segment
 from .closed_loop import LoopEvaluator
 from .compiled import loop_library
-from .results import LoopResults
+from .results import _Run
 
 
-def simulate_redundant(loop: System, t_span: tuple[float, float], z0: Any,
-                       zd0: Any = None, *, samples: int = 501, rtol: float = 1e-10,
-                       atol: float = 1e-12, alpha: float = 0.0, beta: float = 0.0,
-                       parameters: Mapping[str, float] | None = None) -> LoopResults:
-    """The redundant-coordinate (Lagrange multiplier) form side by side with
-    :func:`simulate_loop`: all tree coordinates z, ż integrated (DOP853) with z̈ and λ from
+def _simulate_redundant(loop: System, t_span: tuple[float, float], z0: Any,
+                        zd0: Any = None, *, samples: int = 501, rtol: float = 1e-10,
+                        atol: float = 1e-12, alpha: float = 0.0, beta: float = 0.0,
+                        parameters: Mapping[str, float] | None = None,
+                        t_eval: Sequence[float] | None = None, method: str = "DOP853",
+                        max_step: float = math.inf) -> _Run:
+    """The redundant-coordinate (Lagrange multiplier) form beside coordinate partitioning:
+    all tree coordinates z, ż integrated (SciPy's ``method``, DOP853 by default) with z̈ and
+    λ from
     ``[M_tree −Φ_zᵀ; Φ_z 0]·[z̈; λ] = [q − k; −c − 2αΦ̇ − β²Φ]`` (index 1, Baumgarte's
     stabilization with α, β; 0, 0: none). No partition, so no singular Φ_d; the price is the
     drift of Φ and Φ̇ with the integration error (Baumgarte's terms damp it), which the
-    results report as they are (no projection). Assembled first like :func:`simulate_loop`.
+    results report as they are (no projection). Assembled first, like the partitioned run.
+    Samples at ``t_eval`` (default: ``samples`` equally spaced times).
     """
     from scipy.integrate import solve_ivp
 
@@ -48,28 +54,38 @@ def simulate_redundant(loop: System, t_span: tuple[float, float], z0: Any,
         zdd, _ = ev.redundant_accelerations(x[:n], x[n:], t, alpha, beta)
         return np.concatenate([x[n:], zdd])
 
+    tev = _times(t0, t1, samples, t_eval)
     started = time.perf_counter()
-    tev = np.linspace(t0, t1, samples)
-    sol = solve_ivp(rhs, (t0, t1), np.concatenate([asm.z, asm.zd]), method="DOP853",
-                    rtol=rtol, atol=atol, t_eval=tev)
+    sol = solve_ivp(rhs, (t0, t1), np.concatenate([asm.z, asm.zd]), method=method,
+                    rtol=rtol, atol=atol, t_eval=tev, max_step=max_step)
     wall = time.perf_counter() - started
 
     def sample(z: np.ndarray, zd: np.ndarray, t: float) -> tuple[np.ndarray, np.ndarray,
                                                                 dict[str, np.ndarray]]:
         zdd, lam = ev.redundant_accelerations(z, zd, t, alpha, beta)
         return zdd, lam, ev._con(z, zd, t)
-    return _redundant_results(loop, ev, sol, sample, t0, wall)
+    return _redundant_results(loop, ev, sol, sample, t0, wall, f"scipy:{method}")
 
 
-def simulate_penalty(loop: System, t_span: tuple[float, float], z0: Any,
-                     zd0: Any = None, *, samples: int = 501, rtol: float = 1e-10,
-                     atol: float = 1e-12, alpha: float = 1e7, xi: float = 1.0,
-                     omega: float = 30.0, iterations: int = 4,
-                     parameters: Mapping[str, float] | None = None,
-                     engine: str = "c") -> LoopResults:
+def _times(t0: float, t1: float, samples: int, t_eval: Sequence[float] | None) -> np.ndarray:
+    """The sample times: ``t_eval``, or ``samples`` equally spaced ones over [t0, t1]."""
+    tev = (np.linspace(t0, t1, samples) if t_eval is None
+           else np.asarray(t_eval, dtype=float))
+    if tev.size and (tev[0] < t0 or tev[-1] > t1 or np.any(np.diff(tev) <= 0)):
+        raise EvaluationError("t_eval must increase within t_span")
+    return tev
+
+
+def _simulate_penalty(loop: System, t_span: tuple[float, float], z0: Any,
+                      zd0: Any = None, *, samples: int = 501, rtol: float = 1e-10,
+                      atol: float = 1e-12, alpha: float = 1e7, xi: float = 1.0,
+                      omega: float = 30.0, iterations: int = 4,
+                      parameters: Mapping[str, float] | None = None,
+                      engine: str = "c", t_eval: Sequence[float] | None = None,
+                      method: str = "DOP853", max_step: float = math.inf) -> _Run:
     """The augmented-Lagrangian (penalty) form in all tree coordinates, for singular
     positions and redundant constraints, where Φ_d of a partition or the bordered matrix of
-    :func:`simulate_redundant` is singular (Bayo & Ledesma's formulation):
+    :func:`_simulate_redundant` is singular (Bayo & Ledesma's formulation):
 
         (M_tree + α·Φ_zᵀΦ_z)·z̈ = q − k − Φ_zᵀ·λ − α·Φ_zᵀ·(c + 2ξωΦ̇ + ω²Φ),
         λ ← λ + α·(Φ_z·z̈ + c + 2ξωΦ̇ + ω²Φ)   (``iterations`` times, from λ = 0)
@@ -81,7 +97,8 @@ def simulate_penalty(loop: System, t_span: tuple[float, float], z0: Any,
     the penalty's accuracy (about ‖M‖/α) and the integration error; the residuals are
     reported as they are. ``λ`` of the results are the multipliers of the last iteration.
     ``engine="c"`` (default): the right-hand side in C (``jd_penalty_accel``) run by jourdain's
-    C integrator (DOP853); "scipy": the same formula in NumPy under SciPy's DOP853.
+    C integrator (``method``: DOP853, RK45, Radau); "scipy": the same formula in NumPy under
+    SciPy's ``method``. Samples at ``t_eval`` (default: ``samples`` equally spaced times).
     """
     from scipy.integrate import solve_ivp
     from scipy.linalg import cho_factor, cho_solve
@@ -89,6 +106,9 @@ def simulate_penalty(loop: System, t_span: tuple[float, float], z0: Any,
     t0, t1 = check_t_span(t_span)
     if engine not in ("c", "scipy"):
         raise EvaluationError(f'engine must be "c" or "scipy", got {engine!r}')
+    if engine == "c" and method not in C_METHODS:
+        raise EvaluationError(f"the C engine's methods are {', '.join(C_METHODS)}, got "
+                              f"{method!r}")
     ev = LoopEvaluator(loop, z0, t0, parameters)
     asm = ev.assemble(z0, zd0, t0)
     n = loop.f
@@ -114,16 +134,16 @@ def simulate_penalty(loop: System, t_span: tuple[float, float], z0: Any,
     def rhs(t: float, x: np.ndarray) -> np.ndarray:
         return np.concatenate([x[n:], accel(x[:n], x[n:], t)[0]])
 
+    tev = _times(t0, t1, samples, t_eval)
     started = time.perf_counter()
-    tev = np.linspace(t0, t1, samples)
     if engine == "c":  # the same right-hand side in C (loop_c.h), in jourdain's C integrator
         sol = _penalty_c(ev, t0, t1, np.concatenate([asm.z, asm.zd]), tev, rtol, atol,
-                         (alpha, xi, omega, iterations))
-        method = "DOP853"
+                         (alpha, xi, omega, iterations), method, max_step)
+        ran = method
     else:
-        sol = solve_ivp(rhs, (t0, t1), np.concatenate([asm.z, asm.zd]), method="DOP853",
-                        rtol=rtol, atol=atol, t_eval=tev)
-        method = "scipy:DOP853"
+        sol = solve_ivp(rhs, (t0, t1), np.concatenate([asm.z, asm.zd]), method=method,
+                        rtol=rtol, atol=atol, t_eval=tev, max_step=max_step)
+        ran = f"scipy:{method}"
     wall = time.perf_counter() - started
 
     def sample(z: np.ndarray, zd: np.ndarray, t: float) -> tuple[np.ndarray, np.ndarray,
@@ -131,7 +151,29 @@ def simulate_penalty(loop: System, t_span: tuple[float, float], z0: Any,
         zdd, lam, cd = accel(z, zd, t)
         # the sign of λ in M·z̈ = … − Φ_zᵀλ: −λ is the multiplier of the other forms
         return zdd, -lam, cd
-    return _redundant_results(loop, ev, sol, sample, t0, wall, method)
+    return _redundant_results(loop, ev, sol, sample, t0, wall, ran)
+
+
+def _simulate_redundant_form(loop: System, formulation: str, t_span: tuple[float, float],
+                             z0: Any, zd0: Any, own: Mapping[str, Any], engine: str, *,
+                             inputs: Any = None, method: str = "DOP853", **kw: Any) -> _Run:
+    """``simulate_closed(..., formulation="redundant" | "penalty")``: the run of
+    :func:`_simulate_redundant` or :func:`_simulate_penalty` with the formulation's own
+    options ``own``; refuses inputs (not available in these forms yet) and methods SciPy
+    lacks."""
+    from ..errors import ClosedSystemError
+
+    if inputs is not None and not (isinstance(inputs, Mapping | Sequence) and not inputs):
+        raise ClosedSystemError(loop, f'simulate(..., formulation="{formulation}", '
+                                "inputs=...): inputs are not available for the "
+                                "redundant-coordinate formulations yet")
+    solvers = ("DOP853", "RK45", "Radau", "BDF", "LSODA")
+    if method not in solvers:
+        raise EvaluationError(f"method must be one of {', '.join(solvers)} or "
+                              f'"scipy:<method>", got {method!r}')
+    if formulation == "redundant":
+        return _simulate_redundant(loop, t_span, z0, zd0, method=method, **kw, **own)
+    return _simulate_penalty(loop, t_span, z0, zd0, engine=engine, method=method, **kw, **own)
 
 
 class _Penalty(ctypes.Structure):
@@ -143,9 +185,9 @@ class _Penalty(ctypes.Structure):
 
 
 def _penalty_c(ev: LoopEvaluator, t0: float, t1: float, x0: np.ndarray, tev: np.ndarray,
-               rtol: float, atol: float, settings: tuple[float, float, float, int]
-               ) -> SimpleNamespace:
-    """The penalty form's run in the C integrator (DOP853): SciPy's solution's fields."""
+               rtol: float, atol: float, settings: tuple[float, float, float, int],
+               method: str = "DOP853", max_step: float = math.inf) -> SimpleNamespace:
+    """The penalty form's run in the C integrator (``method``): SciPy's solution's fields."""
     lib = loop_library(ev.loop)
     tree = mkq_function(ev.loop.tree)
     n, m = ev.n, len(ev.labels)
@@ -158,7 +200,7 @@ def _penalty_c(ev: LoopEvaluator, t0: float, t1: float, x0: np.ndarray, tev: np.
                   float(omega), address(work), address(lam))
     accel = int(ctypes.cast(lib.jd_penalty_accel, ctypes.c_void_p).value or 0)
     seg = Segment(n, ev.u, tree.address, ctypes.addressof(st), accel, t0,
-                  np.concatenate([x0, [0.0]]), tev, C_METHODS["DOP853"], rtol, atol, math.inf)
+                  np.concatenate([x0, [0.0]]), tev, C_METHODS[method], rtol, atol, max_step)
     code = seg.run(t1)
     k = int(seg.n_out[0])
     message = ("the integration reached t_end" if code == 0 else
@@ -171,9 +213,9 @@ def _penalty_c(ev: LoopEvaluator, t0: float, t1: float, x0: np.ndarray, tev: np.
 
 def _redundant_results(loop: System, ev: Any, sol: Any,
                        sample: Callable[[np.ndarray, np.ndarray, float], tuple], t0: float,
-                       wall: float, method: str = "scipy:DOP853") -> LoopResults:
-    """The results of a redundant-coordinate run (``simulate_redundant``,
-    ``simulate_penalty``) from SciPy's solution, each sample evaluated by ``sample(z, ż, t)``
+                       wall: float, method: str = "scipy:DOP853") -> _Run:
+    """The record of a redundant-coordinate run (:func:`_simulate_redundant`,
+    :func:`_simulate_penalty`) from SciPy's solution, each sample evaluated by ``sample(z, ż, t)``
     → ``(z̈, λ, constraint data)``."""
     n = loop.f
     out: dict[str, list] = {k: [] for k in ("z", "zd", "zdd", "Phi", "Phi_dot", "lam", "T",
@@ -190,7 +232,7 @@ def _redundant_results(loop: System, ev: Any, sol: Any,
         out["T"].append(float(cd["T"][0, 0]))
         out["V"].append(float(cd["V"][0, 0]))
     status = "finished" if sol.status == 0 else "failed"
-    return LoopResults(
+    return _Run(
         loop, sol.t, np.array(out["z"]), np.array(out["zd"]), np.array(out["zdd"]),
         np.array(out["Phi"]), np.array(out["Phi_dot"]), np.array(out["lam"]),
         np.array(out["T"]), np.array(out["V"]), list(ev.labels), [(t0, ())], status,
@@ -199,4 +241,4 @@ def _redundant_results(loop: System, ev: Any, sol: Any,
         method)
 
 
-__all__ = ["simulate_penalty", "simulate_redundant"]
+__all__: list[str] = []

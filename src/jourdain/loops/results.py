@@ -1,9 +1,12 @@
-"""Time histories of closed-loop simulations (:class:`LoopResults`), from
-:func:`jourdain.loops.simulate.simulate_loop` and the redundant-coordinate forms of
-:mod:`jourdain.loops.redundant`."""
+"""The internal record of one closed-system run (:class:`_Run`), filled by the drivers of
+:mod:`jourdain.loops.simulate` (coordinate partitioning) and :mod:`jourdain.loops.redundant`
+(the redundant-coordinate forms), and its conversion into the one :class:`jourdain.Results`
+(:func:`_to_results`, with the work ``W`` of the applied forces) that
+:func:`jourdain.loops.simulate.simulate_closed` returns. Not part of the API."""
 
 from __future__ import annotations
 
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -11,27 +14,25 @@ import numpy as np
 
 from ..errors import EvaluationError
 from ..model import System
+from ..numeric import CompiledFunction, mkq_function, parameter_vector
 from .closed_loop import SingularConfiguration
-from .reactions import closing_reactions
+from .compiled import input_function
 
 
 @dataclass
-class LoopResults:
-    """Time histories of a closed-loop simulation.
+class _Run:
+    """Time histories of one run: ``t`` (N,); ``y, yd, ydd`` (N, n) the tree's coordinates
+    and their rates; ``Phi``, ``Phi_dot`` (N, m) the residuals of the closing rows; ``lam``
+    (N, m) their multipliers (row names in ``labels``); ``T``, ``V`` (N,) kinetic and
+    potential energy; ``partitions``: ``[(t_start, independent names), ...]``; ``singular``:
+    the :class:`SingularConfiguration` that stopped the run, or None; ``method``: the
+    integrator that ran."""
 
-    ``t`` (N,); ``z, zd, zdd`` (N, n): the tree's coordinates (on the manifold); ``Phi``,
-    ``Phi_dot`` (N, m): the constraint residuals; ``lam`` (N, m): the closing joints'
-    multipliers (labels in ``labels``); ``T``, ``V`` (N,): kinetic and potential energy;
-    ``partitions``: ``[(t_start, independent names), ...]``; ``status``, ``message``;
-    ``singular``: the :class:`SingularConfiguration` that stopped the run, or None;
-    ``method``: the integrator that ran.
-    """
-
-    loop: System
+    system: System
     t: np.ndarray
-    z: np.ndarray
-    zd: np.ndarray
-    zdd: np.ndarray
+    y: np.ndarray
+    yd: np.ndarray
+    ydd: np.ndarray
     Phi: np.ndarray
     Phi_dot: np.ndarray
     lam: np.ndarray
@@ -47,85 +48,80 @@ class LoopResults:
     parameters: dict[str, float] = field(default_factory=dict)
     method: str = "DOP853"
 
-    @property
-    def coordinate_names(self) -> list[str]:
-        return self.loop.coordinate_names
 
-    @property
-    def max_Phi(self) -> float:
-        """Largest |Φ_i| along the motion."""
-        return float(np.max(np.abs(self.Phi))) if self.Phi.size else 0.0
-
-    @property
-    def max_Phi_dot(self) -> float:
-        """Largest |Φ̇_i| along the motion."""
-        return float(np.max(np.abs(self.Phi_dot))) if self.Phi_dot.size else 0.0
-
-    @property
-    def total_energy(self) -> np.ndarray:
-        return self.T + self.V
-
-    @property
-    def energy_drift(self) -> float:
-        """max |E − E₀| / max(|E₀|, max T) (meaningful for a conservative model)."""
-        E = self.total_energy
-        return float(np.max(np.abs(E - E[0])) / max(abs(E[0]), float(np.max(self.T)), 1e-300))
-
-    def coordinate(self, name: str) -> np.ndarray:
-        """Time history of a tree coordinate (``<name>_d``, ``<name>_dd``: its rates)."""
-        for suffix, arr in (("_dd", self.zdd), ("_d", self.zd), ("", self.z)):
-            base = name[: len(name) - len(suffix)] if suffix and name.endswith(suffix) else name
-            if (not suffix or name.endswith(suffix)) and base in self.coordinate_names:
-                return arr[:, self.coordinate_names.index(base)]
-        raise EvaluationError(f'unknown coordinate "{name}"; coordinates are '
-                              f"{self.coordinate_names}")
-
-    def reaction(self, label: str) -> np.ndarray:
-        """Multiplier history of one constraint row (``closure.Fx``, ...)."""
-        if label not in self.labels:
-            raise EvaluationError(f'unknown constraint row "{label}"; rows are {self.labels}')
-        return self.lam[:, self.labels.index(label)]
-
-    def closing_reactions(self) -> dict[str, dict[str, np.ndarray]]:
-        """Force ``F`` and torque ``T`` (N × 3, in body A's frame, B on A at A's joint point)
-        of every closing joint with points, by name (:mod:`jourdain.loops.reactions`)."""
-        p = np.array([self.parameters[k] for k, _ in self.loop.tree.parameters])
-        return closing_reactions(self.loop, self.z, self.lam, self.t, p)
-
-    def summary(self) -> str:
-        parts = "; ".join(f"t ≥ {t0:.6g}: {', '.join(n)}" for t0, n in self.partitions)
-        return "\n".join([
-            f"{self.loop.name}: {self.status} - {self.message}",
-            f"  t = {self.t[0]:.6g} .. {self.t[-1]:.6g} s, {len(self.t)} points, "
-            f"{self.nfev} right-hand sides, {self.wall_time:.3f} s",
-            f"  independent coordinates: {parts}",
-            f"  constraint residuals: max |Φ| = {self.max_Phi:.3e}, max |Φ̇| = "
-            f"{self.max_Phi_dot:.3e}",
-            f"  relative energy drift {self.energy_drift:.3e} (meaningful when conservative)",
-            *self._reaction_lines()])
-
-    def _reaction_lines(self) -> list[str]:
-        if not len(self.t):
-            return []
-        lines = []
-        for name, w in self.closing_reactions().items():
-            F, T = np.abs(w["F"]).max(axis=0), np.abs(w["T"]).max(axis=0)
-            lines.append(f"  closing joint {name}: max |F| = ({F[0]:.4g}, {F[1]:.4g}, "
-                         f"{F[2]:.4g}), max |T| = ({T[0]:.4g}, {T[1]:.4g}, {T[2]:.4g}) in "
-                         "its body A's axes")
-        return lines
-
-    def tree_results(self) -> Any:
-        """The motion as :class:`jourdain.Results` of the tree (its coordinates z), for the
-        report, CSV/HDF5 and the plots of tree models."""
-        from ..simulation.results import Results
-
-        tree = self.loop.tree
-        n_u = len(tree.inputs)
-        return Results(tree, self.t, self.z, self.zd, self.zdd, np.zeros((len(self.t), n_u)),
-                       np.zeros(len(self.t)), dict(self.parameters), method=self.method,
-                       status=self.status, message=self.message, nfev=self.nfev,
-                       wall_time=self.wall_time)
+def _input_values(loop: System, inputs: Any, fn_u: CompiledFunction | None,
+                  parameters: Mapping[str, float] | None) -> Callable[[float], Any]:
+    """The inputs as a function of time (for the evaluator and the SciPy engine)."""
+    n_u = len(loop.tree.inputs)
+    if fn_u is not None:  # expressions of t and the parameters, compiled
+        p_u, zeros, u_zero = (parameter_vector(loop.tree, parameters), np.zeros(loop.f),
+                              np.zeros(n_u))
+        return lambda t: fn_u(zeros, zeros, t, p_u, u_zero)["u"][:, 0]
+    if callable(inputs):
+        return inputs
+    u_const = np.zeros(n_u) if inputs is None else np.asarray(inputs, dtype=float)
+    if u_const.size != n_u:
+        raise EvaluationError(f"inputs must have {n_u} entries")
+    return lambda _t: u_const
 
 
-__all__ = ["LoopResults"]
+def _to_results(system: System, lr: _Run, parameters: Mapping[str, float] | None,
+                inputs: Any, rtol: float, atol: Any) -> Any:
+    """The run ``lr`` as :class:`jourdain.Results` of ``system``: the tree's coordinates, the
+    inputs along the motion, the closing rows in :attr:`Results.constraints` and ``W``."""
+    from ..simulation.results import Results
+    from ..simulation.results.data import ConstraintHistories
+
+    tree = system.tree
+    n_u = len(tree.inputs)
+    N = len(lr.t)
+    U = np.zeros((N, n_u))
+    if n_u and N:
+        fn_u = input_function(system, inputs) if isinstance(inputs, Mapping) else None
+        u_of = _input_values(system, inputs, fn_u, parameters)
+        U = np.array([np.asarray(u_of(float(t)), dtype=float).reshape(n_u) for t in lr.t])
+    cons = ConstraintHistories(tuple(lr.labels), lr.Phi, lr.Phi_dot, lr.lam,
+                               tuple(lr.partitions), lr.singular)
+    res = Results(system, lr.t, lr.y, lr.yd, lr.ydd, U, np.zeros(N), dict(lr.parameters),
+                  method=lr.method, rtol=rtol, atol=atol, status=lr.status,
+                  message=lr.message, nfev=lr.nfev, wall_time=lr.wall_time,
+                  constraints=cons)
+    res.W = _work(res, tree, parameters, inputs, system)
+    return res
+
+
+#: Gauss–Legendre nodes and weights on [0, 1] (exact for polynomials of degree 5)
+_GAUSS_S = np.array([0.5 - np.sqrt(15) / 10, 0.5, 0.5 + np.sqrt(15) / 10])
+_GAUSS_W = np.array([5.0, 8.0, 5.0]) / 18.0
+
+
+def _work(res: Any, tree: System, parameters: Mapping[str, float] | None, inputs: Any,
+          system: System) -> np.ndarray:
+    """``W = ∫ẏᵀq dt`` since t0 along a closed system's motion (the constraint forces do no
+    work on the manifold, so the tree's q is the closed system's applied forces), by
+    three-point Gauss–Legendre on each step of the samples over their quintic Hermite
+    interpolation (:meth:`Results.interpolate`): of order h⁶ like the interpolation, where
+    the trapezoidal rule over the samples left 2.5e-4 of the four-bar's energy in its
+    balance."""
+    t = res.t
+    N = len(t)
+    W = np.zeros(N)
+    if N < 2:
+        return W
+    h = np.diff(t)
+    tg = (t[:-1, None] + h[:, None] * _GAUSS_S[None, :]).reshape(-1)
+    m = res.interpolate(tg)
+    n_u = len(tree.inputs)
+    U = None
+    if n_u:
+        fn_u = input_function(system, inputs) if isinstance(inputs, Mapping) else None
+        u_of = _input_values(system, inputs, fn_u, parameters)
+        U = np.array([np.asarray(u_of(float(x)), dtype=float).reshape(n_u) for x in tg])
+    q = mkq_function(tree).batch(m["y"], m["yd"], tg, parameter_vector(tree, parameters),
+                                 U)["q"][:, :, 0]
+    power = np.einsum("ij,ij->i", m["yd"], q).reshape(-1, 3)
+    W[1:] = np.cumsum(h * (power @ _GAUSS_W))
+    return W
+
+
+__all__: list[str] = []

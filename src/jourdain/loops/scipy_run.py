@@ -1,8 +1,9 @@
-"""The SciPy driver of :func:`jourdain.loops.simulate.simulate_loop`: SciPy's steppers
-(``DOP853``, ``RK45``, ``Radau``, ``BDF``) stepped from Python, the right-hand side evaluated
-by :class:`~jourdain.loops.closed_loop.LoopEvaluator` (Newton on the dependent coordinates in
+"""The SciPy driver of the coordinate partitioning of
+:func:`jourdain.loops.simulate.simulate_closed`: SciPy's steppers (``DOP853``, ``RK45``,
+``Radau``, ``BDF``) stepped from Python, the right-hand side evaluated by
+:class:`~jourdain.loops.closed_loop.LoopEvaluator` (Newton on the dependent coordinates in
 Python, about 0.3 ms per evaluation). It serves the method the C integrator lacks (BDF) and
-inputs given as Python functions of time; ``engine="scipy"`` asks for it."""
+inputs given as Python functions of time; ``method="scipy:<method>"`` asks for it."""
 
 from __future__ import annotations
 

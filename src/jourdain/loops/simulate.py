@@ -1,6 +1,11 @@
-"""Simulation of closed systems on the constraint manifold (coordinate partitioning):
-:func:`simulate_closed` is what :meth:`jourdain.System.simulate` and :func:`jourdain.simulate`
-call for a system with closing joints; it returns the one :class:`jourdain.Results`.
+"""Simulation of closed systems: :func:`simulate_closed` is what
+:meth:`jourdain.System.simulate` and :func:`jourdain.simulate` call for a system with closing
+joints; it returns the one :class:`jourdain.Results`. ``formulation`` picks the method:
+"partitioned" (the default: coordinate partitioning on the constraint manifold, this module),
+"redundant" (the index-1 Lagrange-multiplier form in all tree coordinates, with Baumgarte's
+``alpha``, ``beta``) or "penalty" (the augmented-Lagrangian form, which passes singular
+positions; ``alpha``, ``xi``, ``omega``, ``iterations``), both in
+:mod:`jourdain.loops.redundant`.
 
 The state is the independent ``(y, ẏ)`` (here ``z`` names the tree's coordinates, ``y`` the
 independent ones); at every evaluation the dependent coordinates are solved by Newton on
@@ -33,7 +38,7 @@ and no better partition exists there — ``Φ_z`` itself has lost rank, a singul
 the mechanism — or re-partitioning is off, the run stops with status "singular" and a
 :class:`SingularConfiguration` naming the time, the state, the condition number, the rank of
 ``Φ_z`` and a partition that would serve (if any). The augmented-Lagrangian form
-(:func:`jourdain.loops.redundant.simulate_penalty`) passes singular positions.
+(``formulation="penalty"``) passes singular positions.
 
 Why not SUNDIALS IDA (scikit-sundae) here, measured (``python benchmarks/loops.py``, the
 four-bar of :func:`jourdain.models.loops.four_bar` over 5 s, on the shared 2-core development
@@ -55,10 +60,11 @@ from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
+import symengine as se
 
 from ..errors import EvaluationError
 from ..model import System
-from ..numeric import CompiledFunction, mkq_function, parameter_vector
+from ..numeric import CompiledFunction
 from ..simulation.options import check_t_span, steps_per_call
 from .c_run import C_METHODS, FAILED, Segment
 from .charts import decide
@@ -68,26 +74,27 @@ from .closed_loop import (
     constraint_function,
 )
 from .compiled import REASONS, LoopKernel, build_loop_library_soon, input_function
-from .redundant import simulate_penalty, simulate_redundant
-from .results import LoopResults
+from .redundant import _simulate_redundant_form
+from .results import _input_values, _Run, _to_results
 from .scipy_run import SOLVERS, run_scipy
 
 _KEYS = ("z", "zd", "zdd", "Phi", "Phi_dot", "lam")
 
 
-def simulate_loop(loop: System, t_span: tuple[float, float], z0: Any,
-                  zd0: Any = None, *, t_eval: Sequence[float] | None = None,
-                  samples: int = 501, rtol: float = 1e-10, atol: float = 1e-12,
-                  method: str = "DOP853", parameters: Mapping[str, float] | None = None,
-                  inputs: Callable[[float], Any] | Sequence[float] | Mapping[str, Any]
-                  | None = None,
-                  repartition: bool = True, cond_limit: float = 1e6,
-                  max_step: float = math.inf, engine: str = "c",
-                  progress: bool | Callable[[float, float], None] = False) -> LoopResults:
+def _simulate_partitioned(loop: System, t_span: tuple[float, float], z0: Any,
+                          zd0: Any = None, *, t_eval: Sequence[float] | None = None,
+                          samples: int = 501, rtol: float = 1e-10, atol: float = 1e-12,
+                          method: str = "DOP853",
+                          parameters: Mapping[str, float] | None = None,
+                          inputs: Callable[[float], Any] | Sequence[float] | Mapping[str, Any]
+                          | None = None,
+                          repartition: bool = True, cond_limit: float = 1e6,
+                          max_step: float = math.inf, engine: str = "c",
+                          progress: bool | Callable[[float, float], None] = False) -> _Run:
     """Integrate a closed-loop system from approximate ``z0, zd0`` (assembled first, the
     independent coordinates of the partition held) over ``t_span``.
 
-    Returns :class:`LoopResults` at ``t_eval`` (default: ``samples`` equally spaced times).
+    Returns the run's record (:class:`~jourdain.loops.results._Run`) at ``t_eval`` (default: ``samples`` equally spaced times).
     A singular configuration stops the run with ``status="singular"`` and the exception in
     ``singular`` (the results up to there are kept) unless a new partition resolves it.
     ``inputs``: constants (in the order of the tree's inputs), a mapping of input names to
@@ -130,7 +137,7 @@ def simulate_loop(loop: System, t_span: tuple[float, float], z0: Any,
 
     def arr(k: str, w: int) -> np.ndarray:
         return np.array(out[k]).reshape(-1, w) if len(out[k]) else np.zeros((0, w))
-    return LoopResults(
+    return _Run(
         loop, np.array(out["t"], dtype=float), arr("z", n), arr("zd", n), arr("zdd", n),
         arr("Phi", m), arr("Phi_dot", m), arr("lam", m), np.array(out["T"], dtype=float),
         np.array(out["V"], dtype=float), list(ev.labels), run["partitions"], run["status"],
@@ -138,21 +145,6 @@ def simulate_loop(loop: System, t_span: tuple[float, float], z0: Any,
         dict(zip([k for k, _ in loop.tree.parameters], ev.p.tolist(), strict=True)),
         run_method)
 
-
-def _input_values(loop: System, inputs: Any, fn_u: CompiledFunction | None,
-                  parameters: Mapping[str, float] | None) -> Callable[[float], Any]:
-    """The inputs as a function of time (for the evaluator and the SciPy engine)."""
-    n_u = len(loop.tree.inputs)
-    if fn_u is not None:  # expressions of t and the parameters, compiled
-        p_u, zeros, u_zero = (parameter_vector(loop.tree, parameters), np.zeros(loop.f),
-                              np.zeros(n_u))
-        return lambda t: fn_u(zeros, zeros, t, p_u, u_zero)["u"][:, 0]
-    if callable(inputs):
-        return inputs
-    u_const = np.zeros(n_u) if inputs is None else np.asarray(inputs, dtype=float)
-    if u_const.size != n_u:
-        raise EvaluationError(f"inputs must have {n_u} entries")
-    return lambda _t: u_const
 
 
 def _run_c(ev: LoopEvaluator, t0: float, t1: float, x: np.ndarray, tev: np.ndarray,
@@ -307,6 +299,14 @@ def _record(out: dict[str, list], kernel: LoopKernel, con: Any, t: np.ndarray,
 
 
 
+#: the formulations of :func:`simulate_closed` and the options each takes (their defaults)
+FORMULATIONS: dict[str, dict[str, float]] = {
+    "partitioned": {},
+    "redundant": {"alpha": 0.0, "beta": 0.0},
+    "penalty": {"alpha": 1e7, "xi": 1.0, "omega": 30.0, "iterations": 4},
+}
+
+
 def simulate_closed(system: System, t_span: tuple[float, float], y0: Any, yd0: Any = None,
                     parameters: Mapping[str, float] | None = None,
                     inputs: Mapping[str, Any] | Sequence[float] | Callable[[float], Any]
@@ -315,24 +315,50 @@ def simulate_closed(system: System, t_span: tuple[float, float], y0: Any, yd0: A
                     max_step: float = math.inf, samples: int = 501,
                     repartition: bool = True, cond_limit: float = 1e6,
                     **options: Any) -> Any:
-    """:meth:`jourdain.System.simulate` of a closed system: the motion on the constraint
-    manifold (coordinate partitioning, :func:`simulate_loop`) as :class:`jourdain.Results`
-    with the tree's coordinates ``y`` (every sample on ``Φ = 0``) and the closing rows in
-    :attr:`Results.constraints` (``Phi``, ``Phi_dot``, ``multipliers``).
+    """:meth:`jourdain.System.simulate` of a closed system: its motion as
+    :class:`jourdain.Results` with the tree's coordinates ``y`` and the closing rows in
+    :attr:`Results.constraints` (``labels``, ``Phi``, ``Phi_dot``, ``multipliers``,
+    ``partitions``, ``singular``).
+
+    ``formulation``:
+
+    * "partitioned" (default): coordinate partitioning, every sample on ``Φ = 0`` to rounding;
+      ``repartition``, ``cond_limit`` as in the module's docs.
+    * "redundant": all tree coordinates with ``ÿ`` and ``λ`` from the bordered (index-1)
+      system, Baumgarte's stabilization ``alpha``, ``beta`` (default 0, 0: none); Φ drifts
+      with the integration error and is reported as it is. SciPy's steppers.
+    * "penalty": the augmented-Lagrangian form (Bayo & Ledesma), which passes singular
+      positions: ``alpha`` (penalty, 1e7), ``xi`` (1.0), ``omega`` (30.0), ``iterations``
+      (4); its C right-hand side in jourdain's C integrator, or SciPy's with
+      ``method="scipy:<method>"``.
+
+    The redundant forms take no inputs yet (a :class:`jourdain.errors.ClosedSystemError`
+    names them) and no partition (``partitions`` is ``[(t0, ())]``).
 
     ``method``: "DOP853", "RK45", "Radau" (jourdain's C integrator with the compiled loop
     right-hand side), "BDF", "LSODA" or "scipy:<method>" (SciPy's steppers). ``t_eval``
     default: ``samples`` equally spaced times. ``progress`` and Ctrl-C as for trees (the C
-    methods: the step loop runs in bounded calls; an interrupted run keeps its motion so far,
-    ``status="interrupted"``); ``output``: the results file, written when the run ends or is
-    interrupted (not sample by sample as a tree's run writes it). Options of tree runs that
-    closed systems do not take yet (``events``, ``first_step``) raise
-    :class:`jourdain.errors.ClosedSystemError` naming them.
+    methods of the partitioned form: the step loop runs in bounded calls; an interrupted run
+    keeps its motion so far, ``status="interrupted"``); ``output``: the results file, written
+    when the run ends or is interrupted (not sample by sample as a tree's run writes it).
+    Options of tree runs that closed systems do not take yet (``events``, ``first_step``)
+    raise :class:`jourdain.errors.ClosedSystemError` naming them.
     """
     from ..errors import ClosedSystemError
-    from ..simulation.results import Results
-    from ..simulation.results.data import ConstraintHistories
 
+    formulation = options.pop("formulation", "partitioned")
+    if formulation not in FORMULATIONS:
+        raise EvaluationError(f"formulation must be one of "
+                              f"{', '.join(repr(k) for k in FORMULATIONS)}, got "
+                              f"{formulation!r}")
+    own = {k: options.pop(k) for k in FORMULATIONS[formulation] if k in options}
+    stray = sorted({k for opts in FORMULATIONS.values() for k in opts if k in options})
+    if stray:
+        takers = {k: [f for f, o in FORMULATIONS.items() if k in o] for k in stray}
+        raise EvaluationError("; ".join(
+            f"simulate(..., {k}=...) is an option of formulation "
+            f"{' and '.join(repr(f) for f in takers[k])}, not of {formulation!r}"
+            for k in stray))
     progress = options.pop("progress", False)
     output = options.pop("output", None)
     raise_on_interrupt = bool(options.pop("raise_on_interrupt", False))
@@ -346,29 +372,22 @@ def simulate_closed(system: System, t_span: tuple[float, float], y0: Any, yd0: A
     elif method not in C_METHODS:
         engine = "scipy"
     if isinstance(inputs, Mapping) and inputs and not all(
-            isinstance(v, int | float | str) for v in inputs.values()):
+            isinstance(v, int | float | str | se.Basic) for v in inputs.values()):
         raise ClosedSystemError(system, "inputs given as tables or Python functions in a "
                                 "mapping are not available for closed systems yet (give "
                                 "numbers or expressions of t, or one function of t)")
-    lr = simulate_loop(system, t_span, y0, yd0, t_eval=t_eval, samples=samples, rtol=rtol,
-                       atol=atol, method=method, parameters=parameters, inputs=inputs,
-                       repartition=repartition, cond_limit=cond_limit, max_step=max_step,
-                       engine=engine, progress=progress)
-    tree = system.tree
-    n_u = len(tree.inputs)
-    N = len(lr.t)
-    U = np.zeros((N, n_u))
-    if n_u and N:
-        fn_u = input_function(system, inputs) if isinstance(inputs, Mapping) else None
-        u_of = _input_values(system, inputs, fn_u, parameters)
-        U = np.array([np.asarray(u_of(float(t)), dtype=float).reshape(n_u) for t in lr.t])
-    cons = ConstraintHistories(tuple(lr.labels), lr.Phi, lr.Phi_dot, lr.lam,
-                               tuple(lr.partitions), lr.singular)
-    res = Results(system, lr.t, lr.z, lr.zd, lr.zdd, U, np.zeros(N), dict(lr.parameters),
-                  method=lr.method, rtol=rtol, atol=atol, status=lr.status,
-                  message=lr.message, nfev=lr.nfev, wall_time=lr.wall_time,
-                  constraints=cons)
-    res.W = _work(res, tree, parameters, inputs, system)
+    if formulation == "partitioned":
+        lr = _simulate_partitioned(system, t_span, y0, yd0, t_eval=t_eval, samples=samples,
+                                   rtol=rtol, atol=atol, method=method,
+                                   parameters=parameters, inputs=inputs,
+                                   repartition=repartition, cond_limit=cond_limit,
+                                   max_step=max_step, engine=engine, progress=progress)
+    else:
+        lr = _simulate_redundant_form(system, formulation, t_span, y0, yd0, own, engine,
+                                      t_eval=t_eval, samples=samples, rtol=rtol, atol=atol,
+                                      method=method, parameters=parameters, inputs=inputs,
+                                      max_step=max_step)
+    res = _to_results(system, lr, parameters, inputs, rtol, atol)
     if output is not None:  # at the end, or with the motion so far when interrupted
         res.save(output)
     if res.interrupted and raise_on_interrupt:
@@ -376,38 +395,4 @@ def simulate_closed(system: System, t_span: tuple[float, float], y0: Any, yd0: A
     return res
 
 
-#: Gauss–Legendre nodes and weights on [0, 1] (exact for polynomials of degree 5)
-_GAUSS_S = np.array([0.5 - np.sqrt(15) / 10, 0.5, 0.5 + np.sqrt(15) / 10])
-_GAUSS_W = np.array([5.0, 8.0, 5.0]) / 18.0
-
-
-def _work(res: Any, tree: System, parameters: Mapping[str, float] | None, inputs: Any,
-          system: System) -> np.ndarray:
-    """``W = ∫ẏᵀq dt`` since t0 along a closed system's motion (the constraint forces do no
-    work on the manifold, so the tree's q is the closed system's applied forces), by
-    three-point Gauss–Legendre on each step of the samples over their quintic Hermite
-    interpolation (:meth:`Results.interpolate`): of order h⁶ like the interpolation, where
-    the trapezoidal rule over the samples left 2.5e-4 of the four-bar's energy in its
-    balance."""
-    t = res.t
-    N = len(t)
-    W = np.zeros(N)
-    if N < 2:
-        return W
-    h = np.diff(t)
-    tg = (t[:-1, None] + h[:, None] * _GAUSS_S[None, :]).reshape(-1)
-    m = res.interpolate(tg)
-    n_u = len(tree.inputs)
-    U = None
-    if n_u:
-        fn_u = input_function(system, inputs) if isinstance(inputs, Mapping) else None
-        u_of = _input_values(system, inputs, fn_u, parameters)
-        U = np.array([np.asarray(u_of(float(x)), dtype=float).reshape(n_u) for x in tg])
-    q = mkq_function(tree).batch(m["y"], m["yd"], tg, parameter_vector(tree, parameters),
-                                 U)["q"][:, :, 0]
-    power = np.einsum("ij,ij->i", m["yd"], q).reshape(-1, 3)
-    W[1:] = np.cumsum(h * (power @ _GAUSS_W))
-    return W
-
-__all__ = ["C_METHODS", "SOLVERS", "LoopResults", "simulate_closed", "simulate_loop",
-           "simulate_penalty", "simulate_redundant"]
+__all__ = ["C_METHODS", "FORMULATIONS", "SOLVERS", "simulate_closed"]
