@@ -61,9 +61,10 @@ def test_cli_and_report_share_the_workflow_not_each_other():
 
 def test_no_deferred_imports_but_heavy_optional_ones():
     # function-level imports only for Matplotlib (imported by the figure workers),
-    # jourdain.loops (SciPy's linear algebra, for loop models only) and jourdain.study (a
-    # study's section of jourdain run --study; xarray is optional)
-    allowed = ("matplotlib", "jourdain.loops", "jourdain.study")
+    # jourdain.loops and jourdain.io.closed_linear, which loads it (SciPy's linear algebra,
+    # for closed systems only) and jourdain.study (a study's section of jourdain run --study;
+    # xarray is optional)
+    allowed = ("matplotlib", "jourdain.loops", "jourdain.io.closed_linear", "jourdain.study")
     for path in _files("cli", "workflow", "io/report"):
         for mod, _, top in _imports(path):
             assert top or mod.startswith(allowed), f"{path}: deferred import of {mod}"
