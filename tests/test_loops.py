@@ -566,3 +566,26 @@ def test_n_four_bar_through_its_singular_flat_positions() -> None:
     assert th0[-1] - th0[0] > math.pi  # it went through the horizontal positions
     assert np.max(np.abs(th0 - reference(n, res.t))) <= 1e-5
     assert res.closure_residual[0] <= 1e-6
+
+
+def test_formulation_is_an_option_of_the_one_simulate() -> None:
+    """``formulation`` picks the method of a closed system's run; every one returns the one
+    Results with the closing rows; unknown formulations and another formulation's options are
+    refused naming them, and a tree takes no formulation."""
+    loop = four_bar()
+    for f in ("redundant", "penalty"):
+        res = loop.simulate((0.0, 0.2), [0.5, 0.8, 1.9], [1.0, 0, 0], samples=5,
+                            formulation=f)
+        assert isinstance(res, jd.Results) and res.status == "finished"
+        assert res.constraint_labels == list(loop.constraints().labels)
+        assert res.Phi.shape == res.Phi_dot.shape == res.multipliers.shape == (5, 2)
+        assert res.constraints.partitions == ((0.0, ()),)
+    with pytest.raises(jd.errors.EvaluationError, match="formulation must be one of"):
+        loop.simulate((0.0, 0.2), [0.5, 0.8, 1.9], [1.0, 0, 0], formulation="index3")
+    with pytest.raises(jd.errors.EvaluationError, match="omega=.*not of 'redundant'"):
+        loop.simulate((0.0, 0.2), [0.5, 0.8, 1.9], [1.0, 0, 0], formulation="redundant",
+                      omega=3.0)
+    with pytest.raises(jd.errors.EvaluationError, match="beta=.*not of 'partitioned'"):
+        loop.simulate((0.0, 0.2), [0.5, 0.8, 1.9], [1.0, 0, 0], beta=3.0)
+    with pytest.raises(TypeError, match="formulation"):
+        loop.tree.simulate((0.0, 0.2), [0.5, 0.8, 1.9], [1.0, 0, 0], formulation="redundant")
