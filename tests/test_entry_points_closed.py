@@ -126,3 +126,68 @@ def test_closed_results_against_the_trees_numbers(closed) -> None:  # noqa: ANN0
         1.0, float(np.max(np.abs(ref))) * abs(lin.Q[0, 0])))
     # the viewer draws the closed mechanism (its frames from the tree's kinematics at y)
     assert jd.view(res) is not None
+
+
+#: every command of the command line on the closed four-bar: its arguments and what the
+#: output must show of the closed system (not of the open tree)
+COMMANDS = {
+    "check": ([], ["closure", "1 by the rank 2 of Φ"]),
+    "eom": ([], ["Φ_y", "M_tree", "λ"]),
+    "eval": (["--json"], ['"closure_residual"', '"independent"']),
+    "reactions": (["--json"], ['"closure.Fx"']),
+    "linearize": (["--json"], ['"independent"']),
+    "simulate": (["--t-end", "0.2"], []),
+    "run": (["--t-end", "0.2"], ["report:"]),
+    "fmu": (["--sources-only"], []),
+    "study": ([], []),
+}
+
+
+def test_every_command_on_a_closed_model(tmp_path: Path,
+                                         capsys: pytest.CaptureFixture[str]) -> None:
+    """Each command gives the closed system's output (its markers above; the numbers are
+    checked against references in tests/test_closed_cli.py, test_closed_report.py,
+    test_fmu_closed.py and test_study_closed.py) and exits 0; the table covers every
+    command the parser has."""
+    import json
+
+    from jourdain.cli import main
+    from jourdain.cli.parser import build_parser
+
+    subs = next(a for a in build_parser()._actions if a.dest == "command")
+    assert set(subs.choices) == set(COMMANDS)  # type: ignore[union-attr]
+    model = str(ROOT / "examples" / "four_bar.toml")
+    for command, (extra, markers) in COMMANDS.items():
+        argv = [command, model, *extra]
+        if command in ("simulate",):
+            argv += ["--out", str(tmp_path / "fb.csv")]
+        elif command == "run":
+            argv += ["--out", str(tmp_path / "report")]
+        elif command == "fmu":
+            argv += ["--out", str(tmp_path / "fb.fmu")]
+        elif command == "study":
+            argv = [command, "--spec", str(ROOT / "examples" / "studies" /
+                                           "four_bar_stability_map.toml"),
+                    "--out", str(tmp_path / "map.nc")]
+        code = main(argv)
+        out, err = capsys.readouterr()
+        assert code == 0, (command, err)
+        for marker in markers:
+            assert marker in out, (command, marker)
+        if command == "eval":  # the closed system's M: 1×1 in theta1, not the tree's 3×3
+            assert np.asarray(json.loads(out)["values"]["M"]).shape == (1, 1)
+    sim = jd.Results.load(tmp_path / "fb.csv")
+    assert sim.y.shape[1] == 3 and (tmp_path / "report" / "loops.json").is_file()
+    assert (tmp_path / "fb.fmu").is_file() and (tmp_path / "map.nc").is_file()
+
+
+def test_to_control_of_a_closed_linearization(closed) -> None:  # noqa: ANN001
+    """python-control's state space of the closed linearization: the independent
+    coordinate's states, and its poles are the linearization's eigenvalues."""
+    control = pytest.importorskip("control")
+    _, _, lin = closed
+    sys_c = jd.to_control(lin)
+    assert list(sys_c.state_labels) == ["theta1", "theta1_d"]
+    poles = np.sort_complex(np.asarray(control.poles(sys_c), complex))
+    ref = np.sort_complex(np.asarray(lin.eigenvalues, complex))
+    assert np.max(np.abs(poles - ref)) <= 1e3 * np.finfo(float).eps * max(1.0, np.abs(ref).max())
