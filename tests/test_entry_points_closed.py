@@ -74,8 +74,9 @@ def test_refused_functions_name_the_closing_joints(closed) -> None:  # noqa: ANN
     }
     assert set(calls) == {k for k, v in OUTCOME.items() if v == "refused"}
     for name, call in calls.items():
-        with pytest.raises(ClosedSystemError, match="closure"):
+        with pytest.raises(ClosedSystemError, match="closure") as info:
             call()
+        assert info.value.capability, name  # the error names what cannot be done
 
 
 def test_symbolic_stages_are_the_trees_by_name_only() -> None:
