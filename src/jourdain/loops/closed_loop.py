@@ -29,7 +29,7 @@ the manifold unless projected back; the independent form stays on the manifold b
 construction (the dependent coordinates are solved by Newton at every evaluation). Where
 Φ_z itself loses rank (a mechanism's flat or bifurcation positions) neither a partition nor
 the bordered matrix can be solved; the augmented-Lagrangian form
-(:func:`jourdain.loops.simulate.simulate_penalty`) passes there.
+(``system.simulate(..., formulation="penalty")``) passes there.
 """
 
 from __future__ import annotations

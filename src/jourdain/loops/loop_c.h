@@ -413,7 +413,7 @@ long jd_loop_samples(const jd_loop *L, long N, const double *t, const double *x,
 /* ---- the augmented-Lagrangian (penalty) form in all tree coordinates (Bayo & Ledesma) ----
  * (M + alpha G^T G) zdd = q - k - G^T lam - alpha G^T (c + 2 xi omega Phi_dot + omega^2 Phi),
  * lam <- lam + alpha (G zdd + c + 2 xi omega Phi_dot + omega^2 Phi), `iterations` times from 0
- * (G = Phi_z); jourdain.loops.redundant.simulate_penalty. */
+ * (G = Phi_z); system.simulate(..., formulation="penalty"), jourdain.loops.redundant. */
 typedef struct {
     jd_tree_fn tree;
     const double *p;

@@ -47,6 +47,8 @@ class _Run:
     singular: SingularConfiguration | None = None
     parameters: dict[str, float] = field(default_factory=dict)
     method: str = "DOP853"
+    #: the integrator's steps, accepted and rejected (0 where the stepper does not count them)
+    steps: tuple[int, int, int] = (0, 0, 0)
 
 
 def _input_values(loop: System, inputs: Any, fn_u: CompiledFunction | None,
@@ -84,7 +86,8 @@ def _to_results(system: System, lr: _Run, parameters: Mapping[str, float] | None
                                tuple(lr.partitions), lr.singular)
     res = Results(system, lr.t, lr.y, lr.yd, lr.ydd, U, np.zeros(N), dict(lr.parameters),
                   method=lr.method, rtol=rtol, atol=atol, status=lr.status,
-                  message=lr.message, nfev=lr.nfev, wall_time=lr.wall_time,
+                  message=lr.message, nfev=lr.nfev, nsteps=lr.steps[0],
+                  n_accepted=lr.steps[1], n_rejected=lr.steps[2], wall_time=lr.wall_time,
                   constraints=cons)
     res.W = _work(res, tree, parameters, inputs, system)
     return res

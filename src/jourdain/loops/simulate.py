@@ -143,7 +143,7 @@ def _simulate_partitioned(loop: System, t_span: tuple[float, float], z0: Any,
         np.array(out["V"], dtype=float), list(ev.labels), run["partitions"], run["status"],
         run["message"], run["nfev"], time.perf_counter() - started, run["singular"],
         dict(zip([k for k, _ in loop.tree.parameters], ev.p.tolist(), strict=True)),
-        run_method)
+        run_method, run.get("steps", (0, 0, 0)))
 
 
 
@@ -204,6 +204,7 @@ def _run_segments(ev: LoopEvaluator, t0: float, t1: float, x: np.ndarray, tev: n
     status, message = "finished", "the integration reached t_end"
     singular: SingularConfiguration | None = None
     nfev, i_eval, t = 0, 0, t0
+    steps = np.zeros(3, dtype=int)  # steps, accepted, rejected (the integrator's counters)
     state = np.concatenate([x, [0.0]])  # [y, ẏ, W]
     con = constraint_function(ev.loop)
     mark = math.nan  # Φ_d's condition number at the partition (nan: measure it)
@@ -224,6 +225,7 @@ def _run_segments(ev: LoopEvaluator, t0: float, t1: float, x: np.ndarray, tev: n
         except KeyboardInterrupt:  # between two calls: the samples so far are consistent
             code, stop = 0, True
         nfev += int(seg.cnt[0])
+        steps += np.asarray(seg.cnt[1:4], dtype=int)
         # before the samples overwrite them: why it stopped and where (a trial state)
         reason, c_now, z_fail = int(kernel.info[2]), kernel.cond, kernel.z.copy()
         k = int(seg.n_out[0])
@@ -277,7 +279,7 @@ def _run_segments(ev: LoopEvaluator, t0: float, t1: float, x: np.ndarray, tev: n
         status, message = "singular", str(singular)
         break
     return {"out": out, "partitions": partitions, "status": status, "message": message,
-            "singular": singular, "nfev": nfev}
+            "singular": singular, "nfev": nfev, "steps": tuple(int(k) for k in steps)}
 
 
 def _record(out: dict[str, list], kernel: LoopKernel, con: Any, t: np.ndarray,
@@ -311,7 +313,7 @@ def simulate_closed(system: System, t_span: tuple[float, float], y0: Any, yd0: A
                     parameters: Mapping[str, float] | None = None,
                     inputs: Mapping[str, Any] | Sequence[float] | Callable[[float], Any]
                     | None = None, method: str = "DOP853", rtol: float = 1e-8,
-                    atol: float = 1e-10, t_eval: Sequence[float] | None = None,
+                    atol: Any = 1e-10, t_eval: Sequence[float] | None = None,
                     max_step: float = math.inf, samples: int = 501,
                     repartition: bool = True, cond_limit: float = 1e6,
                     **options: Any) -> Any:

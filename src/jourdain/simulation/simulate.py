@@ -102,7 +102,8 @@ def simulate(system: System, t_span: tuple[float, float], y0: Any, yd0: Any,
              t_eval: Sequence[float] | None = None, events: Sequence[Event] = (),
              max_step: float = math.inf, first_step: float | None = None,
              progress: bool | Callable[[float, float], None] = False,
-             output: str | None = None, raise_on_interrupt: bool = False) -> Results:
+             output: str | None = None, raise_on_interrupt: bool = False,
+             **closed_options: Any) -> Results:
     """Integrate ``M(y,t)·ÿ + k(y,ẏ,t) = q(y,ẏ,t)`` over ``t_span`` from ``y0, ẏ0``.
 
     Parameters
@@ -128,6 +129,8 @@ def simulate(system: System, t_span: tuple[float, float], y0: Any, yd0: Any,
     output : path of a results file (``.csv``, ``.h5``) written as the run goes (accepted steps
         or ``t_eval`` samples appended under ``status: running``), then complete
     raise_on_interrupt : re-raise KeyboardInterrupt after keeping the results
+    closed_options : for a closed system only: ``formulation`` ("partitioned", "redundant",
+        "penalty") and its options (:func:`jourdain.loops.simulate.simulate_closed`)
 
     Returns
     -------
@@ -152,7 +155,10 @@ def simulate(system: System, t_span: tuple[float, float], y0: Any, yd0: Any,
                                method=method, rtol=rtol, atol=atol, t_eval=t_eval,
                                max_step=max_step, events=tuple(events), first_step=first_step,
                                progress=progress, output=output,
-                               raise_on_interrupt=raise_on_interrupt)
+                               raise_on_interrupt=raise_on_interrupt, **closed_options)
+    if closed_options:
+        raise EvaluationError(f"simulate: {', '.join(sorted(closed_options))} are options of "
+                              f"closed systems; {system.name!r} has no closing joints")
     f = system.f
     t0, t1 = check_t_span(t_span)
     yv = _initial(y0, f, "y0", system, "")

@@ -5,7 +5,6 @@ motions (:class:`NominalMotion`) and simulation settings (:class:`SimulationSett
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
 
 import symengine as se
 

@@ -46,6 +46,8 @@ pendulum: 8e-8).
 
 from __future__ import annotations
 
+import numpy as np
+
 from ...errors import JourdainError
 from .data import PLOT_POINTS, TimeHistories
 from .files import FORMAT, VERSION, append_incremental, open_incremental
@@ -88,8 +90,16 @@ class Results(WithPlots):
         lines = [f"{self.name}: {self.status} - {self.message}",
                  f"  t = {self.t[0]:.6g} .. {self.t[-1]:.6g} s, {len(self.t)} points, method "
                  f"{self.method}, rtol {self.rtol:g}",
-                 f"  {self.n_accepted} steps accepted, {self.n_rejected} rejected, "
-                 f"{self.nfev} right-hand sides, {1e3 * self.wall_time:.3f} ms"]
+                 (f"  {self.n_accepted} steps accepted, {self.n_rejected} rejected, "
+                  if self.n_accepted or self.n_rejected else "  ")
+                 + f"{self.nfev} right-hand sides, {1e3 * self.wall_time:.3f} ms"]
+        c = self.constraints
+        if c is not None:  # a closed system's: its partitions, residuals and closing joints
+            parts = "; ".join(f"t ≥ {t0:.6g}: {', '.join(n)}" for t0, n in c.partitions)
+            phi, phid = self.closure_residual
+            lines += [f"  independent coordinates: {parts}",
+                      f"  closure residuals: max |Φ| = {phi:.3e}, max |Φ̇| = {phid:.3e}"]
+            lines += self._closing_lines()
         try:
             if self.conservative:
                 lines.append(f"  relative energy drift {self.energy_drift:.3e} (conservative model)")
@@ -102,6 +112,23 @@ class Results(WithPlots):
         except JourdainError:
             pass
         return "\n".join(lines)
+
+    def _closing_lines(self) -> list[str]:
+        """The largest force and torque of each closing joint along the motion (in its body
+        A's axes), from the multipliers."""
+        if not len(self.t) or self.system is None:
+            return []
+        from ...loops.reactions import closing_reactions
+
+        p = np.array([self.parameters[k] for k, _ in self.system.parameters])
+        lines = []
+        for name, w in closing_reactions(self.system, self.y, self.multipliers, self.t,
+                                         p).items():
+            F, T = np.abs(w["F"]).max(axis=0), np.abs(w["T"]).max(axis=0)
+            lines.append(f"  closing joint {name}: max |F| = ({F[0]:.4g}, {F[1]:.4g}, "
+                         f"{F[2]:.4g}), max |T| = ({T[0]:.4g}, {T[1]:.4g}, {T[2]:.4g}) in its "
+                         "body A's axes")
+        return lines
 
 
 __all__ = ["FORMAT", "PLOT_POINTS", "VERSION", "Results", "TimeHistories", "append_incremental",
