@@ -94,7 +94,7 @@ def _loops() -> dict:
     tree = slider_tree()
     return {
         "revolute": (four_bar(), [1.1, 0.3, 1.9], [1.5, 0, 0]),
-        "spherical": (mf.system, list(mf.simulation.y0), [1.0, 0.5, 0, 0.3, 0]),
+        "spherical": (mf.system, list(mf.simulation.y0), [1.0, 0, 0, 0.3, 0]),
         "prismatic": (tree.closed_by([ClosingJoint("guide", "prismatic", "world",
                                                            "slider", axis="x")], ("phi",)),
                       [0.5, -0.6, 0.1], [2.0, 0, 0]),

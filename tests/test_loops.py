@@ -587,5 +587,5 @@ def test_formulation_is_an_option_of_the_one_simulate() -> None:
                       omega=3.0)
     with pytest.raises(jd.errors.EvaluationError, match="beta=.*not of 'partitioned'"):
         loop.simulate((0.0, 0.2), [0.5, 0.8, 1.9], [1.0, 0, 0], beta=3.0)
-    with pytest.raises(TypeError, match="formulation"):
+    with pytest.raises(jd.errors.EvaluationError, match="no closing joints"):
         loop.tree.simulate((0.0, 0.2), [0.5, 0.8, 1.9], [1.0, 0, 0], formulation="redundant")

@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any, TypeVar
 import numpy as np
 
 from ..analysis.reactions import evaluate_keys
-from ..errors import EvaluationError, refuse_closed
+from ..errors import refuse_closed
 from ..model.system import System as Model
 from ..numeric import evaluate as evaluate_eom
 from ..numeric.linearization import Linearization, linearization  # with its numbers
@@ -171,10 +171,6 @@ class System(Model):
                                    rtol=DEFAULT_RTOL if rtol is None else rtol,
                                    atol=DEFAULT_ATOL if atol is None else atol,
                                    t_eval=t_eval, **options)
-        if "formulation" in options:
-            raise EvaluationError(f"{self.name!r}: formulation= chooses how a closed "
-                                  "system's constraints are integrated; this system has no "
-                                  "closing joints")
         return simulate(self, t_span, y0, yd0, parameters=parameters, inputs=inputs,
                         method=DEFAULT_METHOD if method is None else method,
                         rtol=DEFAULT_RTOL if rtol is None else rtol,

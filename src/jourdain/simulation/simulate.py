@@ -156,9 +156,7 @@ def simulate(system: System, t_span: tuple[float, float], y0: Any, yd0: Any,
                                max_step=max_step, events=tuple(events), first_step=first_step,
                                progress=progress, output=output,
                                raise_on_interrupt=raise_on_interrupt, **closed_options)
-    if closed_options:
-        raise EvaluationError(f"simulate: {', '.join(sorted(closed_options))} are options of "
-                              f"closed systems; {system.name!r} has no closing joints")
+    _tree_takes_no(system, closed_options)
     f = system.f
     t0, t1 = check_t_span(t_span)
     yv = _initial(y0, f, "y0", system, "")
@@ -199,6 +197,22 @@ def simulate(system: System, t_span: tuple[float, float], y0: Any, yd0: Any,
                                                              KeyboardInterrupt):
         raise run["exception"]
     return res
+
+
+#: options of :func:`simulate` for closed systems only (:func:`jourdain.loops.simulate.simulate_closed`)
+CLOSED_OPTIONS = frozenset({"formulation", "samples", "repartition", "cond_limit", "alpha",
+                            "beta", "xi", "omega", "iterations"})
+
+
+def _tree_takes_no(system: System, options: Mapping[str, Any]) -> None:
+    """A tree given options of closed systems: an error naming them; any other keyword is
+    misspelt, a TypeError as Python gives (never ignored)."""
+    unknown = sorted(set(options) - CLOSED_OPTIONS)
+    if unknown:
+        raise TypeError(f"simulate() got an unexpected keyword argument {unknown[0]!r}")
+    if options:
+        raise EvaluationError(f"simulate: {', '.join(sorted(options))}: options of closed "
+                              f"systems; {system.name!r} has no closing joints")
 
 
 def _initial(x: Any, f: int, what: str, system: System, suffix: str) -> np.ndarray:
