@@ -41,7 +41,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from ...errors import EvaluationError, JourdainError, ModelError
+from ...errors import ClosedSystemError, EvaluationError, JourdainError, ModelError
 from ...model.system import System
 from ...numeric import parameter_vector
 from ...numeric.ccode import argument_names, function_source
@@ -151,8 +151,8 @@ def export_fmu(model: Any, path: str | os.PathLike[str], *,
     system, mf = _model_of(model)
     closed = bool(getattr(system, "closing", ()))
     if closed and reactions is not None and (isinstance(reactions, str) or list(reactions)):
-        raise ModelError(f"{system.name!r} has closing joints: the FMU of a closed system gives "
-                         "no reaction outputs yet (export it without reactions)")
+        raise ClosedSystemError(system, "the FMU of a closed system gives no reaction "
+                                "outputs yet (export it without reactions)")
     if not cond_limit > 1:
         raise EvaluationError(f"cond_limit must be > 1, got {cond_limit!r}")
     if system.f == 0:
