@@ -29,7 +29,7 @@ a multiplier 1 of the full system).
 from __future__ import annotations
 
 import ctypes
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -228,26 +228,8 @@ def floquet(lin: Linearization | CompiledLinearization, period: float, t0: float
     if accel is not None:  # all 2f columns by the compiled DOP853, then Routh's rows/columns
         Phi = _monodromy_compiled(accel, f, m, p, (t0, t0 + T), rtol)[ix]
     else:  # no compiler: SciPy's DOP853 on the reduced state
-        from scipy.integrate import solve_ivp
-
-        def rhs(t: float, z: np.ndarray) -> np.ndarray:
-            return (state_matrix(t)[ix] @ z.reshape(n, n)).ravel()
-
-        sol = solve_ivp(rhs, (t0, t0 + T), np.eye(n).ravel(), method="DOP853", rtol=rtol,
-                        atol=rtol * 1e-3)
-        if not sol.success:
-            raise EvaluationError(f"floquet: the integration over one period failed: "
-                                  f"{sol.message}")
-        Phi = sol.y[:, -1].reshape(n, n)
-    if not np.all(np.isfinite(Phi)):
-        raise EvaluationError("floquet: the monodromy matrix is not finite")
-    mu = np.linalg.eigvals(Phi)
-    mu = mu[np.lexsort((-mu.imag, -np.round(np.abs(mu), 12)))]
-    with np.errstate(divide="ignore"):
-        lam = np.log(mu.astype(complex)) / T
-    # the integration's global error is a few rtol times the size of Φ (DOP853 keeps the
-    # local error per step below rtol·|z|, and a period takes tens to thousands of steps)
-    tol = max(1e3 * rtol, 1e2 * np.finfo(float).eps) * max(1.0, float(np.linalg.norm(Phi, 2)))
+        Phi = monodromy_scipy(lambda t: state_matrix(t)[ix], n, t0, T, rtol)
+    mu, lam, tol = multipliers(Phi, T, rtol)
     verdict, reason = _verdict(Phi, mu, tol)
     if cyc:
         reason += (f"; in Routh's sense, without the position(s) of the cyclic coordinate(s) "
@@ -257,6 +239,39 @@ def floquet(lin: Linearization | CompiledLinearization, period: float, t0: float
     return Floquet(period=T, t0=t0, monodromy=Phi, multipliers=mu, exponents=lam,
                    verdict=verdict, reason=reason, tolerance=tol, state_names=state,
                    cyclic=cyc, parameters=pars)
+
+
+def monodromy_scipy(state_matrix: Callable[[float], np.ndarray], n: int, t0: float, T: float,
+                    rtol: float) -> np.ndarray:
+    """The monodromy matrix of ``ẋ = A(t)·x`` (n states) over ``[t0, t0 + T]`` by SciPy's
+    DOP853 from Python, ``A(t) = state_matrix(t)``."""
+    from scipy.integrate import solve_ivp
+
+    def rhs(t: float, z: np.ndarray) -> np.ndarray:
+        return (state_matrix(t) @ z.reshape(n, n)).ravel()
+
+    sol = solve_ivp(rhs, (t0, t0 + T), np.eye(n).ravel(), method="DOP853", rtol=rtol,
+                    atol=rtol * 1e-3)
+    if not sol.success:
+        raise EvaluationError(f"floquet: the integration over one period failed: "
+                              f"{sol.message}")
+    return sol.y[:, -1].reshape(n, n)
+
+
+def multipliers(Phi: np.ndarray, T: float, rtol: float
+                ) -> tuple[np.ndarray, np.ndarray, float]:
+    """The Floquet multipliers μ of the monodromy matrix ``Phi`` (by modulus, then imaginary
+    part), the exponents ``ln(μ)/T`` and the tolerance of the verdict on |μ| = 1."""
+    if not np.all(np.isfinite(Phi)):
+        raise EvaluationError("floquet: the monodromy matrix is not finite")
+    mu = np.linalg.eigvals(Phi)
+    mu = mu[np.lexsort((-mu.imag, -np.round(np.abs(mu), 12)))]
+    with np.errstate(divide="ignore"):
+        lam = np.log(mu.astype(complex)) / T
+    # the integration's global error is a few rtol times the size of Φ (DOP853 keeps the
+    # local error per step below rtol·|z|, and a period takes tens to thousands of steps)
+    tol = max(1e3 * rtol, 1e2 * np.finfo(float).eps) * max(1.0, float(np.linalg.norm(Phi, 2)))
+    return mu, lam, tol
 
 
 def _monodromy_accel(fn: object) -> int | None:

@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 import symengine as se
 
-from ..analysis.floquet import Floquet, _verdict
+from ..analysis.floquet import Floquet, _verdict, monodromy_scipy, multipliers
 from ..errors import ClosedSystemError, EvaluationError, warn
 from ..model import System
 from ..stages.linearization import NominalMotionWarning
@@ -113,8 +113,6 @@ class ClosedLinearization:
                 cyclic: Sequence[str] | None = None) -> Floquet:
         """Monodromy matrix, Floquet multipliers and exponents and the verdict over one
         ``period`` from ``t0`` (as :func:`jourdain.floquet` for trees)."""
-        from scipy.integrate import solve_ivp
-
         if parameters:
             raise EvaluationError("floquet: a closed system's linearization holds one set of "
                                   "parameters; linearize again for others")
@@ -129,26 +127,8 @@ class ClosedLinearization:
             raise EvaluationError(f"floquet: rtol must be in (0, 1e-3), got {rtol!r}")
         t0 = float(t0)
         reason_extra = self._check(t0, T)
-        n = 2 * len(self.names)
-
-        def rhs(t: float, x: np.ndarray) -> np.ndarray:
-            return (self.state_matrix(t) @ x.reshape(n, n)).ravel()
-
-        sol = solve_ivp(rhs, (t0, t0 + T), np.eye(n).ravel(), method="DOP853", rtol=rtol,
-                        atol=rtol * 1e-3)
-        if not sol.success:
-            raise EvaluationError(f"floquet: the integration over one period failed: "
-                                  f"{sol.message}")
-        Phi = sol.y[:, -1].reshape(n, n)
-        if not np.all(np.isfinite(Phi)):
-            raise EvaluationError("floquet: the monodromy matrix is not finite")
-        mu = np.linalg.eigvals(Phi)
-        mu = mu[np.lexsort((-mu.imag, -np.round(np.abs(mu), 12)))]
-        with np.errstate(divide="ignore"):
-            lam = np.log(mu.astype(complex)) / T
-        # as for trees: the global error is a few rtol times the size of Φ
-        tol = max(1e3 * rtol, 1e2 * np.finfo(float).eps) * max(1.0, float(np.linalg.norm(Phi,
-                                                                                        2)))
+        Phi = monodromy_scipy(self.state_matrix, 2 * len(self.names), t0, T, rtol)
+        mu, lam, tol = multipliers(Phi, T, rtol)
         verdict, reason = _verdict(Phi, mu, tol)
         state = (*self.names, *(f"{c}_d" for c in self.names))
         return Floquet(period=T, t0=t0, monodromy=Phi, multipliers=mu, exponents=lam,
