@@ -31,6 +31,7 @@ from __future__ import annotations
 import ctypes
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -168,12 +169,7 @@ def floquet(lin: Linearization | CompiledLinearization, period: float, t0: float
                   "linearize the closed system about expressions of t for its independent "
                   "coordinates (its linearization about a state has no period)")
 
-    T = float(period)
-    if not np.isfinite(T) or T <= 0:
-        raise EvaluationError(f"floquet: the period must be a positive finite number, got "
-                              f"{period!r}")
-    if not 0 < rtol < 1e-3:
-        raise EvaluationError(f"floquet: rtol must be in (0, 1e-3), got {rtol!r}")
+    T = check_period(period, rtol)
     t0 = float(t0)
     comp = _compiled(lin)
     base = comp.linearization
@@ -239,6 +235,18 @@ def floquet(lin: Linearization | CompiledLinearization, period: float, t0: float
     return Floquet(period=T, t0=t0, monodromy=Phi, multipliers=mu, exponents=lam,
                    verdict=verdict, reason=reason, tolerance=tol, state_names=state,
                    cyclic=cyc, parameters=pars)
+
+
+def check_period(period: Any, rtol: float) -> float:
+    """The period as a positive finite number, and ``rtol`` in (0, 1e-3); EvaluationError
+    naming the bad one."""
+    T = float(period)
+    if not np.isfinite(T) or T <= 0:
+        raise EvaluationError(f"floquet: the period must be a positive finite number, got "
+                              f"{period!r}")
+    if not 0 < rtol < 1e-3:
+        raise EvaluationError(f"floquet: rtol must be in (0, 1e-3), got {rtol!r}")
+    return T
 
 
 def monodromy_scipy(state_matrix: Callable[[float], np.ndarray], n: int, t0: float, T: float,

@@ -25,7 +25,13 @@ from typing import Any
 import numpy as np
 import symengine as se
 
-from ..analysis.floquet import Floquet, _verdict, monodromy_scipy, multipliers
+from ..analysis.floquet import (
+    Floquet,
+    _verdict,
+    check_period,
+    monodromy_scipy,
+    multipliers,
+)
 from ..errors import ClosedSystemError, EvaluationError, warn
 from ..model import System
 from ..stages.linearization import NominalMotionWarning
@@ -119,12 +125,7 @@ class ClosedLinearization:
         if cyclic:
             raise ClosedSystemError(self.system, "cyclic coordinates in Routh's sense are not "
                                     "found for closed systems")
-        T = float(period)
-        if not np.isfinite(T) or T <= 0:
-            raise EvaluationError(f"floquet: the period must be a positive finite number, got "
-                                  f"{period!r}")
-        if not 0 < rtol < 1e-3:
-            raise EvaluationError(f"floquet: rtol must be in (0, 1e-3), got {rtol!r}")
+        T = check_period(period, rtol)
         t0 = float(t0)
         reason_extra = self._check(t0, T)
         Phi = monodromy_scipy(self.state_matrix, 2 * len(self.names), t0, T, rtol)
