@@ -146,7 +146,6 @@ def _simulate_partitioned(loop: System, t_span: tuple[float, float], z0: Any,
         run_method, run.get("steps", (0, 0, 0)))
 
 
-
 def _run_c(ev: LoopEvaluator, t0: float, t1: float, x: np.ndarray, tev: np.ndarray,
            method: str, rtol: float, atol: float, max_step: float, repartition: bool,
            cond_limit: float, fn_u: CompiledFunction | None = None,
@@ -218,6 +217,8 @@ def _run_segments(ev: LoopEvaluator, t0: float, t1: float, x: np.ndarray, tev: n
         seg = Segment(f, kernel.ev.u, kernel.tree.address, kernel.state_address,
                       kernel.accel_address, t, state, tev[i_eval:], C_METHODS[method], rtol,
                       atol, max_step)
+        seg.atol[-1] = 1e300  # W out of the error norm: in joules it made the steps depend on
+        # the length unit (the results integrate W over the samples)
         z_start, y_start = kernel.z.copy(), state[:f].copy()
         stop = False
         try:
@@ -296,9 +297,6 @@ def _record(out: dict[str, list], kernel: LoopKernel, con: Any, t: np.ndarray,
         out[k].extend(s[k])
     out["T"].extend(e["T"][:, 0, 0].tolist())
     out["V"].extend(e["V"][:, 0, 0].tolist())
-
-
-
 
 
 #: the formulations of :func:`simulate_closed` and the options each takes (their defaults)
