@@ -441,7 +441,7 @@ def test_cli_check_and_run_on_the_four_bar(tmp_path: Path, capsys: pytest.Captur
 
     assert main(["check", str(EXAMPLES / "four_bar.toml")]) == 0
     text = capsys.readouterr().out
-    assert "closure" in text and "1 by the rank 2 of Φ_z" in text and "1 (planar)" in text
+    assert "closure" in text and "1 by the rank 2 of Φ_y" in text and "1 (planar)" in text
     assert main(["check", "--json", str(EXAMPLES / "slider_crank.toml")]) == 0
     s = json.loads(capsys.readouterr().out)["loops"]
     assert s["degrees_of_freedom_rank"] == 1 and s["independent"] == ["phi"]

@@ -30,7 +30,7 @@ def loop_summary(model: Any) -> dict[str, Any]:
         "degrees_of_freedom_grubler_spatial": loop.grubler(),
         "degrees_of_freedom_grubler_planar": planar,
         "degrees_of_freedom_rank": loop.f - rank,
-        "rank_Phi_z": rank,
+        "rank_Phi_y": rank,
         "independent": list(ev.independent_names),
         "dependent": list(ev.dependent_names),
         "cond_Phi_d": ev.part.cond,
@@ -75,7 +75,7 @@ def check_lines(s: Mapping[str, Any]) -> list[str]:
     planar = s["degrees_of_freedom_grubler_planar"]
     lines.append(
         f"  degrees of freedom of the mechanism: {s['degrees_of_freedom_rank']} by the rank "
-        f"{s['rank_Phi_z']} of Φ_z at the assembled initial configuration; Grübler: "
+        f"{s['rank_Phi_y']} of Φ_y at the assembled initial configuration; Grübler: "
         f"{s['degrees_of_freedom_grubler_spatial']} (spatial)"
         + (f", {planar} (planar)" if planar is not None else ""))
     lines.append(f"  independent: {', '.join(s['independent'])}; dependent: "

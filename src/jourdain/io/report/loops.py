@@ -177,7 +177,7 @@ def loops_section(run: Run, res: Any) -> str:
             [("tree coordinates", str(len(summ["tree_coordinates"]))),
              ("Grübler (spatial)", str(summ["degrees_of_freedom_grubler_spatial"])),
              ("Grübler (planar)", "—" if planar is None else str(planar)),
-             ("rank of Φ_y at the assembled initial configuration", str(summ["rank_Phi_z"])),
+             ("rank of Φ_y at the assembled initial configuration", str(summ["rank_Phi_y"])),
              ("degrees of freedom by the rank", str(summ["degrees_of_freedom_rank"])),
              ("independent (initial partition)", esc(", ".join(summ["independent"]))),
              ("dependent", esc(", ".join(summ["dependent"]))),
@@ -187,7 +187,7 @@ def loops_section(run: Run, res: Any) -> str:
             ["", "value"], "info"))
         doc.update({k: summ[k] for k in (
             "constraint_rows", "degrees_of_freedom_grubler_spatial",
-            "degrees_of_freedom_grubler_planar", "degrees_of_freedom_rank", "rank_Phi_z",
+            "degrees_of_freedom_grubler_planar", "degrees_of_freedom_rank", "rank_Phi_y",
             "independent", "dependent", "cond_Phi_d")})
     if res is None or len(res.t) == 0:
         s.append(note("no motion: the partitions, closure residuals and closing joints' "
