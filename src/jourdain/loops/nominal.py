@@ -15,8 +15,9 @@ import symengine as se
 
 from ..errors import EvaluationError
 from ..model import System
+from ..stages.linearization.nominal import NOMINAL_RTOL
 from .closed_loop import LoopEvaluator
-from .linearization import LoopLinearization, linearize_loop
+from .linearization import LoopLinearization, linearize_loop, linearize_loop_exact
 from .periodic import ClosedLinearization, linearize_along
 
 
@@ -33,6 +34,16 @@ def _time_variant(system: System, lin: LoopLinearization, y: np.ndarray, yd: np.
             if np.abs(a - b).max(initial=0.0) > 1e-8 * scale:
                 return True
     return False
+
+
+def _at_rest_in_equilibrium(lin: LoopLinearization, yd: np.ndarray, ydd: Any) -> bool:
+    """At rest (ẏ_s = ÿ_s = 0) where ``h`` vanishes against the forces at work (M̃ and Q of
+    the differences as their scale): an equilibrium, where the exact linearization of
+    :func:`linearize_loop_exact` holds."""
+    if np.any(yd != 0) or (ydd is not None and np.any(np.asarray(ydd) != 0)):
+        return False
+    scale = float(np.abs(lin.Q).max(initial=0.0)) * (1.0 + float(np.abs(lin.z_s).max()))
+    return float(np.abs(lin.h).max(initial=0.0)) <= NOMINAL_RTOL * max(scale, 1e-300)
 
 
 def _is_motion(v: Any) -> bool:
@@ -98,6 +109,10 @@ def linearize_closed(system: System, nominal: Any, inputs: Mapping[str, float] |
         # along the nominal state held, a linear time-variant system (its Floquet analysis)
         held = {c: se.Float(float(v)) for c, v in zip(names, lin.z_s, strict=True)}
         return linearize_along(system, held, parameters)
+    if _at_rest_in_equilibrium(lin, yd, ydd):
+        # the symbolic derivatives there (the constraint forces' geometric stiffness
+        # included): exact where the differences carry an error of about eps^(2/3)
+        lin = linearize_loop_exact(system, lin.z_s, 0.0, parameters)
     pars = system.parameter_values
     pars.update(dict(parameters or {}))
     return replace(lin, system=system, parameters=pars)

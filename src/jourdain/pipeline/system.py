@@ -119,8 +119,10 @@ class System(Model):
         ``nominal`` (``{coordinate: value, "<coordinate>_d": rate}`` or the f tree
         coordinates; assembled onto the manifold): a
         :class:`jourdain.loops.linearization.LoopLinearization` with ``M_tilde, P, Q, h, D,
-        G, K, N``, the state matrix ``A`` and its ``eigenvalues`` (central differences of the
-        compiled M, k, q on the manifold)."""
+        G, K, N``, the state matrix ``A`` and its ``eigenvalues`` (symbolic derivatives at an
+        equilibrium at rest, else central differences of the compiled M, k, q on the
+        manifold); about a motion (expressions of t) or in a rheonomic system, a time-variant
+        :class:`jourdain.loops.periodic.ClosedLinearization` (``jd.floquet``)."""
         if self.closing:
             from ..loops.nominal import linearize_closed
 
