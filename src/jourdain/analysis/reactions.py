@@ -158,6 +158,24 @@ def solve_g(Q_bar: np.ndarray, N_hat: np.ndarray, k_hat: np.ndarray, q_hat: np.n
     return g, [names[i] for i in und] if names else [str(i) for i in und]
 
 
+def reactions_along(lay: ReactionLayout, M_bar: np.ndarray, Q_bar: np.ndarray,
+                    q_c: np.ndarray, q_e: np.ndarray) -> np.ndarray:
+    """``g`` (N, q) from ``N̂·g = k̂ − q̂`` at N states at once (leading axis N of ``M_bar``,
+    ``Q_bar``, ``q_c``, ``q_e``): one batched solve, or state by state (:func:`solve_g`) where
+    bodies without inertia or redundant directions need the bordered system."""
+    N, kh, qh = projected_reactions(lay, M_bar, Q_bar, q_c, q_e)
+    if not lay.singular_rows:  # N̂ g = k̂ − q̂ for all states in one batched solve
+        try:
+            return np.linalg.solve(N, (kh - qh)[:, :, None])[:, :, 0]
+        except np.linalg.LinAlgError:
+            pass
+    g = np.empty((N.shape[0], N.shape[1]))
+    for i in range(N.shape[0]):
+        g[i], _ = solve_g(Q_bar[i], N[i], kh[i], qh[i], q_c[i], q_e[i], lay.singular_rows,
+                          lay.g_names)
+    return g
+
+
 def evaluate_reactions(system: System, y: Any, yd: Any, t: float = 0.0,
                        parameters: Mapping[str, float] | None = None,
                        inputs: Mapping[str, float] | Sequence[float] | None = None,

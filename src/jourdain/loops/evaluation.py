@@ -23,7 +23,13 @@ from typing import Any
 
 import numpy as np
 
-from ..analysis.reactions import _reactions_function, projected_reactions, solve_g
+from ..analysis.reactions import (
+    ReactionLayout,
+    _reactions_function,
+    projected_reactions,
+    reactions_along,
+    solve_g,
+)
 from ..errors import EvaluationError, JourdainError
 from ..model import System
 from ..numeric import CompiledFunction, lambdify, state_vectors
@@ -35,51 +41,57 @@ from .reactions import closing_reactions
 
 
 @lru_cache(maxsize=16)
-def _closing_columns(system: System) -> tuple[list[int], CompiledFunction]:
-    """The rows of Φ with a direction in the bodies (not ``generic``) and Q̄_c of those,
-    compiled in the tree's arguments."""
-    con = constraints(system)
-    keep = [i for i, r in enumerate(con.rows) if r.kind != "generic"]
-    Q = con.Q_bar.rows
-    cols = SymMatrix.from_rows([[row[i] for i in keep] for row in Q]) if keep else None
-    mats = {"Q_c": cols} if cols is not None else {"Q_c": SymMatrix.zeros(1, 1)}
-    return keep, lambdify(system.tree, mats)
-
-
-def closed_reactions(system: System, s: Mapping[str, Any], lam: np.ndarray | None, t: float,
-                     parameters: Mapping[str, float] | None, u: np.ndarray,
-                     tree: Mapping[str, np.ndarray]) -> dict[str, Any]:
-    """Q̄, N̂, k̂, q̂ and g of the closed system at the assembled state ``s`` (see the module
-    docstring); ``tree``: the tree's M̄, q̄^c, q̄^e, Q̄, J̄ there."""
+def _closing_columns(system: System) -> tuple[ReactionLayout, int, CompiledFunction | None]:
+    """The layout of the closed system's reactions (the tree's, extended by the closing rows
+    with a direction in the bodies: not ``generic``), the number of the tree's columns, and
+    Q̄_c of those rows compiled in the tree's arguments (None where there is none)."""
     con = constraints(system)
     lay, _ = _reactions_function(system.tree)
-    keep, fn = _closing_columns(system)
-    Qt = np.asarray(tree["Q_bar"])
-    q0 = Qt.shape[1]
-    if keep:
-        args = state_vectors(system.tree, s["z"], s["zd"], t, parameters,
-                             list(u) if len(system.inputs) else None)
-        Qc = np.asarray(fn(*args)["Q_c"]).reshape(Qt.shape[0], len(keep))
-    else:
-        Qc = np.zeros((Qt.shape[0], 0))
-    Q = np.concatenate([Qt, Qc], axis=1)
+    keep = [i for i, r in enumerate(con.rows) if r.kind != "generic"]
+    q0 = len(lay.g_names)
     names = [b.name for b in system.bodies]
     touching = [list(c) for c in lay.touching]
     for j, i in enumerate(keep):
-        row = con.rows[i]
-        for body in (row.body_a, row.body_b):
+        for body in (con.rows[i].body_a, con.rows[i].body_b):
             if body != "world":
                 touching[names.index(body)].append(q0 + j)
     lay_c = replace(lay, touching=tuple(tuple(sorted(set(c))) for c in touching),
                     g_names=(*lay.g_names, *(con.rows[i].label for i in keep)))
+    if not keep:
+        return lay_c, q0, None
+    cols = SymMatrix.from_rows([[row[i] for i in keep] for row in con.Q_bar.rows])
+    return lay_c, q0, lambdify(system.tree, {"Q_c": cols})
+
+
+def _closed_matrices(system: System, tree: Mapping[str, np.ndarray], Qc: np.ndarray | None,
+                     zdd: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``Q̄ = [Q̄_tree, Q̄_c]`` and the q̄^c, q̄^e for ``N̂·g = k̂ − q̂`` of the closed system, at
+    one state or a batch (leading axis): ``k̂ = Q̄ᵀ(J̄_tree·ÿ + M̄⁻¹q̄^c) = Q̄ᵀM̄⁻¹(M̄·J̄_tree·ÿ +
+    q̄^c)``, since J̄_treeᵀQ̄_tree = 0 but the closing columns see the tree's accelerations
+    (Q̄_cᵀJ̄_tree·ÿ = Φ_y·ÿ = −c)."""
+    Qt = np.asarray(tree["Q_bar"])
+    Q = Qt if Qc is None else np.concatenate([Qt, Qc.reshape(*Qt.shape[:-1], -1)], axis=-1)
     M_bar = np.asarray(tree["M_bar"])
-    qc = np.asarray(tree["q_c"]).reshape(-1)
-    qe = np.asarray(tree["q_e"]).reshape(-1)
-    # k̂ = Q̄ᵀ(J̄_tree·ÿ + M̄⁻¹q̄^c) = Q̄ᵀM̄⁻¹(M̄·J̄_tree·ÿ + q̄^c): J̄_treeᵀQ̄_tree = 0, but the
-    # closing columns see the tree's accelerations (Q̄_cᵀJ̄_tree·ÿ = Φ_y·ÿ = −c)
-    qc_eff = qc + M_bar @ (np.asarray(tree["J_bar"]) @ s["zdd"])
-    N, kh, qh = projected_reactions(lay_c, M_bar, Q, qc_eff, qe)
-    g, und = solve_g(Q, N, kh, qh, qc_eff, qe, lay.singular_rows, lay_c.g_names)
+    qc = np.asarray(tree["q_c"]).reshape(*Qt.shape[:-2], -1)
+    qe = np.asarray(tree["q_e"]).reshape(*Qt.shape[:-2], -1)
+    a = np.einsum("...rc,...c->...r", np.asarray(tree["J_bar"]), zdd)
+    return Q, qc + np.einsum("...rc,...c->...r", M_bar, a), qe
+
+
+def closed_reactions(system: System, s: Mapping[str, Any], t: float,
+                     parameters: Mapping[str, float] | None, u: np.ndarray,
+                     tree: Mapping[str, np.ndarray]) -> dict[str, Any]:
+    """Q̄, N̂, k̂, q̂ and g of the closed system at the assembled state ``s`` (see the module
+    docstring); ``tree``: the tree's M̄, q̄^c, q̄^e, Q̄, J̄ there."""
+    lay_c, q0, fn = _closing_columns(system)
+    Qc = None
+    if fn is not None:
+        args = state_vectors(system.tree, s["z"], s["zd"], t, parameters,
+                             list(u) if len(system.inputs) else None)
+        Qc = np.asarray(fn(*args)["Q_c"])
+    Q, qc_eff, qe = _closed_matrices(system, tree, Qc, s["zdd"])
+    N, kh, qh = projected_reactions(lay_c, np.asarray(tree["M_bar"]), Q, qc_eff, qe)
+    g, und = solve_g(Q, N, kh, qh, qc_eff, qe, lay_c.singular_rows, lay_c.g_names)
     if not (np.isfinite(N).all() and np.isfinite(kh).all() and np.isfinite(qh).all()):
         raise EvaluationError(f"N_hat, k_hat or q_hat of {system.name!r} contain NaN or inf at "
                               "this state")
@@ -130,7 +142,7 @@ def evaluate_closed(system: System, y: Any, yd: Any, t: float = 0.0,
                                       initial=0.0)),
     }
     try:
-        r = closed_reactions(system, s, lam, tv, parameters, uv, tree)
+        r = closed_reactions(system, s, tv, parameters, uv, tree)
         q0 = r.pop("_q_tree")
         out.update(r)
         out["joint_wrenches"] = joint_wrenches(tree_sys, r["g"][:q0], s["z"], s["zd"], tv,
@@ -145,26 +157,19 @@ def evaluate_closed(system: System, y: Any, yd: Any, t: float = 0.0,
     return out
 
 
-__all__ = ["closed_reactions", "closed_reactions_along", "evaluate_closed"]
-
-
 def closed_reactions_along(system: System, res: Any) -> tuple[np.ndarray, list[str]]:
     """``g`` (N, q) and its names along a closed system's motion ``res``
-    (:class:`jourdain.Results`): :func:`closed_reactions` at every sample, from the tree's
-    numbers there."""
-    tree_sys = system.tree
-    n = len(res.t)
-    names: list[str] = []
-    rows: list[np.ndarray] = []
-    params = dict(res.parameters)
-    lam = res.multipliers
-    for i in range(n):
-        u = res.u[i] if res.u.shape[1] else np.zeros(0)
-        tree = tree_evaluate(tree_sys, res.y[i], res.yd[i], float(res.t[i]), params,
-                             list(u) if len(system.inputs) else None)
-        s = {"z": res.y[i], "zd": res.yd[i], "zdd": res.ydd[i]}
-        r = closed_reactions(system, s, lam[i], float(res.t[i]), params, u, tree)
-        names = r["g_names"]
-        rows.append(r["g"])
-    q = len(names) if names else 0
-    return (np.array(rows) if rows else np.zeros((0, q))), names
+    (:class:`jourdain.Results`): the tree's compiled numbers for all samples in one call, the
+    closing columns likewise, and one batched solve (:func:`reactions_along`), as for a
+    tree's motion."""
+    lay_c, _, fn_c = _closing_columns(system)
+    _, fn = _reactions_function(system.tree)
+    p = np.array([res.parameters[k] for k, _ in system.parameters])
+    U = res.u if res.u.shape[1] else None
+    tree = fn.batch(res.y, res.yd, res.t, p, U)
+    Qc = None if fn_c is None else fn_c.batch(res.y, res.yd, res.t, p, U)["Q_c"]
+    Q, qc_eff, qe = _closed_matrices(system, tree, Qc, res.ydd)
+    return reactions_along(lay_c, np.asarray(tree["M_bar"]), Q, qc_eff, qe), list(lay_c.g_names)
+
+
+__all__ = ["closed_reactions", "closed_reactions_along", "evaluate_closed"]

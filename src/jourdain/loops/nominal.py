@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import replace
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -15,16 +16,33 @@ import symengine as se
 
 from ..errors import EvaluationError
 from ..model import System
+from ..model.validation import force_expressions
+from ..stages.kinematics import kinematics
 from ..stages.linearization.nominal import NOMINAL_RTOL
-from .closed_loop import LoopEvaluator
+from .closed_loop import LoopEvaluator, constraints
 from .linearization import LoopLinearization, linearize_loop, linearize_loop_exact
 from .periodic import ClosedLinearization, linearize_along
 
 
+@lru_cache(maxsize=32)
+def _mentions_t(system: System) -> bool:
+    """Whether t appears explicitly anywhere the closed equations come from: the tree's
+    kinematics (a prescribed motion), a force element's law (an excitation) or a closing
+    row."""
+    t = system.t
+    kin = kinematics(system.tree)
+    exprs = [e for bk in kin.bodies for m in (bk.r_O, bk.S) for e in m.entries()]
+    exprs += [e for f in system.forces for e in force_expressions(f)]
+    exprs += constraints(system).Phi.entries()
+    return any(t in se.sympify(e).free_symbols for e in exprs)
+
+
 def _time_variant(system: System, lin: LoopLinearization, y: np.ndarray, yd: np.ndarray,
                   ydd: Any, parameters: Mapping[str, float] | None) -> bool:
-    """Whether M̃, P, Q change with t at the state held (tested at two more times, as the
-    numeric linearization of trees does where t appears)."""
+    """Whether M̃, P, Q change with t at the state held: tested at two more times where t
+    appears at all (:func:`_mentions_t`), as the numeric linearization of trees does."""
+    if not _mentions_t(system):
+        return False
     for t in (0.318309886, 1.2732395447):
         other = linearize_loop(system, lin.z_s, yd, t, ydd, parameters)
         for a, b in ((lin.M_tilde, other.M_tilde), (lin.P, other.P), (lin.Q, other.Q)):

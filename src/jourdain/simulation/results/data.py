@@ -222,29 +222,16 @@ class TimeHistories:
         if system.closing:  # every joint's, the closing joints' included (METHOD.md §7)
             from ...loops.evaluation import closed_reactions_along
 
-            g_closed, names_closed = closed_reactions_along(system, self)
-            self._energies["g"], self._energies["g_names"] = g_closed, names_closed
+            self._energies["g"], self._energies["g_names"] = closed_reactions_along(system, self)
             return
-        from ...analysis.reactions import _reactions_function, projected_reactions, solve_g
+        from ...analysis.reactions import _reactions_function, reactions_along
 
         lay, fn = _reactions_function(system)
         p = np.array([self.parameters[k] for k, _ in system.parameters])
         U = self.u if self.u.shape[1] else None
         out = fn.batch(self.y, self.yd, self.t, p, U)
-        qc, qe = out["q_c"][:, :, 0], out["q_e"][:, :, 0]
-        N, kh, qh = projected_reactions(lay, out["M_bar"], out["Q_bar"], qc, qe)
-        g = None
-        if not lay.singular_rows:  # N̂ g = k̂ − q̂ for all states in one batched solve
-            try:
-                g = np.linalg.solve(N, (kh - qh)[:, :, None])[:, :, 0]
-            except np.linalg.LinAlgError:
-                g = None
-        if g is None:  # bodies without inertia or redundant directions: state by state
-            g = np.empty((len(self.t), N.shape[1]))
-            for i in range(len(self.t)):
-                g[i], _ = solve_g(out["Q_bar"][i], N[i], kh[i], qh[i], qc[i], qe[i],
-                                  lay.singular_rows, lay.g_names)
-        self._energies["g"] = g
+        self._energies["g"] = reactions_along(lay, out["M_bar"], out["Q_bar"],
+                                              out["q_c"][:, :, 0], out["q_e"][:, :, 0])
         self._energies["g_names"] = list(lay.g_names)
 
     @property
