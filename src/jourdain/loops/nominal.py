@@ -98,9 +98,9 @@ def linearize_closed(system: System, nominal: Any, inputs: Mapping[str, float] |
             try:
                 val = float(v)
             except (TypeError, ValueError):
-                raise ClosedSystemError(system, f"the nominal value of {key} is {v!r}: closed "
-                                        "systems are linearized about a state (numbers), not "
-                                        "a motion given by expressions, yet") from None
+                raise EvaluationError(f"nominal {key}: expected a number or a SymEngine "
+                                      f"expression of t and the parameters, got {v!r}"
+                                      ) from None
             if key in names:
                 y[names.index(key)] = val
             elif key.endswith("_dd") and key[:-3] in names:
@@ -134,7 +134,6 @@ def linearize_closed(system: System, nominal: Any, inputs: Mapping[str, float] |
     pars = system.parameter_values
     pars.update(dict(parameters or {}))
     return replace(lin, system=system, parameters=pars)
-
 
 
 def linearize_state(system: System, nominal: Any,

@@ -139,8 +139,10 @@ class ClosedLinearization:
     def _check(self, t0: float, T: float) -> str:
         """The matrices must repeat with the period; the nominal motion should solve the
         equations (h ≈ 0 against the forces at work), else a warning."""
+        at: dict[float, dict[str, np.ndarray]] = {}
         for a, b in ((t0, t0 + T), (t0 + T / 3, t0 + 4 * T / 3)):
             ma, mb = self.matrices(a), self.matrices(b)
+            at[a] = ma
             for key in ("M_tilde", "P", "Q"):
                 scale = max(1.0, float(np.abs(ma[key]).max(initial=0.0)))
                 if np.abs(ma[key] - mb[key]).max(initial=0.0) > 1e-6 * scale:
@@ -148,8 +150,7 @@ class ClosedLinearization:
                         f"floquet: the linearization of {self.system.name!r} is not periodic "
                         f"with T = {T:.6g}: {key} at t = {a:.6g} and t = {b:.6g} differ by "
                         f"{np.abs(ma[key] - mb[key]).max():.3g}")
-        for t in (t0, t0 + T / 3):
-            m = self.matrices(t)
+        for t, m in at.items():  # at t0 and t0 + T/3, computed above
             _, _, ydd = self.state(t)
             scale = (np.abs(m["M_tilde"]) @ np.abs(ydd) + np.abs(m["Q"]).max(initial=0.0)
                      + np.abs(m["h"]))
@@ -171,20 +172,16 @@ def linearize_along(system: System, nominal: Mapping[Any, Any],
     names = system.coordinate_names
     f = system.f
     exprs: dict[str, se.Basic] = {}
+    allowed = {"t", *system.parameter_values}
     for k, v in nominal.items():
         key = str(k)
         if key not in names:
             raise EvaluationError(f'nominal: unknown coordinate "{key}"; coordinates are '
                                   f"{', '.join(names)} (rates follow from the expressions)")
-        try:
-            exprs[key] = se.sympify(v) if isinstance(v, int | float) else v
-        except (TypeError, ValueError, se.SympifyError):
-            raise EvaluationError(f"nominal {key}: expected a number or an expression, got "
-                                  f"{v!r}") from None
+        exprs[key] = se.sympify(v) if isinstance(v, int | float) else v
         if not isinstance(exprs[key], se.Basic):
             raise EvaluationError(f"nominal {key}: expected a number or a SymEngine "
                                   f"expression (jourdain.t, jourdain.cos, ...), got {v!r}")
-        allowed = {"t", *system.parameter_values}
         unknown = sorted({str(s) for s in exprs[key].free_symbols} - allowed)
         if unknown:
             raise EvaluationError(f"nominal {key}: unknown name(s) {', '.join(unknown)}; the "
