@@ -218,8 +218,7 @@ def _redundant_results(loop: System, ev: Any, sol: Any,
     :func:`_simulate_penalty`) from SciPy's solution, each sample evaluated by ``sample(z, ż, t)``
     → ``(z̈, λ, constraint data)``."""
     n = loop.f
-    out: dict[str, list] = {k: [] for k in ("z", "zd", "zdd", "Phi", "Phi_dot", "lam", "T",
-                                             "V")}
+    out: dict[str, list] = {k: [] for k in ("z", "zd", "zdd", "Phi", "Phi_dot", "lam")}
     for k in range(len(sol.t)):
         z, zd, t = sol.y[:n, k], sol.y[n:, k], float(sol.t[k])
         zdd, lam, cd = sample(np.ascontiguousarray(z), np.ascontiguousarray(zd), t)
@@ -229,13 +228,11 @@ def _redundant_results(loop: System, ev: Any, sol: Any,
         out["Phi"].append(cd["Phi"][:, 0])
         out["Phi_dot"].append(cd["Phi_z"] @ zd + cd["Phi_t"][:, 0])
         out["lam"].append(lam)
-        out["T"].append(float(cd["T"][0, 0]))
-        out["V"].append(float(cd["V"][0, 0]))
     status = "finished" if sol.status == 0 else "failed"
     return _Run(
         loop, sol.t, np.array(out["z"]), np.array(out["zd"]), np.array(out["zdd"]),
         np.array(out["Phi"]), np.array(out["Phi_dot"]), np.array(out["lam"]),
-        np.array(out["T"]), np.array(out["V"]), list(ev.labels), [(t0, ())], status,
+        list(ev.labels), [(t0, ())], status,
         str(sol.message), int(sol.nfev), wall, None,
         dict(zip([k for k, _ in loop.tree.parameters], ev.p.tolist(), strict=True)),
         method)

@@ -23,8 +23,7 @@ from .compiled import input_function
 class _Run:
     """Time histories of one run: ``t`` (N,); ``y, yd, ydd`` (N, n) the tree's coordinates
     and their rates; ``Phi``, ``Phi_dot`` (N, m) the residuals of the closing rows; ``lam``
-    (N, m) their multipliers (row names in ``labels``); ``T``, ``V`` (N,) kinetic and
-    potential energy; ``partitions``: ``[(t_start, independent names), ...]``; ``singular``:
+    (N, m) their multipliers (row names in ``labels``); ``partitions``: ``[(t_start, independent names), ...]``; ``singular``:
     the :class:`SingularConfiguration` that stopped the run, or None; ``method``: the
     integrator that ran."""
 
@@ -36,8 +35,6 @@ class _Run:
     Phi: np.ndarray
     Phi_dot: np.ndarray
     lam: np.ndarray
-    T: np.ndarray
-    V: np.ndarray
     labels: list[str]
     partitions: list[tuple[float, tuple[str, ...]]]
     status: str = "finished"

@@ -28,8 +28,7 @@ def run_scipy(ev: LoopEvaluator, t0: float, t1: float, x: np.ndarray, tev: np.nd
     import scipy.integrate  # noqa: PLC0415 (heavy, needed by this driver only)
 
     stepper = getattr(scipy.integrate, method)
-    out: dict[str, list] = {k: [] for k in ("t", "z", "zd", "zdd", "Phi", "Phi_dot", "lam",
-                                             "T", "V")}
+    out: dict[str, list] = {k: [] for k in ("t", "z", "zd", "zdd", "Phi", "Phi_dot", "lam")}
     partitions = [(t0, tuple(ev.independent_names))]
     status, message, singular = "finished", "the integration reached t_end", None
     t, nfev, k_eval = t0, 0, 0
@@ -43,7 +42,7 @@ def run_scipy(ev: LoopEvaluator, t0: float, t1: float, x: np.ndarray, tev: np.nd
         f = ev.part.f
         s = ev.accelerations(xx[:f], xx[f:], tt, u_of(tt))
         out["t"].append(tt)
-        for k in ("z", "zd", "zdd", "Phi", "Phi_dot", "T", "V"):
+        for k in ("z", "zd", "zdd", "Phi", "Phi_dot"):
             out[k].append(s[k])
         out["lam"].append(ev.multipliers(s))
 

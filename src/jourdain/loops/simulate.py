@@ -71,7 +71,6 @@ from .charts import decide
 from .closed_loop import (
     LoopEvaluator,
     SingularConfiguration,
-    constraint_function,
 )
 from .compiled import REASONS, LoopKernel, build_loop_library_soon, input_function
 from .redundant import _simulate_redundant_form
@@ -139,8 +138,8 @@ def _simulate_partitioned(loop: System, t_span: tuple[float, float], z0: Any,
         return np.array(out[k]).reshape(-1, w) if len(out[k]) else np.zeros((0, w))
     return _Run(
         loop, np.array(out["t"], dtype=float), arr("z", n), arr("zd", n), arr("zdd", n),
-        arr("Phi", m), arr("Phi_dot", m), arr("lam", m), np.array(out["T"], dtype=float),
-        np.array(out["V"], dtype=float), list(ev.labels), run["partitions"], run["status"],
+        arr("Phi", m), arr("Phi_dot", m), arr("lam", m), list(ev.labels), run["partitions"],
+        run["status"],
         run["message"], run["nfev"], time.perf_counter() - started, run["singular"],
         dict(zip([k for k, _ in loop.tree.parameters], ev.p.tolist(), strict=True)),
         run_method, run.get("steps", (0, 0, 0)))
@@ -198,14 +197,13 @@ def _run_segments(ev: LoopEvaluator, t0: float, t1: float, x: np.ndarray, tev: n
     kernel = LoopKernel(ev)
     kernel.set_inputs(fn_u)
     kernel.z[:] = ev.z_guess
-    out: dict[str, list] = {k: [] for k in ("t", *_KEYS, "T", "V")}
+    out: dict[str, list] = {k: [] for k in ("t", *_KEYS)}
     partitions = [(t0, tuple(ev.independent_names))]
     status, message = "finished", "the integration reached t_end"
     singular: SingularConfiguration | None = None
     nfev, i_eval, t = 0, 0, t0
     steps = np.zeros(3, dtype=int)  # steps, accepted, rejected (the integrator's counters)
     state = np.concatenate([x, [0.0]])  # [y, ẏ, W]
-    con = constraint_function(ev.loop)
     mark = math.nan  # Φ_d's condition number at the partition (nan: measure it)
     while i_eval < tev.size:
         f = ev.part.f
@@ -232,7 +230,7 @@ def _run_segments(ev: LoopEvaluator, t0: float, t1: float, x: np.ndarray, tev: n
         k = int(seg.n_out[0])
         if k:  # the samples, followed from the segment's start
             kernel.restart(z_start, y_start)
-            _record(out, kernel, con, seg.out_t[:k], seg.out_x[:k, :2 * f])
+            _record(out, kernel, seg.out_t[:k], seg.out_x[:k, :2 * f])
             i_eval += k
         if stop:
             t_last = out["t"][-1] if out["t"] else t
@@ -283,20 +281,16 @@ def _run_segments(ev: LoopEvaluator, t0: float, t1: float, x: np.ndarray, tev: n
             "singular": singular, "nfev": nfev, "steps": tuple(int(k) for k in steps)}
 
 
-def _record(out: dict[str, list], kernel: LoopKernel, con: Any, t: np.ndarray,
-            x: np.ndarray) -> None:
-    """Samples at ``t`` of the states ``x = [y, ẏ]`` on the manifold (C), with T and V."""
+def _record(out: dict[str, list], kernel: LoopKernel, t: np.ndarray, x: np.ndarray) -> None:
+    """Samples at ``t`` of the states ``x = [y, ẏ]`` on the manifold (C); the energies are
+    the results' (:class:`jourdain.Results`, from the tree's kinematics)."""
     s, bad = kernel.samples(t, x)
     if bad >= 0:  # a sample off the manifold's reach (at a singular position): cut there
         t = t[:bad]
         s = {k: v[:bad] for k, v in s.items()}
-    ev = kernel.ev
-    e = con.batch(s["z"], s["zd"], t, ev.p, ev.u)
     out["t"].extend(t.tolist())
     for k in _KEYS:
         out[k].extend(s[k])
-    out["T"].extend(e["T"][:, 0, 0].tolist())
-    out["V"].extend(e["V"][:, 0, 0].tolist())
 
 
 #: the formulations of :func:`simulate_closed` and the options each takes (their defaults)
