@@ -233,8 +233,7 @@ class LoopEvaluator:
         gamma[list(self.part.dependent)] = -getrs(lu[0], lu[1], c2["c"][rows, 0])[0]
         Phi_dot = c2["Phi_z"] @ zd + c2["Phi_t"][:, 0]
         return {"z": z, "zd": zd, "J_z": J_z, "gamma": gamma, "Phi": c2["Phi"][:, 0],
-                "Phi_dot": Phi_dot, "Phi_z": c2["Phi_z"], "T": float(c2["T"][0, 0]),
-                "V": float(c2["V"][0, 0])}
+                "Phi_dot": Phi_dot, "Phi_z": c2["Phi_z"]}
 
     def mkq(self, y: Any, yd: Any, t: float, u: Any = None) -> dict[str, Any]:
         """``M, k, q`` in the independent coordinates (with :meth:`state`'s fields and the

@@ -1,6 +1,6 @@
 """The errors of the numbers of closed systems, and the constraint stage
 (:mod:`jourdain.stages.constraints`: Φ, Φ_y, Φ_t, c) of a closed :class:`jourdain.System`
-compiled with the tree's energies (:func:`constraint_function`). In this package ``z`` names
+compiled (:func:`constraint_function`). In this package ``z`` names
 the tree's coordinates (the system's ``y``) and ``y`` the independent ones. The method is
 described in :mod:`jourdain.loops.closed_loop`."""
 
@@ -10,14 +10,12 @@ from functools import lru_cache
 
 import numpy as np
 
-from ..analysis.energy import energy
 from ..errors import AssemblyError, ModelError, SingularConfiguration
 from ..model import System
 from ..numeric import CompiledFunction, lambdify
 from ..stages.constraints import Constraints
 from ..stages.constraints import constraints as constraint_stage
 from ..stages.kinematics import kinematics  # the model has no stage methods (issue 16)
-from ..symbolic import SymMatrix
 
 EPS = float(np.finfo(float).eps)
 
@@ -43,14 +41,11 @@ def _constraints(loop: System) -> Constraints:
 
 @lru_cache(maxsize=16)
 def constraint_function(loop: System) -> CompiledFunction:
-    """Compiled ``Phi, Phi_z, Phi_t, c`` and the tree's energies ``T, V`` (memoized)."""
+    """Compiled ``Phi, Phi_z, Phi_t, c`` (memoized; the energies of a run are its
+    :class:`jourdain.Results`')."""
     con = constraints(loop)
-    e = energy(kinematics(loop.tree))
     return lambdify(loop.tree, {"Phi": con.Phi, "Phi_z": con.Phi_y, "Phi_t": con.Phi_t,
-                                "c": con.c, "T": SymMatrix.column([e.T]),
-                                "V": SymMatrix.column([e.V])})
-
-
+                                "c": con.c})
 
 
 __all__ = ["EPS", "AssemblyError", "Constraints", "SingularConfiguration",
