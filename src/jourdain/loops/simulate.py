@@ -356,7 +356,10 @@ def simulate_closed(system: System, t_span: tuple[float, float], y0: Any, yd0: A
     progress = options.pop("progress", False)
     output = options.pop("output", None)
     raise_on_interrupt = bool(options.pop("raise_on_interrupt", False))
-    unknown = {k: v for k, v in options.items() if v not in (None, False, ())}
+    misspelt = sorted(set(options) - {"events", "first_step"})
+    if misspelt:  # as Python says it, and as a tree's run does (never ignored)
+        raise TypeError(f"simulate() got an unexpected keyword argument {misspelt[0]!r}")
+    unknown = {k: v for k, v in options.items() if v not in (None, ())}
     if unknown:
         raise ClosedSystemError(system, f"simulate(..., {', '.join(sorted(unknown))}=...) "
                                 "is not available for closed systems yet")
