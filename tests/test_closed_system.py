@@ -53,6 +53,30 @@ def test_closing_columns_are_the_constraint_gradients(name: str) -> None:
         assert np.max(np.abs(lhs - rhs)) <= eval_tol(6 * len(system.bodies), scale)
 
 
+@pytest.mark.parametrize("kind,axis", [("revolute", "z"), ("universal", "z"),
+                                       ("prismatic", "x"), ("point_on_line", "x"),
+                                       ("point_on_plane", "y"), ("spherical", None)])
+def test_closing_columns_of_every_kind_with_both_bodies_moving(kind: str, axis: str | None
+                                                               ) -> None:
+    """The same virtual-work identity ``J̄_treeᵀ·Q̄_c = Φ_yᵀ`` for every kind of closing joint
+    between two moving bodies, off-centre points (a row (p_B − p_A)·w with w fixed in A acts
+    on A at the point coinciding with p_B: the column must say so)."""
+    fb = four_bar()
+    b, c = jd.symbols("b c")
+    cj = jd.ClosingJoint("cj", kind, "coupler", "rocker", point_a=(0.3 * b, 0.1, 0.02),
+                         point_b=(c, 0.05, -0.01), **({"axis": axis} if axis else {}))
+    system = fb.tree.closed_by([cj])
+    con = system.constraints()
+    ne = system.tree.newton_euler()
+    fn = lambdify(system.tree, {"J": ne.J_bar, "Qc": con.Q_bar, "Py": con.Phi_y})
+    p = np.array(list(system.parameter_values.values()))
+    for y in ([0.4, 0.7, 1.3], [-1.1, 2.0, 0.2]):
+        out = fn(np.array(y), np.zeros(3), 0.0, p, np.zeros(0))
+        scale = float(np.max(np.abs(out["J"]).T @ np.abs(out["Qc"])))
+        assert np.max(np.abs(out["J"].T @ out["Qc"] - out["Py"].T)) <= eval_tol(
+            6 * len(system.bodies), scale), con.labels
+
+
 @pytest.mark.parametrize("name", CLOSED)
 def test_closed_evaluate_invariants_and_reactions(name: str) -> None:
     """At the assembled state: Φ_y·L = 0, L̄ᵀ·Q̄ = 0 (J̄ of the closed system against every

@@ -166,11 +166,14 @@ def constraint_rows(kin: Kinematics, closing: Sequence[ClosingJoint]) -> list[Co
             d = _sub(pB, pA)
             normals = ((cj.axis,) if cj.type == "point_on_plane"
                        else perpendiculars(cj.axis))  # type: ignore[arg-type]
+            # δΦ = (δp_B − δp_A)·w + (p_B − p_A)·δw, w fixed in A: the force −λ·w acts on A
+            # at the point of A that coincides with p_B (its moment about p_A is the second
+            # term), and +λ·w on B at p_B
+            at_b = {**at, "p_a": pB}
             for k, nv in enumerate(normals, 1):
                 w = _mv(SA, nv)  # type: ignore[arg-type]
-                # δΦ = δ(p_B − p_A)·w + ...: the force on A along w is −λ
                 rows.append(ConstraintRow(n, f"{n}.N{k}" if len(normals) > 1 else f"{n}.N",
-                                          _dot(d, w), "force", tuple(-c for c in w), **at))
+                                          _dot(d, w), "force", tuple(-c for c in w), **at_b))
             if cj.type == "prismatic":
                 for lab, i, j in (("Mz", 0, 1), ("Mx", 1, 2), ("My", 2, 0)):
                     a = _mv(SA, ex[i])
