@@ -113,7 +113,11 @@ def linear_analysis(model: ModelFile, about: str | None,
     if system.closing:  # in the independent coordinates (jourdain.io.closed_linear)
         from .closed_linear import closed_linear_analysis
 
-        return closed_linear_analysis(model, about, parameters, t, period)
+        nom = model.nominal_motion(about) if about is not None else None
+        if period is None and nom is not None:
+            period = nom.period
+        T = None if period is None else period_value(system, period, parameters)
+        return closed_linear_analysis(model, about, parameters, t, T)
     nominal = model.nominal_motion(about)
     params = dict(parameters or {}) or None
     with warnings.catch_warnings():

@@ -15,14 +15,13 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ClosedSystemError, EvaluationError, JourdainError
+from ..errors import ClosedSystemError, JourdainError
 from ..loops.linearization import (
     LoopLinearization,
     equilibrium,
     linearize_loop,
-    linearize_loop_exact,
 )
-from ..loops.nominal import linearize_closed
+from ..loops.nominal import linearize_closed, linearize_state
 from ..model import System
 
 
@@ -30,15 +29,23 @@ def linearize_near(loop: System, z0: Any,
                    parameters: Mapping[str, float] | None = None
                    ) -> tuple[LoopLinearization, str]:
     """The linearization about the equilibrium nearest ``z0``, else about ``z0`` at rest;
-    with the words saying which."""
+    with the words saying which (:func:`jourdain.loops.nominal.linearize_state`: exact at the
+    equilibrium, central differences elsewhere; ClosedSystemError where it changes with t)."""
+    state, about = _nearest_state(loop, z0, parameters)
+    return linearize_state(loop, state, parameters), about
+
+
+def _nearest_state(loop: System, z0: Any, parameters: Mapping[str, float] | None
+                   ) -> tuple[dict[str, float], str]:
+    """The equilibrium nearest ``z0`` (else ``z0`` itself, at rest) by coordinate, with the
+    words saying which."""
     try:
         z_s = equilibrium(loop, z0, parameters=parameters)
+        about = "equilibrium nearest the initial configuration"
     except JourdainError as exc:
+        z_s = np.asarray(z0, dtype=float)
         about = f"initial configuration at rest (no equilibrium: {exc})"
-        return linearize_loop(loop, np.asarray(z0, dtype=float), parameters=parameters), about
-    # at an equilibrium the symbolic derivatives apply (the exact linearization)
-    return (linearize_loop_exact(loop, z_s, parameters=parameters),
-            "equilibrium nearest the initial configuration")
+    return dict(zip(loop.coordinate_names, z_s.tolist(), strict=True)), about
 
 
 def linearization_document(loop: System, lin: LoopLinearization, about: str
@@ -82,17 +89,17 @@ def closed_linearization_at(system: System, y: Any, yd: Any, t: float,
 
 def closed_linear_analysis(model: Any, about: str | None,
                            parameters: Mapping[str, float] | None = None, t: float = 0.0,
-                           period: Any = None) -> dict[str, Any]:
+                           period: float | None = None) -> dict[str, Any]:
     """:func:`jourdain.io.capabilities.linear_analysis` of a model with closing joints: the
     linearization in the independent coordinates about the nominal state ``about`` (constant
     numbers) or, without it, about the equilibrium nearest the initial configuration
-    (:func:`linearize_near`); its numbers, modes and stability verdict (``closed``: True)."""
+    (:func:`linearize_near`); its numbers, modes and stability verdict (``closed``: True).
+    ``period``: a number (evaluated by the caller, :func:`jourdain.io.capabilities.period_value`)
+    for the Floquet analysis."""
     from ..analysis.modes import modes, stability
 
     system: System = model.system
     nominal = model.nominal_motion(about) if about is not None else None
-    if period is None and nominal is not None:
-        period = nominal.period
     params = dict(parameters or {}) or None
     if period is not None:
         return _periodic(system, nominal, model.simulation.y0 or [0.0] * system.f, params, t,
@@ -122,29 +129,22 @@ def closed_linear_analysis(model: Any, about: str | None,
 
 
 def _periodic(system: System, nominal: Any, y0: Any, params: Mapping[str, float] | None,
-              t: float, period: Any) -> dict[str, Any]:
+              t: float, T: float) -> dict[str, Any]:
     """The Floquet analysis of the closed ``system`` about the ``nominal`` motion (None: the
-    equilibrium nearest ``y0``) over ``period`` (a number, or an expression in the parameters)
-    from ``t``."""
+    equilibrium nearest ``y0``) over the period ``T`` from ``t``."""
     import symengine as se
 
     from ..analysis.floquet import floquet
-    from ..loops.periodic import ClosedLinearization
+    from ..loops.periodic import ClosedLinearization, linearize_along
 
-    values = {**system.parameter_values, **dict(params or {})}
-    try:
-        T = float(se.sympify(period).subs({se.Symbol(k): v for k, v in values.items()}))
-    except (RuntimeError, TypeError, ValueError) as exc:
-        raise EvaluationError(f"the period {period} has no numeric value: {exc}") from None
     if nominal is not None:
         mapping = dict(zip(system.coordinate_names, nominal.y, strict=True))
         lin = linearize_closed(system, mapping, dict(nominal.inputs) or None, params)
         where = f'nominal motion "{nominal.name}"'
     else:  # the equilibrium nearest the initial configuration, as without --periodic
-        lin, where = linearize_near(system, y0, params)
-    if not isinstance(lin, ClosedLinearization):
-        from ..loops.periodic import linearize_along
-
+        state, where = _nearest_state(system, y0, params)
+        lin = linearize_closed(system, state, None, params)
+    if not isinstance(lin, ClosedLinearization):  # time-invariant: held over the period
         lin = linearize_along(system, {c: se.Float(float(v)) for c, v in
                                        zip(system.coordinate_names, lin.z_s, strict=True)},
                               params)

@@ -86,8 +86,8 @@ def linearization_section(run: Run) -> str:
     """Section 4 of a closed system: M̃, P, Q, h, D, G, K, N and the eigenvalues in the
     independent coordinates about the equilibrium nearest the initial configuration (else the
     initial configuration at rest)."""
-    from ...loops.linearization import equilibrium
-    from ...loops.nominal import linearize_state
+    from ...analysis.modes import stability
+    from ..closed_linear import linearization_document, linearize_near
 
     model, out, info = run.model, run.out, run.info
     system = model.system
@@ -101,14 +101,7 @@ def linearization_section(run: Run) -> str:
     y0, _ = assembled_state(run)
     params = run.params or None
     try:
-        try:
-            z_s = equilibrium(system, y0, parameters=params)
-            about = "equilibrium nearest the initial configuration"
-        except JourdainError as exc:
-            z_s = y0
-            about = f"initial configuration at rest (no equilibrium found nearby: {exc})"
-        lin = linearize_state(system, dict(zip(system.coordinate_names, z_s, strict=True)),
-                              parameters=params)
+        lin, about = linearize_near(system, y0, params)
     except (JourdainError, np.linalg.LinAlgError) as exc:
         s.append(note(f"could not linearize: {exc}"))
         info.notes.append(f"linearization: {exc}")
@@ -130,19 +123,12 @@ def linearization_section(run: Run) -> str:
                      numstr(-lam.real / w) if w > 0 else "—"))
     s.append(html_table(rows, ["Re λ / (1/s)", "Im λ / (rad/s)", "f<sub>n</sub> / Hz", "ζ"]))
     s.append(run.figures.add(eigen_plot, lams, "eigenvalues about the equilibrium"))
-    stable = bool(np.all(ev.real < -1e-9))
-    marginal = bool(np.all(ev.real < 1e-9))
-    verdict = ("asymptotically stable" if stable else
-               "not asymptotically stable (eigenvalues on the imaginary axis)" if marginal
-               else "unstable (an eigenvalue with positive real part)")
-    s.append(f"<p>Stability: <span class='{'ok' if stable else 'bad'}'>{esc(verdict)}</span>"
-             "</p>")
-    info.summary_lines.append(f"  linearized about the {about.split(' (')[0]}: {verdict}")
-    from ..closed_linear import linearization_document
-
+    st = stability(lin.state_space(), cyclic=())  # the verdict of trees and of the CLI
+    cls = "ok" if st.is_stable else "bad"
+    s.append(f"<p>Stability: <span class='{cls}'>{esc(st.verdict)}</span> — "
+             f"{esc(st.reason)}</p>")
+    info.summary_lines.append(f"  linearized about the {about.split(' (')[0]}: {st.verdict}")
     doc = linearization_document(system, lin, about)
-    doc["method"] = ("System.linearize: central differences of the compiled M, k, q in the "
-                     "independent coordinates on the manifold")
     fn = out / "linearization-equilibrium.json"
     fn.write_text(json.dumps(doc, indent=1), encoding="utf-8")
     info.files.append(fn)
