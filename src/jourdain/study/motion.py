@@ -111,15 +111,10 @@ def _simulate_case(ctx: Context, i: int, P: np.ndarray, Y: np.ndarray, YD: np.nd
     inputs = {k: v for k, v in ctx.model.simulation.inputs} or None
     parameters = dict(zip(ctx.parameter_names, P[i].tolist(), strict=True))
     try:
-        if ctx.closed:  # on the constraint manifold: the closed system's own simulate()
-            r = system.simulate((0.0, s["t_end"]), Y[i], YD[i], parameters=parameters,
-                                inputs={k: str(v) for k, v in inputs.items()} if inputs
-                                else None, method=s["method"], rtol=s["rtol"], atol=s["atol"],
-                                t_eval=t_eval)
-        else:
-            r = simulate(system, (0.0, s["t_end"]), Y[i], YD[i], parameters=parameters,
-                         inputs=inputs, method=s["method"], rtol=s["rtol"], atol=s["atol"],
-                         t_eval=t_eval, raise_on_interrupt=True)  # Ctrl-C stops the study
+        # a closed system's on its constraint manifold (simulate routes it)
+        r = simulate(system, (0.0, s["t_end"]), Y[i], YD[i], parameters=parameters,
+                     inputs=inputs, method=s["method"], rtol=s["rtol"], atol=s["atol"],
+                     t_eval=t_eval, raise_on_interrupt=True)  # Ctrl-C stops the study
         if len(r.t) != len(t_eval):
             raise StudyError(f"the run stopped at t = {r.t[-1]:.6g} ({r.status}: "
                              f"{r.message})")
