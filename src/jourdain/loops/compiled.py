@@ -66,15 +66,22 @@ def build_loop_library_soon(loop: System) -> None:
     build_soon(loop_library, loop, name="jourdain-loop-build")
 
 
-@lru_cache(maxsize=16)
-def _loop_library(loop: System) -> ctypes.CDLL:
+def loop_source(loop: System) -> str:
+    """The C source of ``loop``'s kernel: the generated ``jd_con`` (Φ, Φ_y, Φ_t) and
+    ``jd_gam`` (the convective term c) in the tree's arguments, then ``loop_c.h`` (what the
+    library here and the FMU of a closed system compile)."""
     tree = loop.tree
     con = constraints(loop)
     names = argument_names(tree.y, tree.yd, tree.t, tree.parameter_symbols, tree.inputs)
     kernel = (resources.files(__package__) / "loop_c.h").read_text()
-    source = (HEADER + function_source("jd_con", [*con.Phi.entries(), *con.Phi_y.entries(),
-                                                  *con.Phi_t.entries()], names)
-              + function_source("jd_gam", con.c.entries(), names) + kernel)
+    return (HEADER + function_source("jd_con", [*con.Phi.entries(), *con.Phi_y.entries(),
+                                                *con.Phi_t.entries()], names)
+            + function_source("jd_gam", con.c.entries(), names) + kernel)
+
+
+@lru_cache(maxsize=16)
+def _loop_library(loop: System) -> ctypes.CDLL:
+    source = loop_source(loop)
     lib = build(content_key(_VERSION, source), source, ("-O2",))
     vp, lg = ctypes.c_void_p, ctypes.c_long
     lib.jd_loop_samples.restype = lg

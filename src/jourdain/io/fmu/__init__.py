@@ -264,24 +264,18 @@ def _closed_parts(system: System, pvals: Mapping[str, float], y0v: list[float],
     with their (assembled) start values and the further outputs: the initial configuration
     assembled as System.simulate assembles it (the independent coordinates held), and the
     partition chosen there, which the FMU keeps."""
-    from importlib import resources
-
     from ...loops import LoopEvaluator, constraints
-    from ...numeric.ccode import HEADER
+    from ...loops.compiled import loop_source
 
     tree = system.tree
     try:
         ev = LoopEvaluator(system, y0v, 0.0, dict(pvals), None)
         asm = ev.assemble(y0v, yd0v, 0.0)
         con = constraints(system)
-        names = argument_names(tree.y, tree.yd, tree.t, tree.parameter_symbols, tree.inputs)
-        src = (HEADER + function_source("jd_con", [*con.Phi.entries(), *con.Phi_y.entries(),
-                                                   *con.Phi_t.entries()], names)
-               + function_source("jd_gam", con.c.entries(), names))
+        src = loop_source(system)
     except JourdainError as exc:
         raise ModelError(f"{system.name!r} cannot be exported as an FMU: {exc}") from None
-    kernel = (resources.files("jourdain.loops") / "loop_c.h").read_text()
-    loop_src = (src + kernel + "\n/* ---- the FMU's adapter (jourdain/io/fmu/closed.c) ---- */\n"
+    loop_src = (src + "\n/* ---- the FMU's adapter (jourdain/io/fmu/closed.c) ---- */\n"
                 + (_HERE / "closed.c").read_text())
     part = ev.part
     all_names = tree.coordinate_names
