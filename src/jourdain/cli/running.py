@@ -98,9 +98,7 @@ def _run(args: argparse.Namespace, pool: ProcessPoolExecutor | None) -> int:
         from ..study import load_study
 
         study = load_study(args.study, model=model.path)
-    # a closed system's run reports no progress yet (simulate on the manifold takes none)
-    progress = (None if model.system.closing else
-                progress_printer(args.progress, f"simulating {model.system.name}"))
+    progress = progress_printer(args.progress, f"simulating {model.system.name}")
     try:
         info = write_report(model, out, parameters=params, t_end=opts.get("t_end"),
                             max_ops=args.max_ops, progress=progress or False,

@@ -24,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from ...analysis.modes import stability
 from ...errors import JourdainError
 from ...numeric import parameter_vector
 from .figures import eigen_plot, time_plot
@@ -86,7 +87,6 @@ def linearization_section(run: Run) -> str:
     """Section 4 of a closed system: M̃, P, Q, h, D, G, K, N and the eigenvalues in the
     independent coordinates about the equilibrium nearest the initial configuration (else the
     initial configuration at rest)."""
-    from ...analysis.modes import stability
     from ..closed_linear import linearization_document, linearize_near
 
     model, out, info = run.model, run.out, run.info

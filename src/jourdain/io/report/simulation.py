@@ -35,13 +35,11 @@ def simulation_section(run: Run) -> str:
         csv = out / "simulation.csv"
         try:
             t0 = time.perf_counter()
-            try:  # written as the run goes; a failed run keeps the motion up to the failure
-                if system.closing:  # on the manifold; simulation.csv written after it
-                    res = capabilities.simulate(model, run.params, t_end=run.t_end)
-                    res.save(csv)
-                else:
-                    res = capabilities.simulate(model, run.params, t_end=run.t_end,
-                                                progress=run.progress, output=csv)
+            # written as the run goes (a closed system's at its end or on an interruption); a
+            # failed run keeps the motion up to the failure
+            try:
+                res = capabilities.simulate(model, run.params, t_end=run.t_end,
+                                            progress=run.progress, output=csv)
             except JourdainError as exc:
                 partial = getattr(exc, "results", None)  # the motion up to the failure
                 if partial is None or len(partial.t) < 2:
