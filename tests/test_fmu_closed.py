@@ -36,19 +36,9 @@ from jourdain.cli import main  # noqa: E402
 from jourdain.errors import ModelError  # noqa: E402
 from jourdain.io import load_model  # noqa: E402
 from jourdain.io.fmu import export_fmu  # noqa: E402
-from jourdain.numeric.toolchain import CompilerError, compiler  # noqa: E402
+from tests.test_fmu import FMU_RTOL, ROOT, TRAJ_TOL, needs_cc  # noqa: E402
 
-ROOT = Path(__file__).resolve().parents[1]
-TRAJ_TOL = 1e-6  # see the module docstring
-PHI_TOL = 1e-11
-FMU_RTOL = 1e-10
-
-try:
-    compiler()
-    HAVE_CC = True
-except CompilerError:
-    HAVE_CC = False
-needs_cc = pytest.mark.skipif(not HAVE_CC, reason="no C compiler: the FMU binary is compiled")
+PHI_TOL = 1e-11  # see the module docstring
 
 
 @pytest.fixture(scope="module")
