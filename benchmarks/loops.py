@@ -18,7 +18,13 @@ error measured against a reference (jourdain at rtol 1e-13) at the end, each the
 * IDA (scikit-sundae, if installed): the index-1 redundant form in z, ż, λ with jourdain's
   compiled tree and constraints in the residual.
 
-    python benchmarks/loops.py [--T 5] [--repeat 5] [--no-ida]
+Units of length (``--units``): the same four-bar with its lengths and g multiplied by
+s = 1, 1e-3, 1e-5 (the angle equations unchanged), each route at rtol 1e-10 over ``T``: the
+right-hand sides it takes and how far its angles end from its own run at s = 1 (jourdain's
+also the closure residual relative to the lengths). A stop or an error norm that mixes metres
+and radians shows as more right-hand sides and angles apart at small s.
+
+    python benchmarks/loops.py [--T 5] [--repeat 5] [--no-ida] [--units]
 """
 
 from __future__ import annotations
@@ -65,14 +71,14 @@ def kane_full_four_bar():  # noqa: ANN201
 PARS = [0.4, 1.0, 0.8, 1.1, 1.0, 2.0, 1.5, 9.81]
 
 
-def simulate_sympy(fns, z0, zd0, T, rtol):  # noqa: ANN001, ANN201
+def simulate_sympy(fns, z0, zd0, T, rtol, pars=PARS):  # noqa: ANN001, ANN201
     from scipy.integrate import solve_ivp
 
     MMf, Ff = fns
 
     def rhs(_t: float, x: np.ndarray) -> np.ndarray:
-        MM = np.asarray(MMf(*x, *PARS), dtype=float)
-        F = np.asarray(Ff(*x, *PARS), dtype=float).reshape(-1)
+        MM = np.asarray(MMf(*x, *pars), dtype=float)
+        F = np.asarray(Ff(*x, *pars), dtype=float).reshape(-1)
         return np.linalg.solve(MM, F)
 
     t0 = time.perf_counter()
@@ -109,14 +115,62 @@ def simulate_ida(loop, z0, zd0, T, rtol):  # noqa: ANN001, ANN201
     return wall, zT, float(np.max(np.abs(cd["Phi"])))
 
 
-def main() -> None:
+SCALES = (1.0, 1e-3, 1e-5)
+
+
+def length_units(T: float, rtol: float = 1e-10) -> list[dict]:
+    """The four-bar at the lengths and g of :data:`PARS` times each of :data:`SCALES`, by
+    jourdain (System.simulate) and by sympy + SciPy in one run: per route and scale the
+    right-hand sides, the angles' largest distance from the route's s = 1 run at T, and for
+    jourdain max|Φ| / s (the closure residual relative to the lengths)."""
+    loop = four_bar()
+    names = ("a", "b", "c", "d", "m1", "m2", "m3", "g")
+    lengths = {"a", "b", "c", "d", "g"}
+    fns = kane_full_four_bar()
+    start = loop.evaluate([0.5, 0.8, 1.9], [1.0, 0, 0])  # assembled: a consistent state
+    z0, zd0 = start["y"], start["yd"]
+    loop.simulate((0, 0.1), z0, zd0, samples=2, rtol=rtol)  # compiled and loaded before timing
+    rows, base = [], {}
+    for s in SCALES:
+        pars = [v * s if n in lengths else v for n, v in zip(names, PARS, strict=True)]
+        t0 = time.perf_counter()
+        r = loop.simulate((0, T), z0, zd0, samples=2, rtol=rtol, atol=rtol * 1e-2,
+                          parameters=dict(zip(names, pars, strict=True)))
+        wall = time.perf_counter() - t0
+        base.setdefault("jourdain", r.y[-1])
+        rows.append({"route": "jourdain", "s": s, "nfev": r.nfev, "wall_s": wall,
+                     "angles_apart": float(np.max(np.abs(r.y[-1] - base["jourdain"]))),
+                     "max_angle": float(np.max(np.abs(r.y))),
+                     "max_Phi_per_length": r.closure_residual[0] / s})
+        wall, zs, nfev = simulate_sympy(fns, z0, zd0, T, rtol, pars)
+        base.setdefault("sympy+scipy", zs)
+        rows.append({"route": "sympy+scipy", "s": s, "nfev": nfev, "wall_s": wall,
+                     "angles_apart": float(np.max(np.abs(zs - base["sympy+scipy"])))})
+    return rows
+
+
+def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--T", type=float, default=5.0)
     ap.add_argument("--json", action="store_true")
     ap.add_argument("--repeat", type=int, default=3, help="best of N (IDA: one run)")
     ap.add_argument("--no-ida", action="store_true", help="skip IDA (slow)")
-    args = ap.parse_args()
+    ap.add_argument("--units", action="store_true",
+                    help="only the four-bar in other units of length, jourdain and sympy+SciPy")
+    args = ap.parse_args(argv)
     T = args.T
+    if args.units:
+        rows = length_units(T)
+        if args.json:
+            print(json.dumps(rows, indent=2))
+            return
+        print(f"four-bar, lengths and g times s, rtol 1e-10 over {T} s:")
+        for r in rows:
+            extra = (f", max|Φ|/s {r['max_Phi_per_length']:.1e}"
+                     if "max_Phi_per_length" in r else "")
+            print(f"  {r['route']:<12} s = {r['s']:<6g} {r['nfev']:>7} right-hand sides, "
+                  f"angles {r['angles_apart']:.1e} from s = 1, {r['wall_s']:.4f} s{extra}")
+        return
     out: dict = {}
     out["derivation_s"] = {"jourdain_four_bar": derive_jourdain(four_bar),
                            "jourdain_slider_crank": derive_jourdain(slider_crank)}
