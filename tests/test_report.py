@@ -161,10 +161,11 @@ def test_report_embeds_the_3d_view(report):
 
 def test_report_compiles_the_evaluation_library_beside_the_summarys(tmp_path, monkeypatch):
     """write_report starts System.evaluate's library (the recursion's M̄, J̄, …, Q̄) in its own
-    thread before the summary compiles the integrator's M, k, q, so that the two compilers run
-    side by side; the numbers are those of the library built in this thread alone."""
+    thread before the summary compiles the integrator's M, k, q: both libraries are built, the
+    evaluation's in that thread and the summary's in the calling one, and the numbers are those
+    of the library built in this thread alone. Whether the two compilers overlap in time is the
+    scheduler's business, not a test's (benchmarks/report.py times whole runs)."""
     import threading
-    import time
 
     from jourdain import numeric
     from jourdain.numeric import compiled, toolchain
@@ -172,24 +173,21 @@ def test_report_compiles_the_evaluation_library_beside_the_summarys(tmp_path, mo
     monkeypatch.setenv("JOURDAIN_CACHE", str(tmp_path / "cache"))  # nothing compiled yet
     numeric.clear_cache()
     toolchain._loaded.clear()
-    spans: dict[str, tuple[str, float, float]] = {}
+    built_in: dict[str, str] = {}
     build = compiled.build
 
-    def timed(key, *args, **kwargs):
-        t0 = time.perf_counter()
+    def recorded(key, *args, **kwargs):
         lib = build(key, *args, **kwargs)
-        spans.setdefault(key, (threading.current_thread().name, t0, time.perf_counter()))
+        built_in.setdefault(key, threading.current_thread().name)
         return lib
 
-    monkeypatch.setattr(compiled, "build", timed)
+    monkeypatch.setattr(compiled, "build", recorded)
     model = load_model(ROOT / "examples" / "robot_arm.toml")
     write_report(model, tmp_path / "out")
     eom_key = compiled._eom_function(model.system).key
     mkq_key = compiled.mkq_function(model.system).key
-    assert spans[eom_key][0] == "jourdain-eom-build"
-    assert spans[mkq_key][0] == threading.main_thread().name
-    # the two builds overlapped in time
-    assert spans[eom_key][1] < spans[mkq_key][2] and spans[mkq_key][1] < spans[eom_key][2]
+    assert built_in[eom_key] == "jourdain-eom-build"
+    assert built_in[mkq_key] == threading.main_thread().name
     doc = json.loads((tmp_path / "out" / "values.json").read_text())
     numeric.clear_cache()
     toolchain._loaded.clear()
