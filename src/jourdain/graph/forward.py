@@ -30,6 +30,7 @@ import symengine as se
 from ..errors import JourdainError
 from .identity import Expr, no_gc
 from .nodes import Graph
+from .piecewise import PIECEWISE, Switch, symbolic_partials
 
 ZERO = se.Integer(0)
 ONE = se.Integer(1)
@@ -38,10 +39,14 @@ ONE = se.Integer(1)
 @dataclass(frozen=True)
 class Jet:
     """Result of :func:`jet`: ``values[i]`` is ``exprs[i]`` at the point and ``gradients[i]``
-    a dict ``{j: ∂exprs[i]/∂variables[j] at the point}`` (entries that vanish are left out)."""
+    a dict ``{j: ∂exprs[i]/∂variables[j] at the point}`` (entries that vanish are left out).
+    ``switches``: the piecewise functions (max, min, abs, sign) whose branch at the point
+    still depends on symbols, each with the expression whose zero is its switching point
+    (:mod:`.piecewise`): the gradients hold there only where it is not zero."""
 
     values: tuple[Expr, ...]
     gradients: tuple[dict[int, Expr], ...]
+    switches: tuple[Switch, ...] = ()
 
     def jacobian(self, n: int, offset: int = 0) -> list[list[Expr]]:
         """Dense rows ``∂exprs[i]/∂variables[offset + j]`` for ``j < n``."""
@@ -144,6 +149,7 @@ def _jet(exprs: list[Expr], variables: Sequence[se.Symbol], point: Mapping[se.Sy
     need = needed_gradients(g, value, mask, atom_keys, _is_zero)
 
     # 3. gradients of the needed nodes, bottom-up
+    switches: list[Switch] = []
     for k in g.order:
         if k not in need:
             continue
@@ -152,12 +158,12 @@ def _jet(exprs: list[Expr], variables: Sequence[se.Symbol], point: Mapping[se.Sy
         if not any(grads):
             grad[k] = {}
             continue
-        grad[k] = _chain(g.node[k], [value[c] for c in kids], grads, value[k])
+        grad[k] = _chain(g.node[k], [value[c] for c in kids], grads, value[k], switches)
 
     values = tuple(value[k] for k in g.roots)
     gradients = tuple(dict(grad.get(k, {})) if m else {}
                       for k, m in zip(g.roots, mask, strict=True))
-    return Jet(values, gradients)
+    return Jet(values, gradients, tuple(dict.fromkeys(switches)))
 
 
 def as_basic(v: object) -> Expr:
@@ -195,8 +201,9 @@ def _collect(terms: dict[int, list[Expr]]) -> dict[int, Expr]:
 
 
 def _chain(node: Expr, vals: list[Expr], grads: list[dict[int, Expr]],
-           value: Expr) -> dict[int, Expr]:
-    """Gradient of ``node`` from its arguments' values and gradients (chain rule)."""
+           value: Expr, switches: list[Switch]) -> dict[int, Expr]:
+    """Gradient of ``node`` from its arguments' values and gradients (chain rule); the
+    branches of piecewise functions that depend on symbols are added to ``switches``."""
     name = type(node).__name__
     terms: dict[int, list[Expr]] = {}
     if name == "Add":
@@ -220,7 +227,10 @@ def _chain(node: Expr, vals: list[Expr], grads: list[dict[int, Expr]],
         if ge:
             _accumulate(terms, value * se.log(b), ge)
         return _collect(terms)
-    coeffs = partials(node, name, vals, value)
+    if name in PIECEWISE:
+        coeffs = symbolic_partials(name, vals, [bool(gk) for gk in grads], switches)
+    else:
+        coeffs = partials(node, name, vals, value)
     for c, gk in zip(coeffs, grads, strict=True):
         if gk:
             _accumulate(terms, c, gk)
@@ -249,10 +259,8 @@ def partials(node: Expr, name: str, v: list[Expr], value: Expr) -> list[Expr]:
         return [se.sinh(v[0])]
     if name == "tanh":
         return [ONE - value**2]
-    if name == "Abs":
-        return [se.sign(v[0])]
-    if name == "sign":
-        return [ZERO]
+    if name in PIECEWISE:  # the branch at the point, no switches recorded
+        return symbolic_partials(name, v, [True] * len(v), [])
     if name == "atan2":
         yy, xx = v
         r2 = xx**2 + yy**2

@@ -23,12 +23,14 @@ from ..errors import EvaluationError, JourdainError
 from .forward import needed_gradients, partials
 from .identity import Expr, no_gc
 from .nodes import Graph
+from .piecewise import PIECEWISE, describe, float_partials
 
 # --- numbers -------------------------------------------------------------------------------------
 _FLOAT_FUNCS: dict[str, Callable[..., float]] = {
     "sin": math.sin, "cos": math.cos, "tan": math.tan, "asin": math.asin, "acos": math.acos,
     "atan": math.atan, "sinh": math.sinh, "cosh": math.cosh, "tanh": math.tanh, "log": math.log,
     "Abs": abs, "atan2": math.atan2, "sign": lambda x: float((x > 0) - (x < 0)),
+    "Max": max, "Min": min,
 }
 
 
@@ -56,7 +58,7 @@ def _float_values(g: Graph, values: Mapping[str, float]) -> dict[int, float]:
         else:
             num[ka] = float(a)
     funcs = _FLOAT_FUNCS
-    fsum, prod = math.fsum, math.prod
+    fsum, prod = _sum, math.prod
     kind, children = g.kind, g.children
     for k in g.order:
         args = [num[c] for c in children[k]]
@@ -87,6 +89,19 @@ def _float_values(g: Graph, values: Mapping[str, float]) -> dict[int, float]:
     return num
 
 
+def _sum(args: list[float]) -> float:
+    """``math.fsum`` (exactly rounded), or the floating-point sum where fsum refuses: inf where
+    a partial sum overflows, NaN for inf − inf (fsum raises OverflowError and ValueError there;
+    the callers check their results for inf and NaN and name the quantity)."""
+    try:
+        return math.fsum(args)
+    except (OverflowError, ValueError):
+        total = 0.0
+        for x in args:
+            total += x  # Python floats: inf and NaN, never an exception or a warning
+        return total
+
+
 def free_symbol_names(exprs: Sequence[Expr]) -> set[str]:
     """Names of the symbols in some expressions, visiting each shared node once (SymEngine's
     ``free_symbols`` walks a shared graph as a tree)."""
@@ -105,8 +120,6 @@ _DFLOAT = {
     "sinh": lambda v, val: math.cosh(v[0]),
     "cosh": lambda v, val: math.sinh(v[0]),
     "tanh": lambda v, val: 1.0 - val * val,
-    "Abs": lambda v, val: float((v[0] > 0) - (v[0] < 0)),
-    "sign": lambda v, val: 0.0,
 }
 
 
@@ -190,6 +203,10 @@ def _jet_float(g: Graph, variables: Sequence[se.Symbol], values: Mapping[str, fl
         else:
             if name in _DFLOAT:
                 coeffs = [_DFLOAT[name](vals, value[k])]
+            elif name in PIECEWISE:  # the branch at the point; refused at the switch
+                coeffs = float_partials(name, vals, [x is not None for x in grads],
+                                        lambda node=node: describe(type(node).__name__,
+                                                                   node.args))
             elif name == "atan2":
                 yy, xx = vals
                 r2 = xx * xx + yy * yy

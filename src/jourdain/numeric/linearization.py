@@ -30,6 +30,8 @@ from typing import Any
 import numpy as np
 
 from ..errors import EvaluationError
+from ..graph import evaluate_float
+from ..graph.piecewise import switches_at
 from ..stages.linearization import formation as _formation
 from ..stages.linearization import general as _general
 from ..stages.linearization import result as _result
@@ -73,9 +75,12 @@ class CompiledLinearization:
 
     def __call__(self, t: float = 0.0,
                  parameters: Mapping[str, float] | None = None) -> dict[str, np.ndarray]:
-        system = self.linearization.system
+        lin = self.linearization
+        system = lin.system
         p = parameter_vector(system, parameters)
         f = system.f
+        if lin.switches:  # a piecewise function exactly at its switching point: refused
+            switches_at(lin.switches, _result.values_at(lin, time_value(t), p), evaluate_float)
         out = self.function(np.zeros(f), np.zeros(f), time_value(t), p,
                             np.zeros(len(system.inputs)))
         return _result.finish(self.linearization, dict(out))

@@ -139,6 +139,7 @@ def linearization(eom: EquationsOfMotion, nominal: Mapping[Any, Any] | Any,
         u_s=SymMatrix.column(u_s) if m else SymMatrix(()),
         M_tilde=SymMatrix.from_rows(Mt), P=SymMatrix.from_rows(P), Q=SymMatrix.from_rows(Q),
         h=SymMatrix.column(h), B=SymMatrix(tuple(tuple(row) for row in B)),
+        switches=J.switches,
     )
     _warn_if_not_solution(lin)
     return lin

@@ -17,6 +17,7 @@ import numpy as np
 import symengine as se
 
 from ...graph import evaluate_float, jet
+from ...graph.piecewise import Switch, switches_at
 from ...symbolic import SymMatrix
 
 if TYPE_CHECKING:
@@ -39,6 +40,9 @@ class GeneralLinearization:
     Q: SymMatrix
     h: SymMatrix
     B: SymMatrix
+    #: piecewise functions whose branch depends on the state: (what, expression whose zero is
+    #: the switching point), refused there by :func:`evaluate_general_at`
+    switches: tuple[Switch, ...] = ()
 
     @property
     def system(self) -> System:
@@ -52,6 +56,7 @@ def evaluate_general_at(glin: GeneralLinearization, values: Mapping[str, float]
     checked (``glin.evaluate`` of :mod:`jourdain.numeric.linearization` checks them)."""
     mats = {"M_tilde": glin.M_tilde, "P": glin.P, "Q": glin.Q, "h": glin.h, "B": glin.B}
     flat = [e for m in mats.values() for e in m.entries()]
+    switches_at(glin.switches, values, evaluate_float)
     nums = iter(evaluate_float(flat, dict(values)))
     out: dict[str, np.ndarray] = {}
     for name, m in mats.items():
@@ -96,4 +101,5 @@ def linearization_general(eom: EquationsOfMotion) -> GeneralLinearization:
         B=SymMatrix(tuple(tuple(-total(grad_r[i][2 * f + v]) for v in range(m))
                           for i in range(f))),
         h=SymMatrix.column([-total(val_r[i]) for i in range(f)]),
+        switches=J.switches,
     )

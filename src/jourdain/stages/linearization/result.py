@@ -23,6 +23,7 @@ import symengine as se
 
 from ...errors import EvaluationError, JourdainError
 from ...graph import evaluate_float, free_symbol_names
+from ...graph.piecewise import Switch, switches_at
 from ...symbolic import SymMatrix
 
 if TYPE_CHECKING:
@@ -71,6 +72,11 @@ class Linearization:
         Names of the matrices among M̃, P, Q, B that depend on t (empty for a time-invariant
         result). Where t appears but cancels (a symmetric rotor turning at Ω t), numeric tests
         at several times and parameter values decide, and the matrices are stored at t = 0.
+    switches : tuple of (str, expression)
+        The piecewise functions of the model (max, min, abs, sign) whose branch at the nominal
+        motion depends on the parameters or t: the matrices hold the derivative of the active
+        branch, and numbers where an expression is exactly zero (the switching point) are
+        refused (:class:`jourdain.graph.piecewise.SwitchingPoint`).
     """
 
     equations_of_motion: EquationsOfMotion
@@ -84,6 +90,7 @@ class Linearization:
     h: SymMatrix
     B: SymMatrix
     time_dependence: tuple[str, ...]
+    switches: tuple[Switch, ...] = ()
 
     # --- context -----------------------------------------------------------------------------
     @property
@@ -203,6 +210,7 @@ def evaluate_at(lin: Linearization, values: Mapping[str, float]) -> dict[str, np
     ``lin.evaluate(t, parameters)`` (:mod:`jourdain.numeric.linearization`)."""
     blocks = lin.blocks()
     flat = [e for m in blocks.values() for e in m.entries()]
+    switches_at(lin.switches, values, evaluate_float)
     try:
         nums = evaluate_float(flat, dict(values))
     except EvaluationError:
