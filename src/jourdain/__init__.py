@@ -101,6 +101,7 @@ from .model import (
     velocity,
 )
 from .model.closing import ClosingJoint
+from .model.contacts import KnifeEdge, RollingDisc, VelocityConstraint
 from .numeric.linearization import (  # the stage's results with their numbers (issue 16)
     CompiledLinearization,
     GeneralLinearization,
@@ -131,7 +132,7 @@ __all__ = [
     "Gravity", "Force", "Torque", "SpringDamper", "GeneralizedForce", "RotationalSpringDamper",
     "Bushing", "rate", "acceleration", "elongation", "elongation_d", "deflection",
     "deflection_d",
-    "ClosingJoint",
+    "ClosingJoint", "RollingDisc", "KnifeEdge", "VelocityConstraint",
     "Quantity", "position", "velocity", "point_acceleration", "angular_velocity",
     "relative_position", "relative_velocity", "distance", "distance_rate",
     # functions for expressions in models (SymEngine's)

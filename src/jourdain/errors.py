@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import sys
 import warnings
 from pathlib import Path
@@ -32,15 +33,23 @@ class ClosedSystemError(ModelError):
 
     def __init__(self, system: object, capability: str, hint: str = "") -> None:
         names = ", ".join(c.name for c in getattr(system, "closing", ()))
-        msg = (f"{getattr(system, 'name', 'the system')!r} is closed by the closing joint(s) "
-               f"{names}: {capability}")
+        contacts = ", ".join(c.name for c in getattr(system, "contacts", ()))
+        if contacts:
+            what = (f"constrained by the contact(s) {contacts}"
+                    + (f" and closed by the closing joint(s) {names}" if names else ""))
+        elif names:
+            what = f"closed by the closing joint(s) {names}"
+        else:
+            what = "a general system (generalized velocities other than ẏ)"
+        msg = f"{getattr(system, 'name', 'the system')!r} is {what}: {capability}"
         super().__init__(msg + (f"; {hint}" if hint else ""))
         self.capability = capability
 
 
 def refuse_closed(system: object, capability: str, hint: str = "") -> None:
-    """Raise :class:`ClosedSystemError` when ``system`` has closing joints."""
-    if getattr(system, "closing", ()):
+    """Raise :class:`ClosedSystemError` when ``system`` has closing joints, contacts or
+    generalized velocities of its own (anything the open tree would leave out)."""
+    if getattr(system, "closing", ()) or getattr(system, "is_general", False):
         raise ClosedSystemError(system, capability, hint)
 
 
@@ -80,3 +89,14 @@ def warn(message: str, category: type[Warning] = JourdainWarning) -> None:
         frame = frame.f_back
         level += 1
     warnings.warn(message, category, stacklevel=level)
+
+
+def shorten_words(text: str, n: int = 160) -> str:
+    """``text`` with every run of more than ``n`` characters without a space (a value pasted
+    into a message: 5 000 characters of an invalid string) shortened in the middle, saying
+    how long it was."""
+    if len(text) <= n:
+        return text
+    return re.sub(r"\S{" + str(n + 1) + ",}",
+                  lambda m: f"{m.group()[:n // 2]}…{m.group()[-n // 4:]} "
+                            f"({len(m.group())} characters)", text)

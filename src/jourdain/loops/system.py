@@ -24,6 +24,12 @@ def constraints(loop: System) -> Constraints:
     """The constraint stage of a closed ``loop`` (:func:`jourdain.stages.constraints.constraints`
     on the tree's kinematics), kept by the system; ModelError when its closing joints give no
     row."""
+    if getattr(loop, "is_general", False):
+        from ..errors import ClosedSystemError
+
+        raise ClosedSystemError(loop, "the numbers of closed systems (holonomic rows, "
+                                "ẏ_i as velocities) do not apply; its velocity constraints "
+                                "need the general path (jourdain.loops.general)")
     con = _constraints(loop)
     if not con.rows:
         raise ModelError(f"{loop.name}: the closing joints give no constraint equation (every "

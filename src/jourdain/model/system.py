@@ -16,7 +16,8 @@ import symengine as se
 from ..errors import ModelError
 from .bodies import Body
 from .closing import ClosingJoint, grubler
-from .expressions import as_expr, t
+from .contacts import CONTACT_TYPES, Contact, check_linear
+from .expressions import as_expr, magnitude_problem, t
 from .forces import (
     Bushing,
     Force,
@@ -80,6 +81,14 @@ class System:
     independent : sequence of coordinate names, optional
         The independent coordinates of a closed system (else chosen by pivoting on ``Φ_y`` at
         the initial configuration).
+    contacts : sequence of RollingDisc, KnifeEdge, VelocityConstraint, optional
+        Velocity (nonholonomic) constraints ``A·ẏ + a = 0`` (METHOD.md §7, ``docs/rolling.md``):
+        with any, the system is a *general* one, moving with ``g = f − r`` generalized
+        velocities ``z`` (:attr:`speeds`), ``ẏ = L·z + l``.
+    speeds : sequence of names, or mapping name -> expression, optional
+        The generalized velocities z: coordinate names (``z`` their rates), or definitions
+        ``z_k = Y_k(y, t)·ẏ + b_k`` (expressions linear in the rates ``<coordinate>_d``, e.g. a
+        body-fixed angular velocity component). Else chosen by pivoting on the velocity rows.
     """
 
     coordinates: tuple[se.Symbol, ...]
@@ -92,12 +101,15 @@ class System:
     quantities: tuple[Quantity, ...]
     closing: tuple[ClosingJoint, ...] = ()
     independent: tuple[str, ...] | None = None
+    contacts: tuple[Contact, ...] = ()
+    speeds: tuple[tuple[str, se.Basic], ...] | None = None
 
     def __init__(self, coordinates: Sequence[object] | str, bodies: Sequence[Body],
                  forces: Sequence[ForceElement] = (), parameters: Mapping[str, float] | None = None,
                  inputs: Sequence[object] | str = (), units: Mapping[str, str] | None = None,
                  name: str = "system", closing: Sequence[ClosingJoint] = (),
-                 independent: Sequence[str] | None = None) -> None:
+                 independent: Sequence[str] | None = None, contacts: Sequence[Contact] = (),
+                 speeds: Sequence[str] | Mapping[str, object] | None = None) -> None:
         y = _symbol_list(coordinates, "coordinates")
         u = _symbol_list(inputs, "inputs")
         params = dict(parameters or {})
@@ -115,6 +127,9 @@ class System:
                 raise ModelError(f'parameter "{k}": value must be a number, got {v!r}') from None
             if not math.isfinite(fv):
                 raise ModelError(f'parameter "{k}": value {v!r} is not finite')
+            why = magnitude_problem(fv)
+            if why:
+                raise ModelError(f'parameter "{k}": {why}')
             pvals.append((k, fv))
         set_(self, "parameters", tuple(pvals))
         set_(self, "units", tuple((str(k), str(v)) for k, v in (units or {}).items()))
@@ -133,7 +148,9 @@ class System:
             [e for f in forces for e in force_expressions(f)]).values()))
         validate(self)
         set_(self, "closing", _closing_joints(self, closing))
+        set_(self, "contacts", _contacts(self, contacts))
         set_(self, "independent", _independent(self, independent))
+        set_(self, "speeds", _speeds(self, speeds))
 
     def __hash__(self) -> int:
         """The hash of the fields, computed once: the memoized stages (``mkq_function(system)``
@@ -159,14 +176,21 @@ class System:
     # --- the tree and its closing joints --------------------------------------------------------
     @property
     def is_closed(self) -> bool:
-        """True when closing joints close kinematic loops of the tree."""
-        return bool(self.closing)
+        """True when closing joints close kinematic loops of the tree, or contacts constrain
+        it (every tree-only path refuses it)."""
+        return bool(self.closing) or self.is_general
+
+    @property
+    def is_general(self) -> bool:
+        """True for a *general* system (METHOD.md §7): velocity constraints (contacts), or
+        generalized velocities z other than ẏ."""
+        return bool(self.contacts) or self.speeds is not None
 
     @property
     def tree(self) -> Self:
         """The open tree: the same bodies, joints, forces and parameters without the closing
         joints (the system itself when it has none), of the same class."""
-        if not self.closing:
+        if not self.closing and not self.is_general:
             return self
         tree = self.__dict__.get("_tree")
         if tree is None:
@@ -182,7 +206,8 @@ class System:
         configuration)."""
         return type(self)(self.coordinates, self.bodies, self.forces, dict(self.parameters),
                           self.inputs, dict(self.units), self.name if name is None else name,
-                          closing=(*self.closing, *closing), independent=independent)
+                          closing=(*self.closing, *closing), independent=independent,
+                          contacts=self.contacts, speeds=_speed_arg(self.speeds))
 
     def grubler(self) -> int:
         """Degrees of freedom by the Grübler–Kutzbach count (spatial: 6 per body), the tree's
@@ -246,6 +271,8 @@ class System:
     def __repr__(self) -> str:
         closing = (f", closing joints {[c.name for c in self.closing]}" if self.closing
                    else "")
+        if self.contacts:
+            closing += f", contacts {[c.name for c in self.contacts]}"
         return (f"System({self.name!r}: {len(self.bodies)} bodies{closing}, f={self.f}, "
                 f"coordinates={self.coordinate_names}, parameters={list(dict(self.parameters))}, "
                 f"inputs={self.input_names})")
@@ -284,9 +311,9 @@ def _closing_joints(system: System, closing: Sequence[ClosingJoint]) -> tuple[Cl
 def _independent(system: System, independent: Sequence[str] | None) -> tuple[str, ...] | None:
     if independent is None:
         return None
-    if not system.closing:
+    if not system.closing and not system.contacts:
         raise ModelError("independent coordinates are chosen for closed systems only (this "
-                         "one has no closing joints)")
+                         "one has no closing joints or contacts)")
     ind = tuple(str(c) for c in independent)
     for c in ind:
         if c not in system.coordinate_names:
@@ -295,3 +322,65 @@ def _independent(system: System, independent: Sequence[str] | None) -> tuple[str
     if len(set(ind)) != len(ind):
         raise ModelError(f"independent coordinates {list(ind)} name one twice")
     return ind
+
+
+def _contacts(system: System, contacts: Sequence[Contact]) -> tuple[Contact, ...]:
+    """The velocity constraints, checked: names unique among joints, closing joints and
+    contacts, bodies known, general rows linear in the rates."""
+    contacts = tuple(contacts)
+    taken = {b.joint.name for b in system.bodies} | {c.name for c in system.closing}
+    bodies = set(system.body_names)
+    for c in contacts:
+        if not isinstance(c, CONTACT_TYPES):
+            raise ModelError(f"contacts: expected RollingDisc, KnifeEdge or VelocityConstraint "
+                             f"objects, got {type(c).__name__} {c!r}")
+        if c.name in taken:
+            raise ModelError(f'contact "{c.name}": the name is used twice')
+        taken.add(c.name)
+        for b in c.bodies:
+            if b not in bodies:
+                raise ModelError(f'contact "{c.name}": unknown body "{b}"; bodies are '
+                                 f"{', '.join(system.body_names)}")
+        if hasattr(c, "expressions"):
+            check_linear(c.name, c.expressions, system.coordinates)
+            allowed = set(system.coordinate_names) | {f"{n}_d" for n in system.coordinate_names}
+        else:
+            allowed = set()
+        allowed |= set(dict(system.parameters)) | {"t"}
+        unknown = sorted(c.symbols() - allowed)
+        if unknown:
+            raise ModelError(f'contact "{c.name}": unknown name(s) ' + ", ".join(unknown))
+    return contacts
+
+
+def _speeds(system: System, speeds: Sequence[str] | Mapping[str, object] | None
+            ) -> tuple[tuple[str, se.Basic], ...] | None:
+    """The generalized velocities as (name, definition linear in ẏ): a coordinate's name gives
+    ``<name>_d`` defined as its rate."""
+    if speeds is None:
+        return None
+    names = system.coordinate_names
+    out: list[tuple[str, se.Basic]] = []
+    if isinstance(speeds, Mapping):
+        for k, v in speeds.items():
+            name = str(k)
+            if not name.isidentifier():
+                raise ModelError(f"speeds: name {name!r} must be an identifier")
+            e = as_expr(v, f'speed "{name}"')
+            check_linear(f"speed {name}", [e], system.coordinates)
+            out.append((name, e))
+    else:
+        if isinstance(speeds, str):
+            speeds = [s.strip() for s in speeds.replace(",", " ").split()]
+        for c in speeds:
+            if str(c) not in names:
+                raise ModelError(f'speeds: "{c}" is not a coordinate ({", ".join(names)}); '
+                                 "give definitions as a mapping name -> expression")
+            out.append((f"{c}_d", rate(system.coordinates[names.index(str(c))])))
+    if len({n for n, _ in out}) != len(out):
+        raise ModelError(f"speeds {[n for n, _ in out]} name one twice")
+    return tuple(out)
+
+
+def _speed_arg(speeds: tuple[tuple[str, se.Basic], ...] | None) -> dict[str, se.Basic] | None:
+    return None if speeds is None else dict(speeds)

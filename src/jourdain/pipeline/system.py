@@ -72,7 +72,7 @@ class System(Model):
         """Kinematics of every body (METHOD §1); see :func:`jourdain.stages.kinematics.kinematics`.
         A closed system's bodies move as its tree's: the tree's kinematics (``.system`` is
         :attr:`tree`)."""
-        if self.closing:
+        if self.closing or self.is_general:
             return self.tree.kinematics()
         return self._stage("_kinematics", lambda: kinematics(self))
 
@@ -81,7 +81,8 @@ class System(Model):
         constrained directions Q̄_c; zero rows for a tree. See
         :func:`jourdain.stages.constraints.constraints`."""
         return self._stage("_constraints",
-                           lambda: constraints(self.tree.kinematics(), self.closing))
+                           lambda: constraints(self.tree.kinematics(), self.closing,
+                                               self.contacts))
 
     def _symbolic(self, stage: str) -> None:
         refuse_closed(self, f"the symbolic {stage} of a closed system need its velocity map "
@@ -123,6 +124,13 @@ class System(Model):
         equilibrium at rest, else central differences of the compiled M, k, q on the
         manifold); about a motion (expressions of t) or in a rheonomic system, a time-variant
         :class:`jourdain.loops.periodic.ClosedLinearization` (``jd.floquet``)."""
+        if self.is_general:
+            from ..loops.general_linear import linearize_general
+
+            if inputs:
+                refuse_closed(self, "a linearization with nominal inputs is not available "
+                              "for systems with velocity constraints yet")
+            return linearize_general(self, nominal)
         if self.closing:
             from ..loops.nominal import linearize_closed
 
@@ -141,6 +149,10 @@ class System(Model):
         the model's reactions cannot be formed). ``parameters`` overrides default values by
         name; ``inputs`` gives the inputs by name (or in the order of :attr:`input_names`).
         """
+        if self.is_general:  # velocity constraints (METHOD §7): jourdain.loops.general
+            from ..loops.general_eval import evaluate_general
+
+            return evaluate_general(self, y, yd, t, parameters, inputs)
         if self.closing:  # the closed system's numbers (METHOD §7): jourdain.loops.evaluation
             from ..loops.evaluation import evaluate_closed
 
@@ -165,6 +177,15 @@ class System(Model):
         A closed system moves on its constraint manifold: ``y0, yd0`` are assembled (the
         independent coordinates held) and the results carry the closing rows' residuals and
         multipliers (:func:`jourdain.loops.simulate.simulate_closed`)."""
+        if self.is_general:
+            from ..loops.general_sim import simulate_general
+
+            return simulate_general(self, t_span, y0, yd0, parameters=parameters,
+                                    inputs=inputs,
+                                    method=DEFAULT_METHOD if method is None else method,
+                                    rtol=DEFAULT_RTOL if rtol is None else rtol,
+                                    atol=DEFAULT_ATOL if atol is None else atol,
+                                    t_eval=t_eval, **options)
         if self.closing:
             from ..loops.simulate import simulate_closed
 

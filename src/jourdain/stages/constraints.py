@@ -73,7 +73,9 @@ from ..model.closing import ZERO3, ClosingJoint
 from ..model.expressions import Expr, Vec3
 from ..model.forces import rate
 from ..symbolic import SymMatrix
+from .contact_rows import contact_rows
 from .kinematics import Kinematics, _cross, _dot, _mv
+from .rows import ConstraintRow
 
 if TYPE_CHECKING:
     from ..model.system import System
@@ -101,28 +103,6 @@ def perpendiculars(u: Vec3) -> tuple[Vec3, Vec3]:
 _IDENT = ((se.Integer(1), se.Integer(0), se.Integer(0)),
           (se.Integer(0), se.Integer(1), se.Integer(0)),
           (se.Integer(0), se.Integer(0), se.Integer(1)))
-
-
-@dataclass(frozen=True)
-class ConstraintRow:
-    """One scalar constraint equation Φ_i(y, t) = 0 of a closing joint.
-
-    ``label``: its name (``hinge.Fx``, ``hinge.M1``, ``c.1``); ``kind``: ``force`` (λ is a
-    force on A at p_A along the inertial ``direction``, its opposite on B at p_B), ``moment``
-    (a moment on A about the inertial ``direction``, its opposite on B) or ``generic``;
-    ``direction``: 3 expressions, or None; ``body_a``, ``body_b``, ``p_a``, ``p_b``: where the
-    force acts (inertial points; None for generic rows).
-    """
-
-    joint: str
-    label: str
-    expr: Expr
-    kind: str
-    direction: Vec3 | None
-    body_a: str = "world"
-    body_b: str = "world"
-    p_a: Vec3 | None = None
-    p_b: Vec3 | None = None
 
 
 def constraint_rows(kin: Kinematics, closing: Sequence[ClosingJoint]) -> list[ConstraintRow]:
@@ -187,8 +167,12 @@ def constraint_rows(kin: Kinematics, closing: Sequence[ClosingJoint]) -> list[Co
 class Constraints:
     """Result of :func:`constraints`: the constraint rows of a system (r = 0 for a tree).
 
-    ``Phi`` (r×1), ``Phi_y`` (r×f), ``Phi_t`` (r×1), ``c`` (r×1) with ``Φ̈ = Φ_y·ÿ + c``,
-    ``Q_bar`` (6p×r) the rows' constrained directions in the rows of M̄ (``J̄ᵀ·Q̄_c = Φ_yᵀ``).
+    Holonomic rows first (``r_h`` of them: the closing joints', then the contacts' touching
+    rows), then the velocity rows of contacts. ``Phi`` (r_h×1), ``Phi_y`` (r_h×f), ``Phi_t``
+    (r_h×1) of the holonomic rows; every row at the velocity level ``A·ẏ + a = 0``: ``A``
+    (r×f, ``Φ_y`` in the holonomic rows), ``a`` (r×1), ``c`` (r×1) its time derivative at
+    ÿ = 0 (``A·ÿ + c = 0``), ``Q_bar`` (6p×r) the rows' constrained directions in the rows of
+    M̄ (``J̄ᵀ·Q̄_c = Aᵀ``).
     """
 
     kinematics: Kinematics
@@ -198,6 +182,8 @@ class Constraints:
     Phi_t: SymMatrix
     c: SymMatrix
     Q_bar: SymMatrix
+    A: SymMatrix
+    a: SymMatrix
 
     @property
     def system(self) -> System:
@@ -206,7 +192,7 @@ class Constraints:
 
     @property
     def labels(self) -> list[str]:
-        """The rows' names, ``<closing joint>.<component>``."""
+        """The rows' names, ``<closing joint>.<component>``, ``<contact>.N``, ..."""
         return [r.label for r in self.rows]
 
     @property
@@ -215,14 +201,9 @@ class Constraints:
         return len(self.rows)
 
     @property
-    def A(self) -> SymMatrix:
-        """Velocity rows ``A·ẏ + a = 0``: for holonomic rows ``A = Φ_y``."""
-        return self.Phi_y
-
-    @property
-    def a(self) -> SymMatrix:
-        """Velocity rows ``A·ẏ + a = 0``: for holonomic rows ``a = Φ_t``."""
-        return self.Phi_t
+    def r_h(self) -> int:
+        """Number of holonomic rows (the rows of Φ)."""
+        return sum(1 for r in self.rows if r.holonomic)
 
 
 def _wrench_columns(kin: Kinematics, rows: Sequence[ConstraintRow]) -> SymMatrix:
@@ -261,28 +242,44 @@ def _wrench_columns(kin: Kinematics, rows: Sequence[ConstraintRow]) -> SymMatrix
         SymMatrix.zeros(6 * p, 0)
 
 
-def constraints(kin: Kinematics, closing: Sequence[ClosingJoint] | None = None) -> Constraints:
-    """The constraint rows of the ``closing`` joints (default: those of ``kin.system``): Φ,
-    Φ_y, Φ_t, c and Q̄_c, from the tree's kinematics ``kin`` (zero rows for a tree)."""
-    rows = constraint_rows(kin, kin.system.closing if closing is None else closing)
+def constraints(kin: Kinematics, closing: Sequence[ClosingJoint] | None = None,
+                contacts: Sequence[Any] | None = None) -> Constraints:
+    """The constraint rows of the ``closing`` joints and ``contacts`` (default: those of
+    ``kin.system``): Φ, Φ_y, Φ_t of the holonomic rows, A, a, c of all rows and Q̄_c, from the
+    tree's kinematics ``kin`` (zero rows for a tree)."""
+    system = kin.system
+    rows = constraint_rows(kin, system.closing if closing is None else closing)
+    hol, vel = contact_rows(kin, system.contacts if contacts is None else contacts)
+    rows = [*rows, *[r for r in hol if r.expr != 0], *vel]
     y = kin.y
     yd = [rate(c) for c in y]
     t = kin.t
-    Phi = [r.expr for r in rows]
+    f = len(y)
+    H = [r for r in rows if r.holonomic]
+    Phi = [r.expr for r in H]
     Phi_y = [[se.diff(e, yj) for yj in y] for e in Phi]
     Phi_t = [se.diff(e, t) for e in Phi]
-    # w = Φ̇ = Φ_y ẏ + Φ_t; c = ∂w/∂y·ẏ + ∂w/∂t (the part of Φ̈ without ÿ)
-    c = []
+    A, a, w = [], [], []
     for i in range(len(Phi)):
-        w = se.Add(*(Phi_y[i][j] * yd[j] for j in range(len(y)))) + Phi_t[i]
-        c.append(se.Add(*(se.diff(w, y[j]) * yd[j] for j in range(len(y)))) + se.diff(w, t))
-    f = len(y)
-    return Constraints(kin, tuple(rows),
-                       SymMatrix.column(Phi) if rows else SymMatrix.zeros(0, 1),
-                       SymMatrix.from_rows(Phi_y) if rows else SymMatrix.zeros(0, f),
-                       SymMatrix.column(Phi_t) if rows else SymMatrix.zeros(0, 1),
-                       SymMatrix.column(c) if rows else SymMatrix.zeros(0, 1),
-                       _wrench_columns(kin, rows))
+        A.append(Phi_y[i])
+        a.append(Phi_t[i])
+        w.append(se.Add(*(Phi_y[i][j] * yd[j] for j in range(f))) + Phi_t[i])
+    zero = {d: se.Integer(0) for d in yd}
+    for r in rows[len(H):]:
+        A.append([se.diff(r.expr, d) for d in yd])
+        a.append(se.expand(r.expr.subs(zero)))
+        w.append(r.expr)
+    # c = ∂w/∂y·ẏ + ∂w/∂t: the part of ẇ without ÿ (w = A ẏ + a)
+    c = [se.Add(*(se.diff(wi, y[j]) * yd[j] for j in range(f))) + se.diff(wi, t) for wi in w]
+
+    def col(v: list) -> SymMatrix:
+        return SymMatrix.column(v) if v else SymMatrix.zeros(0, 1)
+
+    def mat(m: list, n: int) -> SymMatrix:
+        return SymMatrix.from_rows(m) if m else SymMatrix.zeros(0, n)
+
+    return Constraints(kin, tuple(rows), col(Phi), mat(Phi_y, f), col(Phi_t), col(c),
+                       _wrench_columns(kin, rows), mat(A, f), col(a))
 
 
 __all__ = ["ConstraintRow", "Constraints", "constraint_rows", "constraints", "perpendiculars"]

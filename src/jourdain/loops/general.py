@@ -1,0 +1,353 @@
+"""The numbers of a *general* system (METHOD.md §7, ``docs/rolling.md``): velocity constraints
+(rolling contacts, knife edges, velocity rows) and generalized velocities ``z``.
+
+The tree's coordinates ``y`` (f) carry the holonomic rows ``Φ(y, t) = 0`` (closing joints, a
+wheel touching the ground: ``r_h``) and all rows at the velocity level ``A·ẏ + a = 0`` (r,
+the holonomic ones as ``Φ_y·ẏ + Φ_t``). The generalized velocities are g = f − r quantities
+``z = Y(y, t)·ẏ + b`` (the user's definitions, or the rates of chosen coordinates). Stacked,
+
+    W·ẏ = [z − b; −a],   W = [Y; A]   ⇒   ẏ = L·z + l,   L = W⁻¹[E; 0],  l = W⁻¹[−b; −a]
+
+(the kinematic differential equations), and from ``W·ÿ + [c_Y; c] = [ż; 0]``: ``ÿ = L·ż + γ``
+with ``γ = −W⁻¹[c_Y; c]``. Projection with ``L̄ᵀ = (J̄_tree·L)ᵀ`` gives ``M·ż + k = q``:
+``M = LᵀM_tree·L``, ``k = Lᵀ(k_tree + M_tree·γ)``, ``q = Lᵀq_tree``. The rows' multipliers
+(the contact forces along their directions) solve ``M_tree·ÿ + k_tree − q_tree = Aᵀλ``.
+
+The state is ``x = (y_i, z)``: the independent coordinates (f − r_h; the dependent ones by
+Newton on Φ = 0, so the holonomic rows hold to rounding at every state) and z. Every function
+here runs in real or in complex arithmetic (:class:`Functions`), so that a linearization takes
+its derivatives by the complex step, exact to rounding (:mod:`jourdain.loops.general_linear`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from functools import lru_cache
+from typing import Any
+
+import numpy as np
+import scipy.linalg as sla
+import symengine as se
+
+from ..errors import EvaluationError, ModelError, SingularConfiguration
+from ..model import System
+from ..model.forces import rate
+from ..numeric import lambdify, mkq_function, parameter_vector
+from ..stages.constraints import Constraints
+from ..stages.constraints import constraints as constraint_stage
+from ..stages.kinematics import kinematics
+from ..stages.newton_euler import newton_euler
+from ..stages.projection import projection
+from ..symbolic import SymMatrix
+from .evaluator import _newton_stop
+from .partitioning import _rank_tol, partition
+
+EPS = float(np.finfo(float).eps)
+
+
+def general_constraints(system: System) -> Constraints:
+    """The constraint stage of ``system`` (kept by a :class:`jourdain.System`)."""
+    stage = getattr(system, "constraints", None)
+    if callable(stage):
+        return stage()
+    return constraint_stage(kinematics(system.tree), system.closing, system.contacts)
+
+
+def _speed_rows(system: System) -> tuple[SymMatrix, SymMatrix, SymMatrix] | None:
+    """``Y``, ``b`` and ``c_Y`` of the user's speed definitions (None: chosen coordinates'
+    rates, found by the partition)."""
+    if system.speeds is None:
+        return None
+    y = system.coordinates
+    yd = [rate(c) for c in y]
+    zero = {d: se.Integer(0) for d in yd}
+    Y, b, c = [], [], []
+    for _, e in system.speeds:
+        Y.append([se.diff(e, d) for d in yd])
+        b.append(se.expand(e.subs(zero)))
+        c.append(se.Add(*(se.diff(e, y[j]) * yd[j] for j in range(len(y))))
+                 + se.diff(e, system.t))
+    return SymMatrix.from_rows(Y), SymMatrix.column(b), SymMatrix.column(c)
+
+
+class Functions:
+    """The tree's ``M, k, q`` and the rows' ``Phi, Phi_y, Phi_t, A, a, c`` (and the speeds'
+    ``Y, b, cY``) at a state: compiled (real) or by SymEngine's complex evaluation."""
+
+    def __init__(self, system: System, complex_: bool = False) -> None:
+        tree = system.tree
+        con = general_constraints(system)
+        mats = {"Phi": con.Phi, "Phi_y": con.Phi_y, "Phi_t": con.Phi_t, "A": con.A, "a": con.a,
+                "c": con.c}
+        sp = _speed_rows(system)
+        if sp is not None:
+            mats.update(Y=sp[0], b=sp[1], cY=sp[2])
+        self.complex = complex_
+        if not complex_:
+            self.tree_fn = mkq_function(tree)
+            self.con_fn = lambdify(tree, mats)
+            return
+        eom = projection(newton_euler(kinematics(tree)))
+        mats.update(M=eom.M, k=eom.k, q=eom.q)
+        self.names = list(mats)
+        self.shapes = [mats[n].shape for n in self.names]
+        args = [*tree.y, *tree.yd, tree.t, *tree.parameter_symbols, *tree.inputs]
+        exprs = [e for n in self.names for e in mats[n].entries()]
+        self.fn = se.Lambdify(args, exprs, real=False, cse=True)
+
+    def __call__(self, y: np.ndarray, yd: np.ndarray, t: float, p: np.ndarray,
+                 u: np.ndarray) -> dict[str, np.ndarray]:
+        if not self.complex:
+            y = np.ascontiguousarray(y, dtype=float)
+            yd = np.ascontiguousarray(yd, dtype=float)
+            out = self.con_fn.split(self.con_fn.raw(y, yd, t, p, u))
+            out.update(self.tree_fn.split(self.tree_fn.raw(y, yd, t, p, u)))
+            return out
+        x = np.concatenate([y, yd, [t], p, u]).astype(complex)
+        flat = np.asarray(self.fn(x)).reshape(-1)
+        out, i = {}, 0
+        for n, (r, c) in zip(self.names, self.shapes, strict=True):
+            out[n] = flat[i:i + r * c].reshape(r, c)
+            i += r * c
+        return out
+
+
+@lru_cache(maxsize=16)
+def functions(system: System, complex_: bool = False) -> Functions:
+    """:class:`Functions` of ``system`` (memoized)."""
+    return Functions(system, complex_)
+
+
+@dataclass(frozen=True)
+class Choice:
+    """The partition of a general system: independent coordinates (indices into y), the
+    holonomic rows kept, the velocity rows kept, the speeds' names and, for chosen
+    coordinates' rates, their indices."""
+
+    independent: tuple[int, ...]
+    dependent: tuple[int, ...]
+    rows_h: tuple[int, ...]
+    rows_v: tuple[int, ...]
+    speeds: tuple[str, ...]
+    speed_coordinates: tuple[int, ...] | None
+
+
+def choose(system: System, fn: dict[str, np.ndarray]) -> Choice:
+    """The partition at the state whose functions are ``fn``: independent coordinates by
+    pivoting on Φ_y (or the user's, checked), the independent velocity rows by pivoting on
+    Aᵀ, and the speeds: the user's (their count checked: g = f − rank A) or the rates of the
+    coordinates left by pivoting on A's columns."""
+    names = system.coordinate_names
+    f = len(names)
+    Pz = np.real(fn["Phi_y"])
+    if Pz.shape[0]:
+        part = partition(system, Pz, system.independent)
+        ind, dep, rows_h = part.independent, part.dependent, part.rows
+    else:
+        ind, dep, rows_h = tuple(range(f)), (), ()
+    A = np.real(fn["A"])
+    _, R, piv = sla.qr(A.T, mode="economic", pivoting=True)
+    diag = np.abs(np.diag(R)) if R.size else np.zeros(0)
+    r = int(np.sum(diag > _rank_tol(A) * 1e3)) if A.size else 0
+    rows_v = tuple(sorted(int(i) for i in piv[:r]))
+    g = f - r
+    if system.speeds is not None:
+        if len(system.speeds) != g:
+            raise ModelError(f"{system.name}: {f} coordinates and {r} independent velocity "
+                             f"rows leave {g} generalized velocities, but {len(system.speeds)} "
+                             f"speeds were given ({', '.join(n for n, _ in system.speeds)})")
+        sc = tuple(names.index(n[:-2]) for n, e in system.speeds
+                   if n.endswith("_d") and n[:-2] in names and e == rate(
+                       system.coordinates[names.index(n[:-2])]))
+        return Choice(ind, dep, rows_h, rows_v, tuple(n for n, _ in system.speeds),
+                      sc if len(sc) == g else None)
+    Ak = A[list(rows_v), :]
+    if r:
+        _, _, cp = sla.qr(Ak, mode="economic", pivoting=True)
+        vdep = {int(j) for j in cp[:r]}
+    else:
+        vdep = set()
+    sc = tuple(j for j in range(f) if j not in vdep)
+    return Choice(ind, dep, rows_h, rows_v, tuple(f"{names[j]}_d" for j in sc), sc)
+
+
+class GeneralEvaluator:
+    """Numbers of a general system at states ``x = (y_i, z)`` (see the module docstring), in
+    real (default) or complex arithmetic."""
+
+    def __init__(self, system: System, y0: Any, t: float = 0.0,
+                 parameters: Mapping[str, float] | None = None, inputs: Any = None,
+                 complex_: bool = False) -> None:
+        tree = system.tree
+        self.system = system
+        self.n = tree.f
+        self.p = parameter_vector(tree, parameters)
+        self.u = (np.zeros(len(tree.inputs)) if inputs is None
+                  else np.ascontiguousarray(inputs, dtype=float))
+        self.fn = functions(system, complex_)
+        self.dtype = complex if complex_ else float
+        self.labels = general_constraints(system).labels
+        y = np.asarray(y0, dtype=float).reshape(-1)
+        if y.size != self.n:
+            raise EvaluationError(f"{system.name}: {self.n} coordinates expected, got {y.size}")
+        real = functions(system, False) if complex_ else self.fn
+        self.choice = choose(system, real(y, np.zeros(self.n), float(t), self.p, self.u))
+        self.y_guess = y.astype(self.dtype)
+        self.max_newton = 25
+        self.newton_tol = 1e-13
+
+    @property
+    def speed_names(self) -> tuple[str, ...]:
+        return self.choice.speeds
+
+    @property
+    def independent_names(self) -> list[str]:
+        return [self.system.coordinate_names[j] for j in self.choice.independent]
+
+    def _f(self, y: np.ndarray, yd: np.ndarray, t: float) -> dict[str, np.ndarray]:
+        return self.fn(y, yd, t, self.p, self.u)
+
+    def positions(self, yi: np.ndarray, t: float, guess: np.ndarray | None = None
+                  ) -> np.ndarray:
+        """The coordinates y with the independent ones ``yi`` held, the dependent ones by
+        Newton on the kept holonomic rows (from ``guess`` or the last solution)."""
+        ch = self.choice
+        y = (self.y_guess if guess is None else guess).astype(self.dtype, copy=True)
+        y[list(ch.independent)] = yi
+        if not ch.dependent:
+            return y
+        rows, dep = list(ch.rows_h), list(ch.dependent)
+        zero = np.zeros(self.n, dtype=self.dtype)
+        last, extra = math.inf, -1
+        for _ in range(self.max_newton + 1):
+            fn = self._f(y, zero, t)
+            Phi = fn["Phi"][rows, 0]
+            if extra < 0:
+                stop, res, last = _newton_stop(np.real(Phi), np.real(fn["Phi_y"][rows]),
+                                               np.real(fn["Phi_t"][rows, 0]), np.real(y),
+                                               float(t), self.newton_tol, last)
+                if stop > 0:
+                    # in complex arithmetic, two more steps carry the imaginary part (the
+                    # derivative) to the same accuracy
+                    extra = 2 if self.dtype is complex else 0
+                elif stop < 0:
+                    break
+            if extra == 0:
+                self.y_guess = y.copy()
+                return y
+            if extra > 0:
+                extra -= 1
+            Pd = fn["Phi_y"][np.ix_(rows, dep)]
+            try:
+                y[dep] -= np.linalg.solve(Pd, Phi)
+            except np.linalg.LinAlgError:
+                break
+        names = self.system.coordinate_names
+        raise SingularConfiguration(
+            f"{self.system.name}: no configuration with the holonomic rows satisfied for "
+            f"{', '.join(f'{names[j]} = {np.real(v):.6g}' for j, v in zip(ch.independent, yi, strict=True))}"
+            f" at t = {t:.6g} (dependent {', '.join(names[j] for j in ch.dependent)})",
+            t=t, z=np.real(y))
+
+    def velocity_map(self, fn: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray,
+                                                                np.ndarray]:
+        """``W``, ``L`` (f×g) and ``l`` (f) at the functions ``fn`` of a configuration
+        (``ẏ = L·z + l``). Raises SingularConfiguration naming the contacts where W is
+        singular (the speeds do not determine the motion there)."""
+        ch = self.choice
+        A = fn["A"][list(ch.rows_v)]
+        a = fn["a"][list(ch.rows_v), 0]
+        g = len(ch.speeds)
+        if ch.speed_coordinates is not None:
+            Y = np.zeros((g, self.n), dtype=self.dtype)
+            Y[np.arange(g), list(ch.speed_coordinates)] = 1.0
+            b = np.zeros(g, dtype=self.dtype)
+        else:
+            Y, b = fn["Y"], fn["b"][:, 0]
+        W = np.vstack([Y, A])
+        rhs = np.zeros((self.n, g + 1), dtype=self.dtype)
+        rhs[:g, :g] = np.eye(g)
+        rhs[:g, g] = -b
+        rhs[g:, g] = -a
+        try:
+            lu = sla.lu_factor(W, check_finite=True)
+        except (ValueError, np.linalg.LinAlgError):
+            lu = None
+        dmin = float(np.min(np.abs(np.diag(lu[0])))) if lu is not None else 0.0
+        if lu is None or not dmin > EPS * self.n * float(np.max(np.abs(W))):
+            names = [c.name for c in self.system.contacts]
+            raise SingularConfiguration(
+                f"{self.system.name}: the speeds {', '.join(ch.speeds)} do not determine the "
+                f"velocities here: the velocity rows of {', '.join(names)} are singular or "
+                "redundant with them at this state (choose other speeds, or a state where the "
+                "contacts are regular)")
+        sol = sla.lu_solve(lu, rhs)
+        return W, sol[:, :g], sol[:, g]
+
+    def state(self, x: np.ndarray, t: float) -> dict[str, Any]:
+        """Everything at the state ``x = (y_i, z)``: ``y, yd, L, gamma, M, k, q, zd`` and the
+        tree's ``M_tree, k_tree, q_tree``."""
+        ni = len(self.choice.independent)
+        yi, z = x[:ni], x[ni:]
+        y = self.positions(yi, t)
+        fn0 = self._f(y, np.zeros(self.n, dtype=self.dtype), t)
+        W, L, l = self.velocity_map(fn0)
+        yd = L @ z + l
+        fn = self._f(y, yd, t)
+        ch = self.choice
+        cc = fn["c"][list(ch.rows_v), 0]
+        cY = (np.zeros(len(z), dtype=self.dtype) if ch.speed_coordinates is not None
+              else fn["cY"][:, 0])
+        gamma = -np.linalg.solve(W, np.concatenate([cY, cc]))
+        Mt, kt, qt = fn["M"], fn["k"][:, 0], fn["q"][:, 0]
+        M = L.T @ Mt @ L
+        k = L.T @ (kt + Mt @ gamma)
+        q = L.T @ qt
+        return {"y": y, "yd": yd, "z": z, "L": L, "l": l, "gamma": gamma, "W": W, "M": M,
+                "k": k, "q": q, "M_tree": Mt, "k_tree": kt, "q_tree": qt, "fn": fn}
+
+    def accelerations(self, x: np.ndarray, t: float) -> dict[str, Any]:
+        """:meth:`state` with ``zd = M⁻¹(q − k)``, ``ydd = L·zd + γ`` and ``xd`` (the state's
+        derivative)."""
+        s = self.state(x, t)
+        try:
+            zd = np.linalg.solve(s["M"], s["q"] - s["k"])
+        except np.linalg.LinAlgError:
+            raise SingularConfiguration(f"{self.system.name}: M in the generalized velocities "
+                                        f"is singular at t = {t:.6g}", t=t,
+                                        z=np.real(s["y"])) from None
+        s["zd"] = zd
+        s["ydd"] = s["L"] @ zd + s["gamma"]
+        s["xd"] = np.concatenate([s["yd"][list(self.choice.independent)], zd])
+        return s
+
+    def multipliers(self, s: dict[str, Any]) -> np.ndarray:
+        """The rows' multipliers λ (contact forces along the rows' directions) from
+        ``M_tree·ÿ + k_tree − q_tree = Aᵀλ`` (rows dropped by the rank test get 0)."""
+        rows = list(self.choice.rows_v)
+        res = s["M_tree"] @ s["ydd"] + s["k_tree"] - s["q_tree"]
+        A = s["fn"]["A"][rows, :].T
+        lam_r = np.linalg.lstsq(np.real(A), np.real(res), rcond=None)[0]
+        lam = np.zeros(len(self.labels))
+        lam[rows] = lam_r
+        return lam
+
+    def initial(self, y0: Any, yd0: Any, t: float) -> np.ndarray:
+        """The state x from approximate coordinates ``y0`` (independent ones held) and rates
+        ``yd0`` (the speeds taken from them: ``z = Y·ẏ0 + b``)."""
+        y0 = np.asarray(y0, dtype=float).reshape(-1)
+        yd0 = np.zeros(self.n) if yd0 is None else np.asarray(yd0, dtype=float).reshape(-1)
+        y = self.positions(y0[list(self.choice.independent)], t, y0)
+        ch = self.choice
+        if ch.speed_coordinates is not None:
+            z = yd0[list(ch.speed_coordinates)]
+        else:
+            fn = self._f(y, yd0, t)
+            z = fn["Y"] @ yd0 + fn["b"][:, 0]
+        return np.concatenate([y[list(ch.independent)], z])
+
+
+__all__ = ["Choice", "Functions", "GeneralEvaluator", "choose", "functions",
+           "general_constraints"]
