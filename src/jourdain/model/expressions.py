@@ -131,6 +131,28 @@ def as_expr(value: object, where: str) -> Expr:
     )
 
 
+#: the magnitudes a parameter may have besides 0: the equations multiply parameters with each
+#: other and with lengths and rates (m·l², k·x, 1/m), and beyond these bounds such products leave
+#: the floating-point range (inf) or fall into subnormal numbers that have lost their digits
+#: (1e-320: a factorization then overflows or does not converge). Physical constants in any unit
+#: system lie far inside (the mass of a galaxy, 1e42 kg; Planck's constant, 6.6e-34 J·s).
+PARAMETER_MAGNITUDE = (1e-150, 1e150)
+
+
+def magnitude_problem(value: float) -> str | None:
+    """Why a parameter value is absurd (subnormal, or outside :data:`PARAMETER_MAGNITUDE`),
+    or None."""
+    a = abs(value)
+    low, high = PARAMETER_MAGNITUDE
+    if a == 0 or low <= a <= high or a != a:
+        return None
+    what = ("a subnormal number (below 2.2e-308, with fewer digits than a float)"
+            if a < 2.2250738585072014e-308 else "too small" if a < low else "too large")
+    return (f"{value:g} is {what}: a parameter's magnitude must be 0 or between {low:g} and "
+            f"{high:g} (products of parameters would leave the floating-point range); "
+            "choose units in which the value is moderate")
+
+
 _NOT_FINITE = {"Infinity": "an infinite constant", "NegativeInfinity": "an infinite constant",
                "ComplexInfinity": "an infinite constant (zoo)", "NaN": "an undefined constant (NaN)"}
 
