@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -83,6 +84,47 @@ def sweep(lin: Linearization | CompiledLinearization, parameter: str,
     return Sweep(parameter, vals, np.array(eigs), np.array(maxre), tuple(verdicts))
 
 
+def _boundary_numeric(lin: Any, parameter: str, a: float, b: float,
+                      parameters: Mapping[str, float] | None, rtol: float) -> float:
+    """:func:`stability_boundary` of a linearization that is numbers about a nominal state
+    (a general system's, :class:`jourdain.loops.general_linear.GeneralLinearization`): each
+    value linearized anew (``lin.at``), bisection on the verdict to 1e-3 of the bracket, then
+    Brent's method on the largest real part (to ``rtol`` and rounding)."""
+    from scipy.optimize import brentq
+
+    if parameter not in dict(lin.parameters or {}):
+        raise EvaluationError(f'stability_boundary: unknown parameter "{parameter}"')
+
+    def analyse(v: float) -> tuple[str, float]:
+        st = stability(lin.at({**(parameters or {}), parameter: float(v)}))
+        return st.verdict, st.max_real_part
+
+    va, vb = analyse(a), analyse(b)
+    ua, ub = va[0] == UNSTABLE, vb[0] == UNSTABLE
+    if ua == ub:
+        word = "unstable" if ua else "stable"
+        raise EvaluationError(f'stability_boundary: the system is {word} at both {parameter} = '
+                              f"{a} and {parameter} = {b}; give a bracket where it changes")
+    while abs(b - a) > max(1e-3, rtol) * max(1.0, abs(a), abs(b)):
+        mid = 0.5 * (a + b)
+        vm = analyse(mid)
+        if (vm[0] == UNSTABLE) == ua:
+            a, va = mid, vm
+        else:
+            b, vb = mid, vm
+    if va[1] * vb[1] < 0:
+        return float(brentq(lambda v: analyse(v)[1], a, b, xtol=1e-14,
+                            rtol=max(rtol * 1e-4, 4 * np.finfo(float).eps)))
+    lo, hi = a, b
+    while abs(hi - lo) > rtol * max(1.0, abs(lo), abs(hi)):
+        mid = 0.5 * (lo + hi)
+        if (analyse(mid)[0] == UNSTABLE) == ua:
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
 def stability_boundary(lin: Linearization | CompiledLinearization, parameter: str,
                        lower: float, upper: float, t: float = 0.0,
                        parameters: Mapping[str, float] | None = None,
@@ -97,6 +139,8 @@ def stability_boundary(lin: Linearization | CompiledLinearization, parameter: st
     """
     from scipy.optimize import brentq
 
+    if callable(getattr(lin, "at", None)):  # a general system's: linearized anew per value
+        return _boundary_numeric(lin, parameter, float(lower), float(upper), parameters, rtol)
     refuse_closed(getattr(lin, "system", None), "the stability boundary needs the symbolic "
                   "linearization, which closed systems do not have")
     base = _linearization_of(lin)
