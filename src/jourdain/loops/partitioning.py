@@ -39,6 +39,8 @@ def _rank_tol(A: np.ndarray) -> float:
 
 def _cond(A: np.ndarray) -> float:
     """2-norm condition number of ``A`` (inf when singular; 1 when empty)."""
+    if not np.isfinite(A).all():  # never factorized: LAPACK's SVD may not return on inf
+        return float("inf")
     s = np.linalg.svd(A, compute_uv=False) if A.size else np.ones(1)
     return float(s[0] / s[-1]) if s[-1] > 0 else float("inf")
 
