@@ -41,6 +41,8 @@ def prebuild_integrator(dest: Path) -> Path:
     _module("jourdain", SRC / "jourdain", package=True)
     _module("jourdain.numeric", SRC / "jourdain" / "numeric", package=True)
     _module("jourdain.errors", SRC / "jourdain" / "errors.py")
+    _module("jourdain.numeric.cachefile", SRC / "jourdain" / "numeric" / "cachefile.py")
+    _module("jourdain.numeric.buildlock", SRC / "jourdain" / "numeric" / "buildlock.py")
     _module("jourdain.numeric.toolchain", SRC / "jourdain" / "numeric" / "toolchain.py")
     ic = _module("jourdain.numeric.integrator_c", SRC / "jourdain" / "numeric" / "integrator_c.py")
     return ic.prebuild(dest)
@@ -71,7 +73,7 @@ class build_integrator(Command):
             print(f"jourdain: the integrator library was not compiled at install time ({exc}); "
                   "it is compiled at its first use instead", file=sys.stderr)
             return
-        self._outputs = [str(so), str(so.with_suffix(".c"))]
+        self._outputs = [str(so), str(so.with_suffix(".c")), f"{so}.sha256"]  # and its seal
 
     def get_outputs(self) -> list[str]:
         return [] if self.editable_mode else list(self._outputs)

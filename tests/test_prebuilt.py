@@ -72,9 +72,11 @@ def test_prebuild_replaces_an_earlier_version_and_keeps_other_files(tmp_path):
     pre.mkdir()
     (pre / "0123abcd.so").write_bytes(b"an earlier version")
     (pre / "0123abcd.c").write_text("/* its source */")
+    (pre / "0123abcd.so.sha256").write_text("its seal\n")
     (pre / "README").write_text("not ours to delete")
     so = integrator_c.prebuild(pre)
-    assert sorted(p.name for p in pre.iterdir()) == sorted([so.name, so.stem + ".c", "README"])
+    assert sorted(p.name for p in pre.iterdir()) == sorted([so.name, so.stem + ".c",
+                                                           so.name + ".sha256", "README"])
 
 
 def test_a_prebuilt_library_that_is_not_private_or_switched_off_is_not_loaded(tmp_path,

@@ -6,7 +6,6 @@ its ``jd_accel``, memoized per system (:func:`clear_cache`).
 from __future__ import annotations
 
 import ctypes
-import pickle
 import shutil
 import warnings
 from collections.abc import Mapping
@@ -22,6 +21,7 @@ from ..stages.newton_euler import newton_euler
 from ..stages.projection import projection
 from ..stages.reactions import joint_directions, reactions
 from ..symbolic import SymMatrix
+from .cachefile import dump_pickle, keep_sealed, load_pickle
 from .ccode import HEADER, argument_names, function_source
 from .integrator_ldl import ldl_source  # the solve written out per f (H1)
 from .recursive import LDL_SOLVE, recursive_units
@@ -32,9 +32,7 @@ from .toolchain import (
     cache_dir,
     compiler,
     content_key,
-    keep_file,
     library_dir,
-    not_private,
 )
 
 if TYPE_CHECKING:
@@ -108,18 +106,15 @@ def _jit(system: System, names: tuple[str, ...], shapes: tuple[tuple[int, int], 
          exprs: list[se.Basic], source: str) -> JitFunction | None:
     """``exprs`` compiled by SymEngine's LLVM backend (``opt_level=0``: the shortest compile;
     a lean function is evaluated once per sample), kept in ``<cache>/<key>.llvm`` under the
-    hash of the generated C ``source`` (private files only, as for the libraries); None where
-    this SymEngine has no LLVM backend or it cannot compile the expressions."""
+    hash of the generated C ``source``, pickled with its key and sealed
+    (:mod:`jourdain.numeric.cachefile`: unpickled only when private, whole and of this key,
+    else deleted and compiled again); None where this SymEngine has no LLVM backend or it
+    cannot compile the expressions."""
     args = arguments(system)  # the C reads what it uses; the LLVM function takes all
     key = content_key("llvm", _GENERATOR_VERSION, se.__version__, source,
                       " ".join(map(str, args)))
     path = library_dir() / f"{key}.llvm"
-    fn = None
-    if path.exists() and not not_private(path):
-        try:
-            fn = pickle.loads(path.read_bytes())  # noqa: S301 - this user's own private cache
-        except Exception:  # noqa: BLE001 - an unreadable entry is rebuilt
-            fn = None
+    fn = load_pickle(path, key)
     if fn is None:
         try:
             fn = se.Lambdify(list(args), exprs, backend="llvm", cse=True, real=True,
@@ -127,8 +122,8 @@ def _jit(system: System, names: tuple[str, ...], shapes: tuple[tuple[int, int], 
         except (RuntimeError, ValueError, TypeError, NotImplementedError):
             return None
         try:
-            keep_file(path, pickle.dumps(fn))
-        except (OSError, TypeError, pickle.PicklingError):  # a cache that cannot be written
+            keep_sealed(path, dump_pickle(key, fn))
+        except Exception:  # noqa: BLE001 - one that cannot be pickled is compiled next time
             pass
     return JitFunction(names, shapes, args, key, system.f, len(system.parameters),
                        len(system.inputs), fn)
@@ -313,7 +308,8 @@ def clear_cache(disk: bool = False) -> None:
         d = cache_dir()
         if d.is_dir():
             for p in d.iterdir():
-                if p.suffix in (".so", ".c") or p.name.endswith((".so.tmp", ".c.tmp")):
+                if (p.suffix in (".so", ".c", ".llvm", ".sha256")
+                        or p.name.endswith((".so.tmp", ".c.tmp"))):
                     p.unlink(missing_ok=True)
                 elif p.is_dir() and (p.name.startswith(".build-") or p.name == "meshes"):
                     shutil.rmtree(p, ignore_errors=True)  # builds cut off; parsed meshes

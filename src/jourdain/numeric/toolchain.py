@@ -1,10 +1,17 @@
 """Compile generated C once with the system's C compiler and cache the shared library on disk.
 
 The cache is a plain directory (``$JOURDAIN_CACHE``, else ``$XDG_CACHE_HOME/jourdain``, else
-``~/.cache/jourdain``) holding ``<key>.c`` (the source, for reading) and ``<key>.so`` (the
-library), where ``<key>`` is a SHA-256 hash of the content that determines the code. Deleting
-the directory, or any file in it, is always safe: the library is rebuilt on the next use. Only
-shared libraries compiled from jourdain's own generated source are loaded; nothing is pickled.
+``~/.cache/jourdain``) holding ``<key>.c`` (the source, for reading), ``<key>.so`` (the library)
+and its seal ``<key>.so.sha256``, where ``<key>`` is a SHA-256 hash of the content that
+determines the code. Deleting the directory, or any file in it, is always safe: the library is
+rebuilt on the next use. Only shared libraries compiled from jourdain's own generated source are
+loaded. The cache also holds pickles, each with its seal: functions compiled by LLVM
+(``<key>.llvm``, :mod:`jourdain.numeric.compiled`) and models read from URDF files
+(``urdf/<key>.pickle``, :mod:`jourdain.io.urdf.cache`); besides them, JSON and NumPy files that
+are read as data only. No file is loaded or unpickled before it passed the checks of
+:mod:`jourdain.numeric.cachefile`: private, whole (its SHA-256 against its seal: a truncated or
+changed library is deleted and rebuilt, never handed to the dynamic loader) and built for its
+key (each library exports its key, read back after loading; each pickle holds its key).
 
 Code for this machine: the libraries are compiled with ``-march=native`` (every instruction set
 extension of the processor, e.g. AVX-512) where the compiler accepts it, and the key holds the
@@ -24,8 +31,9 @@ Loading a library runs its code, so a library is loaded only from a directory th
 the user and that no one else may write to, and only if the file itself belongs to the user and
 is not writable by others (as Python's own caches are trusted only when private): a library
 another user could have put or changed there is never loaded. A library file that fails the
-check is rebuilt; a cache directory that fails it is not used at all: jourdain says so once
-and compiles into a private temporary directory instead (removed at exit).
+check is rebuilt; a cache directory that fails it, or that cannot be written to (read-only),
+is not used at all: jourdain says so once, naming the directory and ``JOURDAIN_CACHE``, and
+compiles into a private temporary directory instead (removed at exit).
 
 Libraries no model changes (the integrator, :mod:`jourdain.numeric.integrator_c`) are compiled
 when jourdain is installed from source, into ``prebuilt/`` beside this module (``setup.py``,
@@ -38,22 +46,26 @@ library is compiled at its first use, as any other.
 
 from __future__ import annotations
 
+import _ctypes
 import atexit
 import ctypes
 import hashlib
 import os
 import shutil
-import stat
 import subprocess
 import sys
 import tempfile
-import threading
 import warnings
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from functools import lru_cache
 from pathlib import Path
 
 from ..errors import JourdainError
+from .buildlock import build_lock as build_lock  # the builds' locks, also the callers'
+from .buildlock import build_soon as build_soon
+from .cachefile import FORMAT, discard, read_sealed, seal, stamp, stamp_of, stamp_source
+from .cachefile import keep_file as keep_file  # the cache's writer, for the other layers
+from .cachefile import not_private as not_private
 
 #: Compiler flags; part of every cache key. No -ffast-math: NaN checks must keep working. No
 #: contraction to fused multiply-adds: the same results with and without FMA hardware.
@@ -83,44 +95,48 @@ def cache_dir() -> Path:
     return base / "jourdain"
 
 
-def not_private(path: Path) -> str | None:
-    """Why ``path`` cannot be trusted to hold code to load, or None: it must belong to the user
-    running jourdain and be writable by no one else (no group or other write permission)."""
-    try:
-        st = os.stat(path)
-    except OSError as exc:
-        return f"{path} cannot be examined ({exc.strerror})"
-    uid = os.getuid() if hasattr(os, "getuid") else None
-    if uid is not None and st.st_uid != uid:
-        return f"{path} belongs to user id {st.st_uid}, not to you (user id {uid})"
-    if st.st_mode & (stat.S_IWGRP | stat.S_IWOTH):
-        who = " and ".join(w for w, bit in (("its group", stat.S_IWGRP),
-                                            ("all users", stat.S_IWOTH)) if st.st_mode & bit)
-        return f"{path} is writable by {who} (mode {stat.filemode(st.st_mode)})"
-    return None
-
-
 def library_dir() -> Path:
     """Where libraries are built and loaded from: :func:`cache_dir` when it is private (created
-    with mode 0700 if missing), else a private temporary directory, with a warning saying why."""
+    with mode 0700 if missing) and can be written to, else a private temporary directory, with
+    one warning saying why (it names the directory and ``JOURDAIN_CACHE``)."""
     global _fallback
     if _fallback is not None:
         return _fallback
     d = cache_dir()
+    fix = "make it yours and not writable by others (chmod go-w)"
     try:
         d.mkdir(parents=True, exist_ok=True, mode=0o700)
         why = not_private(d)
+        if why is None and d not in _writable:
+            why, fix = _unwritable(d), "make it writable"
     except OSError as exc:
-        why = f"{d} cannot be created ({exc.strerror})"
+        why, fix = f"{d} cannot be created ({exc.strerror})", "make it a directory you can create"
     if why is None:
         return d
     _fallback = Path(tempfile.mkdtemp(prefix="jourdain-"))  # mode 0700, this user's
     atexit.register(shutil.rmtree, _fallback, True)
-    warnings.warn(f"jourdain does not load compiled code from its cache directory: {why}. "
-                  f"Compiling into the private directory {_fallback} for this run instead; make "
-                  f"the cache yours and not writable by others (chmod go-w), or set "
-                  "JOURDAIN_CACHE to a private directory.", RuntimeWarning, stacklevel=2)
+    warnings.warn(f"jourdain does not use its compile cache {d}: {why}. Compiling into the "
+                  f"private temporary directory {_fallback} for this run instead (removed at "
+                  f"exit); to keep compiled code between runs, {fix}, or set JOURDAIN_CACHE to "
+                  "a private, writable directory.", RuntimeWarning, stacklevel=2)
     return _fallback
+
+
+#: the cache directories found writable in this process (:func:`_unwritable`)
+_writable: set[Path] = set()
+
+
+def _unwritable(d: Path) -> str | None:
+    """Why nothing can be written into ``d`` (a read-only folder or file system), or None:
+    tried with a file created and removed there, once per directory and process."""
+    try:
+        fd, probe = tempfile.mkstemp(prefix=".probe-", dir=d)
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as exc:
+        return f"{d} cannot be written to ({exc.strerror})"
+    _writable.add(d)
+    return None
 
 
 def compiler() -> str:
@@ -142,26 +158,6 @@ def compiler() -> str:
 
 #: compiler() by ($CC or the default names, $PATH)
 _found: dict[tuple[str | None, ...], str] = {}
-
-
-def keep_file(path: Path, data: bytes) -> None:
-    """Write ``data`` to ``path`` whole or not at all: under a private temporary name beside it,
-    then renamed into place, so that a concurrent reader (another process, another thread)
-    never sees half a file. For the cache's entries: one that cannot be written costs time,
-    not results (an OSError leaves nothing behind and is not raised)."""
-    tmp: str | None = None
-    try:
-        path.parent.mkdir(mode=0o700, parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-        os.replace(tmp, path)
-    except OSError:
-        if tmp is not None:
-            try:
-                os.unlink(tmp)
-            except OSError:
-                pass
 
 
 def native_target() -> str | None:
@@ -207,9 +203,10 @@ def host_flags() -> tuple[str, ...]:
 
 
 def content_key(*parts: str) -> str:
-    """SHA-256 of the parts, the compiler flags, the native target and the Python platform."""
+    """SHA-256 of the parts, the compiler flags, the native target, the Python platform and
+    the format of the cache's files (:data:`jourdain.numeric.cachefile.FORMAT`)."""
     h = hashlib.sha256()
-    for part in (*parts, " ".join(CFLAGS), native_target() or "portable", sys.platform):
+    for part in (*parts, " ".join(CFLAGS), native_target() or "portable", sys.platform, FORMAT):
         h.update(part.encode())
         h.update(b"\0")
     return h.hexdigest()[:32]
@@ -226,22 +223,40 @@ def prebuilt_dir() -> Path | None:
 
 def cached_library(key: str) -> ctypes.CDLL | None:
     """The library cached under ``key`` (in :func:`library_dir`, else in :func:`prebuilt_dir`),
-    or None if it was never built (or was deleted)."""
+    or None if it was never built (or was deleted, or failed a check and was deleted now)."""
     if key in _loaded:
         return _loaded[key]
     pre = prebuilt_dir()
     for d in (library_dir(), *([pre] if pre is not None else [])):
         so = d / f"{key}.so"
-        # missing, someone else's or writable by others (then never loaded: rebuilt), or a
-        # truncated or foreign file: the next place, then a build
-        if not so.exists() or not_private(so):
+        # missing, someone else's or writable by others (never loaded: rebuilt over), or not
+        # whole (truncated, changed, unsealed: deleted, never loaded): the next place, then a
+        # build; one of another key is deleted after loading (_open)
+        if not so.exists() or read_sealed(so) is None:
             continue
-        try:
-            lib = ctypes.CDLL(str(so))
-        except OSError:
-            continue
-        _loaded[key] = lib
+        lib = _open(so, key)
+        if lib is not None:
+            _loaded[key] = lib
+            return lib
+    return None
+
+
+def _open(so: Path, key: str) -> ctypes.CDLL | None:
+    """The library ``so`` loaded, if it holds the stamp of ``key`` (built for it, by this
+    jourdain: :func:`jourdain.numeric.cachefile.stamp_source`); else unloaded again (nothing of
+    it was called), deleted, and None."""
+    try:
+        lib = ctypes.CDLL(str(so))
+    except OSError:
+        discard(so)
+        return None
+    if stamp_of(lib) == stamp(key):
         return lib
+    try:  # so that the library rebuilt under this name is loaded, not this one again
+        _ctypes.dlclose(lib._handle)
+    except (AttributeError, OSError):
+        pass
+    discard(so)
     return None
 
 
@@ -251,20 +266,22 @@ def compile_shared(sources: Mapping[str, str | bytes], units: Sequence[str], out
     """Compile the translation ``units`` (names in ``sources``, which may also hold the headers
     they include) into the shared library ``out``: each unit by its own compiler process, in
     parallel, then linked. The sources are written into a private folder beside ``out`` (the
-    include path), removed afterwards; ``out`` is written under a private name and renamed into
-    place, so a concurrent reader never sees half a library. ``flags`` are for compiling
-    (``-shared`` is for the link alone and dropped there); ``unit_flags``, one per unit, follow
-    them for that unit alone (``-O3`` overrides ``-O2``). CompilerError names the unit."""
-    cc = compiler()
+    include path), removed afterwards, and named relative to it, so that the same sources give
+    the same bytes in every build (no temporary path in the library). ``out`` is written under a
+    private name, sealed (:func:`jourdain.numeric.cachefile.seal`) and renamed into place, so a
+    concurrent reader never sees half a library or one without its seal. ``flags`` are for
+    compiling (``-shared`` is for the link alone and dropped there); ``unit_flags``, one per
+    unit, follow them for that unit alone (``-O3`` overrides ``-O2``). CompilerError names the
+    unit."""
+    cc = os.path.abspath(compiler())  # the compiler runs in the build folder
     compile_flags = [f for f in flags if f != "-shared"]
     work = Path(tempfile.mkdtemp(prefix=".build-", dir=out.parent))
     try:
         for name, text in sources.items():
             (work / name).write_bytes(text if isinstance(text, bytes) else text.encode())
-        objects = [work / f"{Path(u).stem}.o" for u in units]
+        objects = [f"{Path(u).stem}.o" for u in units]
         own = list(unit_flags) if unit_flags is not None else [()] * len(units)
-        procs = [subprocess.Popen([cc, *compile_flags, *fl, f"-I{work}", "-c", "-o", str(o),
-                                   str(work / u)],
+        procs = [subprocess.Popen([cc, *compile_flags, *fl, "-I.", "-c", "-o", o, u], cwd=work,
                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
                  for u, o, fl in zip(units, objects, own, strict=True)]
         errors = [p.communicate()[1] for p in procs]
@@ -272,11 +289,13 @@ def compile_shared(sources: Mapping[str, str | bytes], units: Sequence[str], out
             if p.returncode != 0:
                 raise CompilerError(f"compiling {u} with {cc} failed:\n{e[-4000:]}")
         tmp = work / f"{out.name}.tmp"
-        link = subprocess.run([cc, "-shared", "-o", str(tmp), *map(str, objects), "-lm"],
+        link = subprocess.run([cc, "-shared", "-o", tmp.name, *objects, "-lm"], cwd=work,
                               capture_output=True, text=True)
         if link.returncode != 0:
             raise CompilerError(f"linking {out.name} with {cc} failed:\n{link.stderr[-4000:]}")
         os.chmod(tmp, 0o700)  # this user's alone, whatever the umask
+        if not seal(out, tmp.read_bytes()):
+            raise OSError(f"cannot write the seal of {out}")
         os.replace(tmp, out)
     finally:
         shutil.rmtree(work, ignore_errors=True)
@@ -300,67 +319,29 @@ def build(key: str, source: str | Sequence[str], extra_flags: Sequence[str] = ()
         return lib if lib is not None else _build(key, source, extra_flags, unit_flags)
 
 
-_BUILDING: dict[str, threading.Lock] = {}
-_BUILDING_GUARD = threading.Lock()
-
-
-def build_lock(name: str) -> threading.Lock:
-    """The lock of one build, by ``name`` (a library's key, or a name of the caller's for a
-    larger step that builds, such as generating a source): one thread at a time builds it,
-    the others wait and then find it built. Fresh in a child forked while it was held."""
-    with _BUILDING_GUARD:
-        return _BUILDING.setdefault(name, threading.Lock())
-
-
-def _forget_builds() -> None:
-    """In a child forked while a thread built: the build's locks are the parent's (none of
-    its threads runs here to release them); fresh ones."""
-    global _BUILDING_GUARD
-    _BUILDING.clear()
-    _BUILDING_GUARD = threading.Lock()
-
-
-os.register_at_fork(after_in_child=_forget_builds)
-
-
-def build_soon(fn: Callable[..., object], *args: object, name: str = "jourdain-build") -> None:
-    """Start ``fn(*args)``, a function that builds a library (through :func:`build`), in a
-    thread and return at once: the compiler runs in a process of its own, on another core,
-    while the caller goes on (other code to generate and compile). The caller's own later call
-    of ``fn`` waits for that build (:func:`build` holds one lock per library), or builds where
-    this one failed and raises its error then: the thread's errors are dropped. A child
-    forked meanwhile builds for itself."""
-
-    def quietly() -> None:
-        try:
-            fn(*args)
-        except Exception:  # noqa: BLE001 - the caller's own call reports it
-            pass
-
-    # not a daemon: an exit waits for the compiler (Ctrl-C stops the compiler with it), so
-    # that no half-built library is left in the cache
-    threading.Thread(target=quietly, name=name).start()
-
-
 def _build(key: str, source: str | Sequence[str], extra_flags: Sequence[str],
            unit_flags: Sequence[Sequence[str]] | None) -> ctypes.CDLL:
-    so = _compile(library_dir(), key, source, extra_flags, unit_flags)
-    lib = ctypes.CDLL(str(so))
-    _loaded[key] = lib
-    return lib
+    for _ in range(2):  # once more where another process deleted or replaced it meanwhile
+        so = _compile(library_dir(), key, source, extra_flags, unit_flags)
+        lib = _open(so, key)
+        if lib is not None:
+            _loaded[key] = lib
+            return lib
+    raise CompilerError(f"{so} was compiled, but what is there cannot be loaded as the library "
+                        f"of its key (another process replacing it?)")
 
 
 def prebuild(dest: Path, key: str, source: str | Sequence[str],
              unit_flags: Sequence[Sequence[str]] | None = None) -> Path:
     """Compile a library that no model changes into ``dest`` at install time (``setup.py``;
     :func:`cached_library` looks there after the cache): ``<key>.so`` and its source, as
-    :func:`build` would compile it into the cache, with the same flags; the files of other keys
-    in ``dest`` (an earlier version's) are removed. Returns the library's path; raises
+    :func:`build` would compile it into the cache, with the same flags, and its seal; the files
+    of other keys in ``dest`` (an earlier version's) are removed. Returns the library's path; raises
     CompilerError (no compiler, a failed compile), which an install reports and goes on."""
     dest.mkdir(parents=True, exist_ok=True)
     so = _compile(dest, key, source, (), unit_flags)
     for old in dest.iterdir():
-        if old.suffix in (".so", ".c") and old.stem != key:
+        if old.suffix in (".so", ".c", ".sha256") and old.name.split(".")[0] != key:
             old.unlink(missing_ok=True)
     return so
 
@@ -368,7 +349,8 @@ def prebuild(dest: Path, key: str, source: str | Sequence[str],
 def _compile(d: Path, key: str, source: str | Sequence[str], extra_flags: Sequence[str],
              unit_flags: Sequence[Sequence[str]] | None) -> Path:
     """``<d>/<key>.so`` from ``source`` (and ``<d>/<key>.c``): native code where the compiler
-    takes it, else portable code for this process."""
+    takes it, else portable code for this process. The library holds ``key`` (a unit of its
+    own: :func:`jourdain.numeric.cachefile.stamp_source`), checked after every load."""
     units = [source] if isinstance(source, str) else list(source)
     so = d / f"{key}.so"
     src = d / f"{key}.c"
@@ -378,20 +360,21 @@ def _compile(d: Path, key: str, source: str | Sequence[str], extra_flags: Sequen
     with os.fdopen(fd, "w") as fh:
         fh.write("\n".join(units))
     os.replace(tmp_src, src)
-    names = [f"jd_unit{k}.c" for k in range(len(units))]
+    sources = {f"jd_unit{k}.c": u for k, u in enumerate([*units, stamp_source(key)])}
+    names = list(sources)
+    if unit_flags is not None:
+        unit_flags = [*unit_flags, ()]
     native = host_flags()
     try:
         try:
-            compile_shared(dict(zip(names, units, strict=True)), names, so,
-                           (*CFLAGS, *native, *extra_flags), unit_flags)
+            compile_shared(sources, names, so, (*CFLAGS, *native, *extra_flags), unit_flags)
         except CompilerError:
             if not native:
                 raise
             # e.g. an assembler older than the compiler's instruction sets: portable code,
             # for this process (the key stays: the library is correct on this machine); where
             # the portable build fails too, the source is at fault, not the flag
-            compile_shared(dict(zip(names, units, strict=True)), names, so,
-                           (*CFLAGS, *extra_flags), unit_flags)
+            compile_shared(sources, names, so, (*CFLAGS, *extra_flags), unit_flags)
             _native_failed.add(compiler())
     except CompilerError as exc:
         raise CompilerError(f"compiling {src} failed:\n{str(exc)[-4000:]}") from None

@@ -13,13 +13,13 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ...analysis.python_control import MissingDependency
+from ...numeric.cachefile import read_sealed
 from ...numeric.toolchain import (
     CompilerError,
     compile_shared,
     compiler,
     content_key,
     library_dir,
-    not_private,
 )
 
 if TYPE_CHECKING:
@@ -69,20 +69,24 @@ def _binary(sources: Mapping[str, bytes], name: str,
             order: tuple[str, ...] = SOURCES) -> bytes:
     """The compiled binary of the FMU's sources: from jourdain's cache of compiled code
     (:func:`jourdain.numeric.cache_dir`, keyed by the sources, the compiler and its flags) when
-    it was built before, else compiled there by :func:`jourdain.numeric.toolchain.compile_shared`
-    (one compiler per unit, in parallel) and kept."""
+    it was built before (and is private and whole: its seal, :mod:`jourdain.numeric.cachefile`;
+    a damaged one is deleted), else compiled there by
+    :func:`jourdain.numeric.toolchain.compile_shared` (one compiler per unit, in parallel) and
+    kept with its seal."""
     cc = compiler()
     h = hashlib.sha256()
     for k, v in sorted(sources.items()):
         h.update(k.encode() + b"\0" + v + b"\0")
     key = "fmu-" + content_key("fmu", cc, *CFLAGS, h.hexdigest())
     cache = library_dir() / f"{key}{Path(name).suffix}"
-    if not (cache.is_file() and not_private(cache) is None):
+    data = read_sealed(cache)
+    if data is None:
         try:
             compile_shared({k.split("/", 1)[1]: v for k, v in sources.items()}, order, cache,
                            CFLAGS)
         except CompilerError as exc:
             raise CompilerError(f"the FMU's binary: {exc}") from None
-    return cache.read_bytes()
+        data = cache.read_bytes()
+    return data
 
 

@@ -8,23 +8,26 @@ built from a file is therefore kept in the cache directory of the compiled libra
 from it are), pickled, under a SHA-256 of everything it is built from: the file's bytes and
 path, the options of :func:`~jourdain.io.urdf.load_urdf`, and the source of the modules that
 build it and of the model's classes (a changed jourdain makes new keys, never stale models).
-A model that cannot be read back is built again; a cache that cannot be written costs time,
-not results.
+The pickle holds its key and is sealed by its checksum, and it is unpickled only after the
+checks of :mod:`jourdain.numeric.cachefile`: the file (not only its folder) belongs to the user
+and no one else may write to it, it is whole (its SHA-256 against its seal) and of this key;
+a file that fails them is deleted. A model that cannot be read back is built again; a cache
+that cannot be written costs time, not results.
 """
 
 from __future__ import annotations
 
 import hashlib
-import pickle
 from pathlib import Path
 from typing import Any
 
-from ...numeric.toolchain import keep_file, library_dir
+from ...numeric.cachefile import dump_pickle, keep_sealed, load_pickle
+from ...numeric.toolchain import library_dir
 from .model import UrdfModel
 
 __all__ = ["cached", "keep", "model_key"]
 
-FORMAT = "jourdain-urdf-model-1"
+FORMAT = "jourdain-urdf-model-2"
 
 #: the packages whose source a cached model depends on (relative to jourdain's root)
 _SOURCES = ("io/urdf", "model")
@@ -50,20 +53,16 @@ def _file(key: str) -> Path:
 
 
 def cached(key: str) -> UrdfModel | None:
-    """The model kept under ``key``; None when there is none or it cannot be read."""
-    try:
-        with open(_file(key), "rb") as fh:
-            model = pickle.load(fh)
-    except (OSError, pickle.UnpicklingError, EOFError, AttributeError, ImportError,
-            TypeError, ValueError):
-        return None
+    """The model kept under ``key``; None when there is none or it cannot be used."""
+    model = load_pickle(_file(key), key)
     return model if isinstance(model, UrdfModel) else None
 
 
 def keep(key: str, model: UrdfModel) -> None:
-    """Keep ``model`` under ``key`` (written whole under a temporary name, then renamed)."""
+    """Keep ``model`` under ``key`` (written whole under a temporary name, then renamed, after
+    its seal)."""
     try:
-        data = pickle.dumps(model, protocol=pickle.HIGHEST_PROTOCOL)
-    except (pickle.PicklingError, TypeError, AttributeError):
+        data = dump_pickle(key, model)
+    except Exception:  # noqa: BLE001 - a model that cannot be pickled is built next time
         return
-    keep_file(_file(key), data)
+    keep_sealed(_file(key), data)
