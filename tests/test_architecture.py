@@ -42,7 +42,8 @@ MODEL_MAY_IMPORT = ("jourdain.model", "jourdain.errors")
 FLOORS: tuple[tuple[str, ...], ...] = (
     # 0 foundations: the errors, the symbolic matrix, the expression graph (CSE,
     #   differentiation) and identity maps
-    ("jourdain.errors", "jourdain.version", "jourdain.identity", "jourdain.symbolic", "jourdain.graph"),
+    ("jourdain.errors", "jourdain.version", "jourdain.identity", "jourdain.symbolic", "jourdain.graph",
+     "jourdain.extras"),
     # 1 the model: the description a user writes (pure, immutable data), and its units
     ("jourdain.model", "jourdain.units"),
     # 2 the stages of the method: kinematics → Newton–Euler → projection → reactions →

@@ -17,6 +17,7 @@ from scipy.spatial.transform import Rotation  # noqa: E402
 
 import jourdain as jd  # noqa: E402
 from jourdain.cli import main  # noqa: E402
+from jourdain.extras import MissingDependency  # noqa: E402
 from jourdain.io.urdf import UrdfError, load_urdf  # noqa: E402
 from jourdain.numeric import evaluate  # noqa: E402
 from tests.tolerance import EPS  # noqa: E402
@@ -201,7 +202,8 @@ def test_missing_yourdfpy_names_the_extra(monkeypatch, tmp_path):
     arm = tmp_path / "arm.urdf"  # not read before: not in the cache of built models
     arm.write_bytes(ARM.read_bytes() + b"<!-- not in the cache -->\n")
     monkeypatch.setitem(sys.modules, "yourdfpy", None)
-    with pytest.raises(jd.ModelError, match=r"jourdain\[urdf\]"):
+    with pytest.raises(MissingDependency, match=r"URDF import needs the extra: pip install "
+                       r"'jourdain\[urdf\]' \(the package yourdfpy is not installed\)"):
         load_urdf(arm)
 
 

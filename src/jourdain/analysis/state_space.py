@@ -16,6 +16,8 @@ from typing import Any
 import numpy as np
 
 from ..errors import EvaluationError, JourdainError, SingularMassMatrix
+from ..extras import MissingDependency as MissingDependency
+from ..extras import require
 from ..numeric import parameter_vector
 from ..numeric.linearization import (
     CompiledLinearization,
@@ -93,18 +95,8 @@ class StateSpace:
                           inputs=list(self.input_names), outputs=list(out_names), **kw)
 
 
-class MissingDependency(JourdainError, ImportError):
-    """An optional dependency of jourdain is not installed; the message names the extra."""
-
-
 def _control() -> Any:
-    try:
-        import control
-    except ImportError:
-        raise MissingDependency(
-            "this needs python-control, an optional dependency of jourdain: "
-            'pip install "jourdain[control]" (or pip install control)') from None
-    return control
+    return require("control", "python-control (to_control, state_feedback)", "control")
 
 
 def output_matrix(ss: StateSpace, outputs: Sequence[str] | None = None

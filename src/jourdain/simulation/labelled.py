@@ -14,17 +14,13 @@ from typing import Any
 import numpy as np
 
 from ..errors import JourdainError
+from ..extras import require
 
 __all__ = ["results_dataset"]
 
 
 def _xarray() -> Any:
-    try:
-        import xarray as xr
-    except ImportError:
-        raise JourdainError("labelled results need xarray: pip install 'jourdain[study]'"
-                            ) from None
-    return xr
+    return require("xarray", "Labelled output (xarray)", "study")
 
 
 def results_dataset(results: Any) -> Any:

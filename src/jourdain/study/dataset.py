@@ -20,21 +20,16 @@ from typing import Any
 
 import numpy as np
 
+from ..extras import missing, require
 from ..simulation.labelled import results_dataset
 from .compute import VERDICTS, WRENCH_COMPONENTS, Context, output_layout
-from .spec import StudyError
 
 __all__ = ["open_study", "results_dataset", "to_dataset", "write_netcdf"]
 
 
 def xarray() -> Any:
     """The xarray module, or a clear error naming the extra that installs it."""
-    try:
-        import xarray as xr
-    except ImportError:
-        raise StudyError("labelled results need xarray: pip install 'jourdain[study]'"
-                         ) from None
-    return xr
+    return require("xarray", "A parameter study's output (xarray)", "study")
 
 
 @lru_cache(maxsize=1)
@@ -239,4 +234,4 @@ def _engine() -> str:
     for engine, module in (("h5netcdf", "h5netcdf"), ("netcdf4", "netCDF4")):
         if importlib.util.find_spec(module) is not None:
             return engine
-    raise StudyError("writing NetCDF needs h5netcdf (or netCDF4): pip install 'jourdain[study]'")
+    raise missing("NetCDF output (h5netcdf or netCDF4)", "study", "h5netcdf")

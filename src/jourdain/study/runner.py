@@ -25,6 +25,7 @@ from typing import Any
 
 import numpy as np
 
+from ..extras import missing
 from .compute import compute_block, context, output_layout
 from .spec import StudyError, StudySpec
 
@@ -279,8 +280,8 @@ def _run_dask(spec: StudySpec, todo: list[tuple[int, int]], scheduler: Any,
     try:
         from distributed import Client, as_completed
     except ImportError:
-        raise StudyError("running on a Dask cluster needs dask.distributed: pip install "
-                         "'jourdain[study]'") from None
+        raise missing("A study on a Dask cluster (dask.distributed)", "study",
+                      "distributed") from None
     own = not isinstance(scheduler, Client)
     try:
         client = Client(scheduler) if own else scheduler

@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ...analysis.python_control import MissingDependency
+from ...extras import missing
 from ...numeric.cachefile import read_sealed
 from ...numeric.toolchain import (
     CompilerError,
@@ -41,9 +42,7 @@ def fmi_header_dir() -> Path:
     """The folder of the FMI 2.0 headers that FMPy ships (``fmpy/c-code``)."""
     spec = importlib.util.find_spec("fmpy")
     if spec is None or not spec.submodule_search_locations:
-        raise MissingDependency(
-            "exporting an FMU needs the FMI 2.0 headers that FMPy ships, an optional dependency "
-            'of jourdain: pip install "jourdain[fmu]" (or pip install fmpy)')
+        raise missing("FMU export (the FMI 2.0 headers of FMPy)", "fmu", "fmpy")
     for loc in spec.submodule_search_locations:
         d = Path(loc) / "c-code"
         if all((d / h).is_file() for h in FMI_HEADERS):

@@ -13,22 +13,19 @@ from typing import Any
 
 import numpy as np
 
-from ...errors import ModelError
+from ...extras import require
 from ..expressions import RESERVED_NAMES
 from ..modelfile import (
     MAX_FILE_BYTES,
 )
 from .model import Pose, UrdfError
 
+#: what the urdf extra is needed for, in the message of a missing package
+URDF = "URDF import"
+
 
 def _yourdfpy() -> Any:
-    try:
-        import yourdfpy
-    except ImportError:
-        raise ModelError(
-            "reading URDF files needs the package yourdfpy: install jourdain's extra with "
-            "pip install 'jourdain[urdf]' (or pip install yourdfpy)") from None
-    return yourdfpy
+    return require("yourdfpy", URDF, "urdf")
 
 
 def _read_xml(path: str) -> tuple[bytes, dict[tuple[str, str], int]]:
@@ -42,7 +39,7 @@ def _read_xml(path: str) -> tuple[bytes, dict[tuple[str, str], int]]:
     if len(raw) > MAX_FILE_BYTES:
         raise UrdfError(f"the file is larger than {MAX_FILE_BYTES // 1_000_000} MB; URDF "
                         "files of real robots are a few hundred kB", path)
-    from lxml import etree  # a dependency of yourdfpy
+    etree = require("lxml.etree", URDF, "urdf")  # a dependency of yourdfpy
 
     parser = etree.XMLParser(resolve_entities=False, no_network=True, load_dtd=False,
                              huge_tree=False)
