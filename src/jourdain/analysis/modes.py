@@ -219,6 +219,9 @@ def stability(system: StateSpace | AnyLinearization, t: float | None = None,
 
 
 def _cyclic_of(lin: AnyLinearization) -> tuple[str, ...]:
+    known = getattr(lin, "cyclic_in_eta", None)  # a general system's: found in its numbers
+    if known is not None:
+        return tuple(known)
     if callable(getattr(lin, "state_space", None)):  # a closed system's, in numbers: none
         return ()
     base = lin.linearization if hasattr(lin, "linearization") else lin

@@ -141,6 +141,12 @@ def choose(system: System, fn: dict[str, np.ndarray]) -> Choice:
     coordinates left by pivoting on A's columns."""
     names = system.coordinate_names
     f = len(names)
+    bad = [k for k in ("Phi", "Phi_y", "A", "a") if not np.all(np.isfinite(fn[k]))]
+    if bad:
+        raise SingularConfiguration(
+            f"{system.name}: the rows of {', '.join(c.name for c in system.contacts)} are not "
+            f"defined at this state ({', '.join(bad)} not finite: a disc lying flat on the "
+            "ground has no contact point, a knife edge along the normal no direction)")
     Pz = np.real(fn["Phi_y"])
     if Pz.shape[0]:
         part = partition(system, Pz, system.independent)

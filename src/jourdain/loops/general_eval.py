@@ -57,7 +57,7 @@ def evaluate_general(system: System, y: Any, yd: Any = None, t: float = 0.0,
         M_bar=tree["M_bar"], J_bar=J_bar, J_bar_tree=tree["J_bar"], Q_c=Q_c,
         labels=list(ev.labels), **{"lambda": lam},
         contact_forces=dict(zip(ev.labels, (float(v) for v in lam), strict=True)),
-        Phi=fn["Phi"][:, 0], Phi_dot=fn["A"] @ s["yd"] + fn["a"][:, 0],
+        Phi=fn["Phi"].reshape(-1), Phi_dot=fn["A"] @ s["yd"] + fn["a"][:, 0],
         orthogonality=float(np.max(np.abs(J_bar.T @ Q_c), initial=0.0)))
     return out
 

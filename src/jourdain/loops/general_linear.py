@@ -54,6 +54,15 @@ class GeneralLinearization(LoopLinearization):
     x_names: tuple[str, ...] = ()
     nominal: Any = None
 
+    @property
+    def cyclic_in_eta(self) -> tuple[str, ...]:
+        """The coordinates of η that are cyclic (their columns of Q vanish): Routh's reduction
+        of :func:`jourdain.stability` leaves them out (a heading, kept for its rate)."""
+        scale = max(float(np.max(np.abs(self.Q), initial=0.0)),
+                    float(np.max(np.abs(self.M_tilde), initial=0.0)))
+        return tuple(n for i, n in enumerate(self.names)
+                     if np.all(np.abs(self.Q[:, i]) <= ZERO_RTOL * scale))
+
     def at(self, parameters: Mapping[str, float]) -> GeneralLinearization:
         """The linearization about the same nominal (its expressions of the parameters
         evaluated anew) for other parameter values."""

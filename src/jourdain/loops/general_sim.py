@@ -27,8 +27,8 @@ def _sample(ev: GeneralEvaluator, x: np.ndarray, t: float) -> tuple:
     s = ev.accelerations(x, t)
     fn = s["fn"]
     phi = np.zeros(len(ev.labels))
-    rh = fn["Phi"].shape[0]
-    phi[:rh] = fn["Phi"][:, 0]
+    hol = fn["Phi"].reshape(-1)
+    phi[:hol.size] = hol
     phid = fn["A"] @ s["yd"] + fn["a"][:, 0]
     return s["y"], s["yd"], s["ydd"], phi, phid, ev.multipliers(s)
 

@@ -13,12 +13,13 @@ from ..model import (
     Body,
     General,
     Gravity,
+    Planar,
     Revolute,
     Rot,
     Trans,
     symbols,
 )
-from ..model.contacts import RollingDisc
+from ..model.contacts import KnifeEdge, RollingDisc
 from ..pipeline import System
 
 #: Table 1 of Meijaard et al. (2007), Proc. R. Soc. A 463, 1955–1982 (SI units)
@@ -74,4 +75,39 @@ def benchmark_bicycle() -> System:
                   speeds=["phi", "delta", "thetaR"])
 
 
-__all__ = ["BENCHMARK_BICYCLE", "benchmark_bicycle"]
+def chaplygin_sleigh() -> System:
+    """Chaplygin's sleigh: a body moving in the ground plane (planar joint ``x, y, psi``,
+    centre of mass at the body frame's origin) on a knife edge at ``(a, 0, 0)`` along its x
+    axis. Speeds chosen by definition: ``u = cos(psi)·x_d + sin(psi)·y_d`` (the edge's
+    forward speed) and ``w = psi_d``. Closed form (no applied forces): ``u̇ = −a·w²``,
+    ``ẇ = m·a·u·w/(I + m·a²)``, lateral force on the edge ``F = m·I·u·w/(I + m·a²)``."""
+    x, y, psi = symbols("x y psi")
+    m, I, a = symbols("m I a")
+    sleigh = Body("sleigh", "world", Planar("plane", (x, y, psi)), mass=m,
+                  inertia=(I, I, I))
+    return System([x, y, psi], [sleigh], parameters={"m": 2.0, "I": 0.3, "a": 0.4},
+                  name="Chaplygin sleigh",
+                  contacts=[KnifeEdge("edge", "sleigh", (a, 0, 0), "x")],
+                  speeds={"u": se.cos(psi) * symbols("x_d") + se.sin(psi) * symbols("y_d"),
+                          "w": symbols("psi_d")})
+
+
+def rolling_disc() -> System:
+    """A thin uniform disc (mass ``m``, radius ``r``) rolling without slip on the ground
+    ``z = 0`` (gravity ``g`` along −z): centre ``x, y, zc``, heading ``psi``, lean ``phi``
+    and spin ``theta`` (z, x, y; axle y). Speeds ``psi_d, phi_d, theta_d``; ``zc`` follows
+    from the contact (``r·cos(phi)``)."""
+    x, y, zc, psi, phi, theta = symbols("x y zc psi phi theta")
+    m, r, g = symbols("m r g")
+    disc = Body("disc", "world",
+                General("free", [Trans(vector=(x, y, zc)), Rot("z", psi), Rot("x", phi),
+                                 Rot("y", theta)], coordinates=(x, y, zc, psi, phi, theta)),
+                mass=m, inertia=(m * r**2 / 4, m * r**2 / 2, m * r**2 / 4))
+    return System([x, y, zc, psi, phi, theta], [disc], [Gravity((0, 0, -g))],
+                  parameters={"m": 1.0, "r": 0.5, "g": 9.81}, name="rolling disc",
+                  contacts=[RollingDisc("ground", "disc", r, "y")],
+                  independent=["x", "y", "psi", "phi", "theta"],
+                  speeds=["psi", "phi", "theta"])
+
+
+__all__ = ["BENCHMARK_BICYCLE", "benchmark_bicycle", "chaplygin_sleigh", "rolling_disc"]

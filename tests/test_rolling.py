@@ -1,0 +1,102 @@
+"""Velocity constraints (METHOD.md §7): Chaplygin's sleigh (a knife edge, speeds given by
+definition) and the rolling disc against their closed forms, and the errors of bad input."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import jourdain as jd
+from jourdain.errors import ModelError, SingularConfiguration
+from jourdain.models.rolling import chaplygin_sleigh, rolling_disc
+
+EPS = float(np.finfo(float).eps)
+
+
+def _sleigh_state(rng: np.random.Generator, a: float) -> tuple[np.ndarray, np.ndarray, float,
+                                                               float]:
+    y = rng.uniform(-1.0, 1.0, 3)
+    u, w = rng.uniform(-2.0, 2.0, 2)
+    psi = y[2]
+    ex = np.array([np.cos(psi), np.sin(psi)])
+    ey = np.array([-np.sin(psi), np.cos(psi)])
+    vc = u * ex - a * w * ey  # the centre of mass, a behind the edge
+    return y, np.array([vc[0], vc[1], w]), u, w
+
+
+def test_sleigh_equals_its_closed_form() -> None:
+    s = chaplygin_sleigh()
+    p = s.parameter_values
+    m, I, a = p["m"], p["I"], p["a"]
+    rng = np.random.default_rng(7)
+    for _ in range(5):
+        y, yd, u, w = _sleigh_state(rng, a)
+        out = s.evaluate(y, yd)
+        assert out["speeds"] == ["u", "w"]
+        np.testing.assert_allclose(out["z"], [u, w], rtol=0, atol=10 * EPS * 4)
+        ref = np.array([-a * w * w, m * a * u * w / (I + m * a * a)])
+        scale = float(np.max(np.abs(ref))) + 1.0
+        assert np.max(np.abs(out["zd"] - ref)) <= 100 * EPS * scale
+        F = m * I * u * w / (I + m * a * a)
+        assert abs(out["contact_forces"]["edge.T"] - F) <= 100 * EPS * (abs(F) + 1.0)
+
+
+def test_sleigh_run_keeps_energy_and_the_edge() -> None:
+    s = chaplygin_sleigh()
+    p = s.parameter_values
+    m, I, a = p["m"], p["I"], p["a"]
+    y, yd, u, w = _sleigh_state(np.random.default_rng(2), a)
+    res = s.simulate((0.0, 5.0), y, yd, rtol=1e-11, atol=1e-12)
+    assert res.status == "finished"
+    T = 0.5 * m * (res.yd[:, 0] ** 2 + res.yd[:, 1] ** 2) + 0.5 * I * res.yd[:, 2] ** 2
+    assert np.max(np.abs(T - T[0])) <= 1e-8 * T[0]
+    assert np.max(np.abs(res.constraints.Phi_dot)) <= 1e3 * EPS * (1 + np.abs(res.yd).max())
+
+
+@pytest.mark.parametrize("Omega", [2.0, 3.0, 6.0])
+def test_rolling_disc_lean_frequency_and_critical_spin(Omega: float) -> None:
+    """Upright rolling at spin Ω (thin uniform disc, I_d = m r²/4, I_a = m r²/2): the lean
+    obeys (I_d + m r²)·φ̈ + (I_a(I_a + m r²)Ω²/I_d − m g r)·φ = 0 once the heading rate is
+    eliminated; stable (marginally) above Ω² = g/(3r)."""
+    d = rolling_disc()
+    p = d.parameter_values
+    m, r, g = p["m"], p["r"], p["g"]
+    Id, Ia = m * r * r / 4, m * r * r / 2
+    lin = d.linearize({"zc": r, "theta_d": -Omega})
+    assert lin.names == ("psi", "phi") and set(lin.cyclic) == {"x", "y", "theta"}
+    w2 = (Ia * (Ia + m * r * r) * Omega ** 2 / Id - m * g * r) / (Id + m * r * r)
+    nonzero = lin.eigenvalues[np.abs(lin.eigenvalues) > 1e-6]
+    ref = np.sqrt(complex(-w2))
+    assert np.allclose(np.sort_complex(nonzero), np.sort_complex([-ref, ref]),
+                       rtol=1e-12, atol=1e-12)
+    verdict = jd.stability(lin).verdict
+    assert verdict == ("unstable" if Omega ** 2 < g / (3 * r) else "marginally stable")
+
+
+def test_contact_forces_of_a_disc_at_rest() -> None:
+    d = rolling_disc()
+    p = d.parameter_values
+    out = d.evaluate([0.3, -0.2, p["r"], 0.4, 0.0, 1.0], np.zeros(6))
+    f = out["contact_forces"]
+    weight = p["m"] * p["g"]
+    assert abs(f["ground.N"] - weight) <= 10 * EPS * weight
+    assert abs(f["ground.T1"]) <= 10 * EPS * weight and abs(f["ground.T2"]) <= 10 * EPS * weight
+
+
+def test_bad_input_names_the_element() -> None:
+    s = chaplygin_sleigh()
+    with pytest.raises(ModelError, match="unknown body"):
+        jd.System(s.coordinates, s.bodies, contacts=[jd.KnifeEdge("k", "nobody")],
+                  parameters=dict(s.parameters))
+    with pytest.raises(ModelError, match="not linear"):
+        jd.System(s.coordinates, s.bodies, parameters=dict(s.parameters),
+                  contacts=[jd.VelocityConstraint("v", [jd.symbols("x_d") ** 2])])
+    with pytest.raises(ModelError, match="leave 2 generalized velocities"):
+        jd.System(s.coordinates, s.bodies, parameters=dict(s.parameters),
+                  contacts=s.contacts, speeds=["x"]).evaluate([0, 0, 0], [0, 0, 0])
+    d = rolling_disc()
+    with pytest.raises(SingularConfiguration, match="ground"):
+        d.evaluate([0, 0, 0.0, 0, np.pi / 2, 0], np.zeros(6))
+    with pytest.raises(jd.ClosedSystemError if hasattr(jd, "ClosedSystemError") else
+                       ModelError, match="contact"):
+        jd.kinematics(d)
