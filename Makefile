@@ -86,5 +86,5 @@ viewer-assets:
 	tools/build_viewer.sh
 
 clean:
-	rm -rf $(VENV) .pytest_cache .ruff_cache .jourdain-test-cache .jourdain-docs-cache site \
+	rm -rf $(VENV) .venv-docs .pytest_cache .ruff_cache .jourdain-test-cache .jourdain-docs-cache site \
 	  src/jourdain/numeric/prebuilt
