@@ -154,11 +154,12 @@ def linearize_general(system: System, nominal: Any,
                               "needs speeds that are rates of coordinates (speeds=[names]); "
                               "the first-order Jacobian is A_x of a linearization with them")
     pos = {j: i for i, j in enumerate(ch.independent)}
-    matched = [pos.get(j) for j in ch.speed_coordinates]
-    if any(m is None for m in matched):
-        bad = [names[j] for j, m in zip(ch.speed_coordinates, matched, strict=True) if m is None]
+    found = [pos.get(j) for j in ch.speed_coordinates]
+    if any(m is None for m in found):
+        bad = [names[j] for j, m in zip(ch.speed_coordinates, found, strict=True) if m is None]
         raise EvaluationError(f"{system.name}: the speeds' coordinates {', '.join(bad)} are "
                               "dependent; choose them independent (independent=[...])")
+    matched: list[int] = [int(m) for m in found if m is not None]
     scale = max(float(np.max(np.abs(Jr), initial=0.0)), float(np.max(np.abs(M))))
     tol = ZERO_RTOL * scale
     zero_col = [bool(np.all(np.abs(Jr[:, i]) <= tol)) for i in range(ni)]
@@ -181,9 +182,10 @@ def linearize_general(system: System, nominal: Any,
             keep.append(k)
     kz = [ni + k for k in keep]
     ky = [matched[k] for k in keep]
-    Mt = M[np.ix_(keep, keep)]
-    P = Jr[np.ix_(keep, kz)]
-    Q = Jr[np.ix_(keep, ky)]
+    ik = np.array(keep, dtype=int)
+    Mt = M[np.ix_(ik, ik)]
+    P = Jr[np.ix_(ik, np.array(kz, dtype=int))]
+    Q = Jr[np.ix_(ik, np.array(ky, dtype=int))]
     n = len(keep)
     Minv_Q = np.linalg.solve(Mt, Q)
     Minv_P = np.linalg.solve(Mt, P)

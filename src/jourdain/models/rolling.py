@@ -6,6 +6,7 @@ matrices of the benchmark come out of the method, they are not put in."""
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import symengine as se
 
@@ -47,7 +48,7 @@ def benchmark_bicycle() -> System:
     """
     x, y, zc, psi, phi, theta, thR, delta, thF = symbols(
         "x y zc psi phi theta thetaR delta thetaF")
-    p = {k: symbols(k) for k in BENCHMARK_BICYCLE}
+    p: dict[str, Any] = {k: symbols(k) for k in BENCHMARK_BICYCLE}
     w, c, lam, rR, rF = p["w"], p["c"], p["lam"], p["rR"], p["rF"]
     s0 = (w + c - rF * se.tan(lam), 0, rR - rF)  # the steer axis at the front wheel's height
     rear_frame = Body(

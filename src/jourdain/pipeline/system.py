@@ -152,7 +152,7 @@ class System(Model):
         if self.is_general:  # velocity constraints (METHOD §7): jourdain.loops.general
             from ..loops.general_eval import evaluate_general
 
-            return evaluate_general(self, y, yd, t, parameters, inputs)
+            return evaluate_general(self, y, yd, t, parameters, inputs)  # type: ignore[arg-type]
         if self.closing:  # the closed system's numbers (METHOD §7): jourdain.loops.evaluation
             from ..loops.evaluation import evaluate_closed
 

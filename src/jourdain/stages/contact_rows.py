@@ -15,6 +15,7 @@ lying flat (``n·a = ±1``) has no contact point: the evaluation reports it.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 import symengine as se
 
@@ -39,16 +40,16 @@ def _ground_axes(n: Vec3) -> tuple[Vec3, Vec3]:
     one, zero = se.Integer(1), se.Integer(0)
     k = next(i for i in range(3) if n[i] != 0)
     i, j = (k + 1) % 3, (k + 2) % 3
-    t1 = tuple(one if m == i else zero for m in range(3))
-    t2 = tuple(one if m == j else zero for m in range(3))
-    return t1, _scale(n[k], t2)  # type: ignore[arg-type]
+    t1: Any = tuple(one if m == i else zero for m in range(3))
+    t2: Any = tuple(one if m == j else zero for m in range(3))
+    return t1, _scale(n[k], t2)
 
 
 def material_velocity(kin: Kinematics, body: str, P: Vec3, f: int) -> tuple[list[Expr], Vec3]:
     """The velocity of ``body``'s material point at the inertial point ``P`` (an expression of
     y, t): its columns over ẏ (inertial, one 3-vector per coordinate) and its rheonomic part."""
     bk = kin[body]
-    S = bk.S.rows
+    S: Any = bk.S.rows
     rO = tuple(bk.r_O.rows[i][0] for i in range(3))
     arm = (P[0] - rO[0], P[1] - rO[1], P[2] - rO[2])
     zero = (se.Integer(0),) * 3
@@ -84,7 +85,7 @@ def contact_rows(kin: Kinematics, contacts: Sequence[Contact]) -> tuple[list, li
                 vel.append(ConstraintRow(n, f"{n}.{i}", e, "generic", None, holonomic=False))
             continue
         bk = kin[c.body]
-        S = bk.S.rows
+        S: Any = bk.S.rows
         rO = tuple(bk.r_O.rows[i][0] for i in range(3))
         nv = c.normal
         if isinstance(c, RollingDisc):
@@ -93,8 +94,8 @@ def contact_rows(kin: Kinematics, contacts: Sequence[Contact]) -> tuple[list, li
             na = _dot(nv, a)
             s = se.sqrt(1 - na * na)
             d = tuple(-(nv[i] - na * a[i]) / s for i in range(3))
-            P = _add(C, _scale(c.radius, d))  # type: ignore[arg-type]
-            at = {"body_a": c.body, "body_b": "world", "p_a": P, "p_b": P}
+            P = _add(C, _scale(c.radius, d))
+            at: dict[str, Any] = {"body_a": c.body, "body_b": "world", "p_a": P, "p_b": P}
             hol.append(ConstraintRow(n, f"{n}.N", _dot(nv, P), "force", nv, **at))
             cols, vbar = material_velocity(kin, c.body, P, f)
             for k, tk in enumerate(_ground_axes(nv), 1):
