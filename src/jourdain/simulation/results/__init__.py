@@ -118,6 +118,11 @@ class Results(WithPlots):
         A's axes), from the multipliers."""
         if not len(self.t) or self.system is None:
             return []
+        if getattr(self.system, "is_general", False):  # contact forces, by row
+            c = self.constraints
+            assert c is not None
+            return [f"  {lab}: max |λ| = {np.abs(c.multipliers[:, i]).max():.4g}"
+                    for i, lab in enumerate(c.labels)]
         from ...loops.reactions import closing_reactions
 
         p = np.array([self.parameters[k] for k, _ in self.system.parameters])
