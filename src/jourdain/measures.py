@@ -80,6 +80,14 @@ class Frames:
             v = _add(v, _scale(c, self.kin.yd[j]))
         return r, v, dict(cols), a_bar
 
+    def body_point(self, body: str, p: Vec3, point_frame: str) -> Vec3:
+        """The coordinates in ``body``'s frame of the place ``p`` given in ``point_frame``
+        (the material point of ``body`` that is there at the instant)."""
+        if point_frame == body:
+            return p
+        r, _ = self.point(point_frame, p)
+        return _mtv(self.S(body), _sub(r, _vec(self.kin[body].r_O)))
+
     def material_point(self, body: str, p: Vec3, point_frame: str
                        ) -> tuple[Vec3, Vec3, dict[int, Vec3], Vec3]:
         """Position, velocity, J_T columns and ā (inertial) of the material point of ``body``

@@ -61,21 +61,30 @@ class Gravity:
 
 @dataclass(frozen=True)
 class Force:
-    """A point force ``vector`` (in ``frame``) acting on ``body`` at ``point`` (body frame)."""
+    """A point force ``vector`` (components in ``frame``) acting on ``body`` at ``point``.
+
+    ``point`` is given in the axes and from the origin of ``point_frame`` (default: ``body``
+    itself), a body or ``"world"``: a point fixed in another frame, such as the contact point
+    below a wheel's hub, is where the force acts, on the material point of ``body`` that is
+    there at the instant (as the kinematic quantities' ``point_frame``). The moment of the
+    force about the body's centre of mass then follows the point as it travels over the body.
+    """
 
     name: str
     body: str
     vector: Vec3
     point: Vec3
     frame: str
+    point_frame: str
 
     def __init__(self, name: str, body: str, vector: object, point: object = (0, 0, 0),
-                 frame: str = "world") -> None:
+                 frame: str = "world", point_frame: str | None = None) -> None:
         object.__setattr__(self, "name", _name(name, "force"))
         object.__setattr__(self, "body", body)
         object.__setattr__(self, "vector", as_vector(vector, f'force "{name}" vector'))
         object.__setattr__(self, "point", as_vector(point, f'force "{name}" point'))
         object.__setattr__(self, "frame", frame)
+        object.__setattr__(self, "point_frame", body if point_frame is None else point_frame)
 
 
 @dataclass(frozen=True)

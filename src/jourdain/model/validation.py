@@ -169,6 +169,10 @@ def validate(sys: Description) -> None:
                 raise ModelError(f'{w}: unknown body "{f.body}"')
             if f.frame != WORLD and f.frame not in body_names:
                 raise ModelError(f'{w}: unknown frame "{f.frame}" (a body name or "world")')
+            point_frame = getattr(f, "point_frame", WORLD)
+            if point_frame != WORLD and point_frame not in body_names:
+                raise ModelError(f'{w}: unknown point_frame "{point_frame}" (a body name or '
+                                 '"world")')
             exprs = list(f.vector) + list(getattr(f, "point", ()))
         elif isinstance(f, SpringDamper):
             for bn in (f.body_a, f.body_b):

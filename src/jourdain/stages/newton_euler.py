@@ -203,7 +203,9 @@ def applied_forces(kin: Kinematics, elements: Sequence[object] | None = None
             acc.gravity = _add(acc.gravity, fe.vector)
         elif isinstance(fe, Force):
             F_I, F_B = acc.to_body(res.resolve_all(fe.vector), fe.frame, fe.body)
-            acc.add_force(fe.body, F_I, F_B, fe.point)
+            if fe.body != WORLD:
+                point = res.frames.body_point(fe.body, fe.point, fe.point_frame)
+                acc.add_force(fe.body, F_I, F_B, point)
         elif isinstance(fe, Torque):
             _, T_B = acc.to_body(res.resolve_all(fe.vector), fe.frame, fe.body)
             acc.add_torque(fe.body, T_B)

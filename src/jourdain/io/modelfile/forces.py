@@ -66,11 +66,11 @@ class _Forces(_Bodies):
                                 f"one of {', '.join(ok)}")
             return b
 
-        def frame() -> str:
-            fr = self.string(spec.get("frame", WORLD), (*p, "frame"))
+        def frame(key: str = "frame", default: object = WORLD) -> str:
+            fr = self.string(spec.get(key, default), (*p, key))
             ok = [WORLD, *self.body_names]
             if fr not in ok:
-                raise self.fail((*p, "frame"), f'unknown frame "{fr}"; expected "world" or a '
+                raise self.fail((*p, key), f'unknown frame "{fr}"; expected "world" or a '
                                 "body name")
             return fr
 
@@ -89,7 +89,8 @@ class _Forces(_Bodies):
                              self.vector(self.require(spec, "vector", p), (*p, "vector"),
                                          allowed, ctx),
                              self.vector(spec.get("point", [0, 0, 0]), (*p, "point"), params,
-                                         pctx), frame())
+                                         pctx), frame(),
+                             point_frame=frame("point_frame", spec.get("body")))
             if ftype == "torque":
                 return Torque(fname, body("body", False),
                               self.vector(self.require(spec, "vector", p), (*p, "vector"),

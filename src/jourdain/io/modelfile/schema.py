@@ -28,7 +28,7 @@ _JOINT_KEYS: dict[str, set[str]] = {
 _JOINT_COMMON = {"type", "name", "position", "orientation"}
 _FORCE_KEYS: dict[str, set[str]] = {
     "gravity": {"vector"},
-    "force": {"body", "vector", "point", "frame"},
+    "force": {"body", "vector", "point", "frame", "point_frame"},
     "torque": {"body", "vector", "frame"},
     "spring_damper": {"body_a", "point_a", "body_b", "point_b", "stiffness", "damping",
                       "rest_length", "law"},
