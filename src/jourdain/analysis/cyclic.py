@@ -27,6 +27,7 @@ import numpy as np
 
 from ..errors import EvaluationError, JourdainError
 from ..graph import Graph, evaluate_float, free_symbol_names, jet_float
+from ..graph.memo import Memo
 from ..numeric import mkq_function, parameter_vector
 from ..stages.kinematics import kinematics  # the model has no stage methods (issue 16)
 from ..stages.linearization.nominal import _perturbed
@@ -55,8 +56,18 @@ def cyclic_coordinates(source: System | EquationsOfMotion) -> tuple[str, ...]:
     :func:`jourdain.graph.jet_float`) at two random states and times, at the
     default parameter values and at a random set near them, must vanish to
     :data:`CYCLIC_RTOL` of the largest value or derivative there. The result is a property of
-    the model, for all parameter values.
+    the model, for all parameter values: it is found once per model (:data:`CYCLIC`, keyed by
+    the model's content), not at every ``jd.stability`` call.
     """
+    system = source.system if isinstance(source, EquationsOfMotion) else source
+    return CYCLIC.get(system, lambda: _find(source))
+
+
+#: the cyclic coordinates of each model (by content: an equal model built anew is the same key)
+CYCLIC: Memo[tuple[str, ...]] = Memo("cyclic coordinates", 128)
+
+
+def _find(source: System | EquationsOfMotion) -> tuple[str, ...]:
 
     eom = source if isinstance(source, EquationsOfMotion) else projection(newton_euler(kinematics(source)))
     system = eom.system

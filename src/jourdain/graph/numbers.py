@@ -22,6 +22,7 @@ import symengine as se
 from ..errors import EvaluationError, JourdainError
 from .forward import needed_gradients, partials
 from .identity import Expr, no_gc
+from .memo import graph_of
 from .nodes import Graph
 from .piecewise import PIECEWISE, describe, float_partials
 
@@ -39,9 +40,10 @@ def evaluate_float(exprs: Sequence[Expr], values: Mapping[str, float]) -> list[f
 
     For a single evaluation this is faster than compiling (no code generation); for many
     evaluations compile with :func:`jourdain.numeric.lambdify`. ``values`` maps symbol names to
-    numbers; a symbol without a value raises :class:`JourdainError`.
+    numbers; a symbol without a value raises :class:`JourdainError`. The graph of the same
+    expression objects is built once (:func:`jourdain.graph.memo.graph_of`).
     """
-    g = Graph(exprs)
+    g = graph_of(exprs)
     with no_gc():
         num = _float_values(g, values)
     return [num[k] for k in g.roots]
@@ -105,7 +107,7 @@ def _sum(args: list[float]) -> float:
 def free_symbol_names(exprs: Sequence[Expr]) -> set[str]:
     """Names of the symbols in some expressions, visiting each shared node once (SymEngine's
     ``free_symbols`` walks a shared graph as a tree)."""
-    return Graph(exprs).symbol_names()
+    return graph_of(exprs).symbol_names()
 
 
 # --- numeric forward mode --------------------------------------------------------------------

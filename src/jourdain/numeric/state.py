@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import EvaluationError, ModelError
+from ..graph.memo import Memo
 from ..model.bodies import check_values
 from .diagnose import nonfinite_message
 
@@ -79,13 +80,46 @@ def parameter_vector(system: System, parameters: Mapping[str, float] | None) -> 
                 raise EvaluationError(f'parameter "{k}" = {v!r} is not finite')
             values[k] = fv
         # the model's numbers must stay physical at the new values, as at the defaults (a
-        # negative mass would give a negative definite M without a word)
-        try:
-            check_values(system.bodies, values)
-        except ModelError as exc:
+        # negative mass would give a negative definite M without a word); checked once per
+        # model and values (one jd.stability call asks five times), and only where a value
+        # that the bodies' data use was given (the defaults passed when the model was made)
+        problem = None
+        if not CHECKED_NAMES.get(system, lambda: _checked_names(system)).isdisjoint(parameters):
+            problem = CHECKS.get((system, tuple(values.items())),
+                                 lambda: _problem(system, values))
+        if problem is not None:
             given = ", ".join(f"{k}={v}" for k, v in parameters.items())
-            raise EvaluationError(f"with the parameters {given}: {exc}") from None
+            raise EvaluationError(f"with the parameters {given}: {problem}") from None
     return np.array(list(values.values()), dtype=float)
+
+
+#: what is wrong with a model's numbers at parameter values (None: nothing), by the model
+#: (its content; its hash is computed once) and the values by name
+CHECKS: Memo[str | None] = Memo("parameter checks", 256)
+
+
+#: the parameters that the checks of a model's numbers read (bodies' mass data, joints' frames
+#: and axes), by the model
+CHECKED_NAMES: Memo[frozenset[str]] = Memo("checked parameters", 256)
+
+
+def _checked_names(system: System) -> frozenset[str]:
+    names: set[str] = set()
+    for b in system.bodies:
+        j = b.joint
+        exprs = [b.mass, *b.com, *(x for row in b.inertia for x in row), *j.position,
+                 *(x for row in j.orientation for x in row),
+                 *(c for s in j.steps if s.axis is not None for c in s.axis)]
+        names.update(str(s) for e in exprs for s in e.free_symbols)
+    return frozenset(names)
+
+
+def _problem(system: System, values: Mapping[str, float]) -> str | None:
+    try:
+        check_values(system.bodies, values)
+    except ModelError as exc:
+        return str(exc)
+    return None
 
 
 def _vector(x: Any, n: int, what: str, names: Sequence[str]) -> np.ndarray:

@@ -23,17 +23,24 @@ from .nominal import ZERO, NominalMotionWarning, _is_zero, _nominal, _perturbed
 from .result import Linearization, check_nominal_at, values_at
 
 
-def _warn_if_not_solution(lin: Linearization) -> None:
-    """A :class:`NominalMotionWarning` when a claimed equilibrium or steady motion leaves
-    h ≠ 0 at t = 0 for the default parameter values (a reference trajectory with ÿ_s ≠ 0 is
-    not checked: h is its feed-forward)."""
+def nominal_warning(lin: Linearization) -> str | None:
+    """The :class:`NominalMotionWarning`'s message when a claimed equilibrium or steady motion
+    leaves h ≠ 0 at t = 0 for the default parameter values (a reference trajectory with
+    ÿ_s ≠ 0 is not checked: h is its feed-forward), else None."""
     defaults = np.array(list(lin.system.parameter_values.values()), dtype=float)
     try:
         result = check_nominal_at(lin, values_at(lin, 0.0, defaults))
     except JourdainError:  # no numbers at the default parameter values: evaluate() will say
-        return
+        return None
     if result.kind != "nominal motion" and not result.is_solution:
-        warn(result.message(), NominalMotionWarning)
+        return result.message()
+    return None
+
+
+def _warn_if_not_solution(lin: Linearization) -> None:
+    message = nominal_warning(lin)
+    if message is not None:
+        warn(message, NominalMotionWarning)
 
 
 def linearization(eom: EquationsOfMotion, nominal: Mapping[Any, Any] | Any,
@@ -72,8 +79,16 @@ def linearization(eom: EquationsOfMotion, nominal: Mapping[Any, Any] | Any,
         When the nominal motion is an equilibrium or a steady motion (ÿ_s = 0) and ``h ≠ 0`` at
         t = 0 for the default parameter values (:func:`.result.check_nominal_at`).
     """
+    y_s, u_s = _nominal(eom.system, nominal, inputs)
+    lin = form(eom, y_s, u_s)
+    _warn_if_not_solution(lin)
+    return lin
+
+
+def form(eom: EquationsOfMotion, y_s: list[se.Basic], u_s: list[se.Basic]) -> Linearization:
+    """:func:`linearization` about the nominal motion ``y_s`` (f expressions) and inputs
+    ``u_s`` (m), already checked (``nominal._nominal``), without the warning."""
     system = eom.system
-    y_s, u_s = _nominal(system, nominal, inputs)
     t = system.t
     f = system.f
     yd_s = [se.diff(e, t) for e in y_s]
@@ -141,7 +156,6 @@ def linearization(eom: EquationsOfMotion, nominal: Mapping[Any, Any] | Any,
         h=SymMatrix.column(h), B=SymMatrix(tuple(tuple(row) for row in B)),
         switches=J.switches,
     )
-    _warn_if_not_solution(lin)
     return lin
 
 def _residual_parts(eom: EquationsOfMotion, ydd_nonzero: list[bool]
