@@ -38,8 +38,9 @@ def read_loops(loader: Any, data: dict, system: _S) -> _S:
     lp = ("loops",)
     loops = loader.table(data.get("loops", {}), lp, {"independent"})
     if not tbl:
-        if loops:
-            raise loader.fail(lp, "[loops] without any [closing_joints.<name>]")
+        if loops and "contacts" not in data:
+            raise loader.fail(lp, "[loops] without any [closing_joints.<name>] or "
+                              "[contacts.<name>]")
         return system
     params = set(loader.params)
     bodies = ["world", *system.body_names]

@@ -91,6 +91,11 @@ class _Loader(_Forces):
             from ...loops.modelfile import read_loops
 
             system = read_loops(self, data, system)
+        if "contacts" in data or "speeds" in data:
+            # velocity constraints (rolling contact): jourdain.loops.contact_file
+            from ...loops.contact_file import read_contacts
+
+            system = read_contacts(self, data, system)
         return ModelFile(self.file, system, description, nominal, sim,
                          tuple(self.descriptions.items()), view)
 

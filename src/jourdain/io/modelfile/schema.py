@@ -13,7 +13,7 @@ MAX_FILE_BYTES = 4_000_000
 _MAX_NESTING = 32
 
 _TOP = {"model", "coordinates", "parameters", "inputs", "bodies", "forces", "nominal",
-        "simulation", "quantities", "closing_joints", "loops"}
+        "simulation", "quantities", "closing_joints", "loops", "contacts", "speeds"}
 _JOINT_KEYS: dict[str, set[str]] = {
     "revolute": {"coordinate", "axis"},
     "prismatic": {"coordinate", "axis"},
