@@ -89,6 +89,7 @@ from .model import (
     distance_rate,
     elongation,
     elongation_d,
+    planar_inertia,
     point_acceleration,
     point_mass,
     position,
@@ -126,7 +127,7 @@ from .wrenches import JointWrench, joint_wrenches
 __all__ = [
     # the model: the system, its bodies, joints and force elements (jourdain.model)
     "System", "Body", "WORLD", "symbols", "t",
-    "box", "cylinder", "disc", "point_mass", "rod",
+    "box", "cylinder", "disc", "point_mass", "rod", "planar_inertia",
     "Joint", "Rot", "Trans", "Revolute", "Prismatic", "Cylindrical", "Universal", "Spherical",
     "Planar", "Free", "Fixed", "General",
     "Gravity", "Force", "Torque", "SpringDamper", "GeneralizedForce", "RotationalSpringDamper",

@@ -1,6 +1,16 @@
 """The model description: what the user describes, immutable once built."""
 
-from .bodies import WORLD, Body, box, cylinder, disc, point_mass, rod
+from .bodies import (
+    WORLD,
+    Body,
+    PlanarInertia,
+    box,
+    cylinder,
+    disc,
+    planar_inertia,
+    point_mass,
+    rod,
+)
 from .expressions import symbols, t
 from .forces import (
     Bushing,
@@ -46,6 +56,7 @@ from .system import System
 
 __all__ = [
     "WORLD", "Body", "box", "cylinder", "disc", "point_mass", "rod", "symbols", "t",
+    "PlanarInertia", "planar_inertia",
     "Force", "GeneralizedForce", "Gravity", "RotationalSpringDamper", "SpringDamper", "Torque",
     "acceleration", "elongation", "elongation_d", "rate", "Bushing", "deflection", "deflection_d",
     "Quantity", "angular_velocity", "distance", "distance_rate", "point_acceleration", "position",

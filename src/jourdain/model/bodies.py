@@ -36,9 +36,12 @@ class Body:
         May be zero only for massless frames (then ``inertia`` must be zero as well).
     com : 3-vector
         Centre of mass in the body frame.
-    inertia : 3x3 matrix or 3-vector
+    inertia : 3x3 matrix or 3-vector, or :func:`planar_inertia`
         Inertia tensor about the centre of mass in the body frame; a 3-vector gives its
-        diagonal (principal moments). Zero for point masses.
+        diagonal (principal moments). Zero for point masses. ``planar_inertia(I, "z")`` gives
+        the moment about the normal of the plane alone, for a body whose angular velocity
+        stays about that axis (checked by the Newton–Euler stage): ``planar`` is then that
+        axis.
     """
 
     name: str
@@ -47,6 +50,7 @@ class Body:
     mass: Expr
     com: Vec3
     inertia: Mat3
+    planar: str | None = None
 
     def __init__(self, name: str, parent: str, joint: Joint, mass: object = None,
                  com: object = (0, 0, 0), inertia: object = None) -> None:
@@ -67,7 +71,11 @@ class Body:
                 f'body "{name}": inertia is missing (use zeros for a point mass, or the helpers '
                 "point_mass, rod, disc, cylinder, box)"
             )
-        if isinstance(inertia, list | tuple) and len(inertia) == 3 and not isinstance(
+        planar = None
+        if isinstance(inertia, PlanarInertia):
+            planar = inertia.axis
+            I = _axis_diag(inertia.axis, inertia.moment, 0, "planar inertia")
+        elif isinstance(inertia, list | tuple) and len(inertia) == 3 and not isinstance(
             inertia[0], list | tuple
         ):
             d = as_vector(inertia, f'body "{name}" inertia')
@@ -87,6 +95,7 @@ class Body:
         object.__setattr__(self, "mass", m)
         object.__setattr__(self, "com", c)
         object.__setattr__(self, "inertia", I)
+        object.__setattr__(self, "planar", planar)
         if not any(x.free_symbols for x in (m, *c, *(x for row in I for x in row))):
             # numbers only: checked now (with parameters: by the System, at their values)
             check_mass_data(self, {})
@@ -129,11 +138,16 @@ def mass_data_problem(body: Body, values: Mapping[str, float]) -> tuple[str, str
     if ev.min() < -1e-12 * scale:
         return "inertia", ("inertia tensor is not positive semi-definite (eigenvalues "
                            f"{np.array2string(ev, precision=4)})")
-    if ev[2] > ev[0] + ev[1] + TRIANGLE_TOL * ev[2]:
+    if ev[2] > ev[0] + ev[1] + TRIANGLE_TOL * ev[2] and body.planar is None:
         return "inertia", ("inertia tensor is not that of a rigid body: its largest principal "
                            f"moment {ev[2]:.6g} exceeds the sum of the other two "
                            f"({ev[0]:.6g} + {ev[1]:.6g}); each principal moment must be at most "
-                           "the sum of the other two (the triangle inequality)")
+                           "the sum of the other two (the triangle inequality). A body that "
+                           "moves in a plane may be given by its moment about the plane's "
+                           "normal alone: inertia=jd.planar_inertia(I_zz, \"z\") in Python, "
+                           "inertia = { planar = { moment = \"I_zz\", axis = \"z\" } } in a "
+                           "model file (accepted where its angular velocity stays about that "
+                           "axis)")
     if m == 0 and np.abs(I).max() > 0:
         return "inertia", "a massless body cannot have rotational inertia"
     return None
@@ -161,6 +175,29 @@ def check_values(bodies: Iterable[Body], values: Mapping[str, float]) -> None:
 def _diag(a: object, b: object, c: object) -> Mat3:
     A, B, C = (as_expr(v, "inertia") for v in (a, b, c))
     return ((A, _ZERO, _ZERO), (_ZERO, B, _ZERO), (_ZERO, _ZERO, C))
+
+
+@dataclass(frozen=True)
+class PlanarInertia:
+    """The inertia of a body that moves in a plane: its ``moment`` about the plane's normal
+    ``axis`` (a body axis, x, y or z) alone, as the models of planar tools give it
+    ((0, 0, I_zz)). See :func:`planar_inertia`."""
+
+    moment: Expr
+    axis: str
+
+
+def planar_inertia(moment: object, axis: str = "z") -> PlanarInertia:
+    """The inertia of a body that moves in a plane, given by its moment about the plane's
+    normal ``axis`` alone: the tensor diag(0, 0, I) for ``"z"``, which no 3-D body has (the
+    triangle inequality), accepted for a body whose angular velocity stays about that axis
+    (the Newton–Euler stage checks it and refuses the model otherwise). Its motion is that of
+    any body with this moment about the axis and the axis principal; the reaction moments
+    across the plane at its joint (``Reactions.planar_moments``) are those of a body without
+    products of inertia about the axis, which the model does not know, and are flagged."""
+    if axis not in ("x", "y", "z"):
+        raise ModelError(f"planar inertia: axis must be x, y or z, got {axis!r}")
+    return PlanarInertia(as_expr(moment, "planar inertia moment"), axis)
 
 
 def point_mass() -> Mat3:

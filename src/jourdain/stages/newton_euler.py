@@ -46,6 +46,7 @@ from .kinematics import (
     _scale,
     step_axis,
 )
+from .planar import check_planar
 
 if TYPE_CHECKING:
     from ..model.system import System
@@ -107,6 +108,7 @@ def newton_euler(kin: Kinematics) -> NewtonEuler:
     system = kin.system
     bodies = system.bodies
     p = len(bodies)
+    check_planar(kin)  # a planar inertia holds where ω stays about its axis
     # q̄^c: Newton m ā, Euler I ᾱ + ω × (I ω)
     qc_T: list[se.Basic] = []
     qc_R: list[se.Basic] = []

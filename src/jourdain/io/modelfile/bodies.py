@@ -28,13 +28,16 @@ from ...model import (
     disc,
     rod,
 )
-from ...model.bodies import mass_data_problem
+from ...model.bodies import mass_data_problem, planar_inertia
 from ...model.forces import _axes
 from ...model.joints import orientation_problem
 from ..toml_positions import Path, line_of
 from .errors import ModelFileError, _type_name
 from .schema import _JOINT_COMMON, _JOINT_KEYS, _SHAPES
 from .values import _Values
+
+#: the planar inertia: the moment about the plane's normal alone (jourdain.planar_inertia)
+_PLANAR = {"planar": {"moment", "axis"}}
 
 
 class _Bodies(_Values):
@@ -128,13 +131,14 @@ class _Bodies(_Values):
         if isinstance(value, dict):
             if len(value) != 1:
                 raise self.fail(path, "a shape table has exactly one key: point, rod, disc, "
-                                "cylinder or box")
+                                "cylinder, box or planar")
             shape, args = next(iter(value.items()))
             sp = (*path, shape)
-            if shape not in _SHAPES:
-                raise self.fail(sp, f'unknown shape "{shape}"{self.suggest(shape, list(_SHAPES))}'
-                                f"; expected one of {', '.join(_SHAPES)}")
-            args = self.table(args, sp, _SHAPES[shape] | {"mass"})
+            shapes = {**_SHAPES, **_PLANAR}
+            if shape not in shapes:
+                raise self.fail(sp, f'unknown shape "{shape}"{self.suggest(shape, list(shapes))}'
+                                f"; expected one of {', '.join(shapes)}")
+            args = self.table(args, sp, shapes[shape] | {"mass"})
             m = self.expr(args["mass"], (*sp, "mass"), params, ctx) if "mass" in args else mass
 
             def get(k: str) -> se.Basic:
@@ -149,6 +153,8 @@ class _Bodies(_Values):
 
             if shape == "point":
                 return [0, 0, 0]
+            if shape == "planar":
+                return planar_inertia(get("moment"), ax("z"))
             if shape == "rod":
                 return rod(m, get("length"), ax("x"))
             if shape == "disc":

@@ -18,6 +18,7 @@ from ...model.joints import Vec3
 from ...symbolic import SymMatrix
 from ..kinematics import _add, _cross, _mat, _mtv, _mv, _scale
 from ..newton_euler import NewtonEuler, joint_transform
+from ..planar import planar_moments
 
 if TYPE_CHECKING:
     from ...model.system import System
@@ -47,6 +48,11 @@ class Reactions:
     joints : tuple of JointReactions
     singular_rows : tuple of int
         Rows of the 6p-vectors where M̄ is zero (no inertia); see the module docstring.
+    planar_moments : tuple of str
+        The components of g that are moments across the plane at the joint of a body with a
+        planar inertia (:func:`jourdain.model.bodies.planar_inertia`): not physical, they are
+        those of a body without products of inertia about its axis, which the model does not
+        know (:mod:`jourdain.stages.planar`).
     orthogonality : tuple of (joint name, "symbolic" | "numeric")
         How ``J̄ᵀ·Q̄ = 0`` was verified for each joint's directions (:func:`check_joints`); the
         assembled matrices are checked by
@@ -65,6 +71,7 @@ class Reactions:
     joints: tuple[JointReactions, ...]
     singular_rows: tuple[int, ...]
     orthogonality: tuple[tuple[str, str], ...] = ()
+    planar_moments: tuple[str, ...] = ()
 
     @property
     def system(self) -> System:
@@ -251,4 +258,5 @@ def reactions(ne: NewtonEuler) -> Reactions:
         q_hat=SymMatrix.column([se.Add(*t) if t else ZERO for t in qh]),
         g_names=tuple(names), joints=tuple(joints), singular_rows=singular,
         orthogonality=tuple(verified.items()),
+        planar_moments=planar_moments(system, tuple(joints), names),
     )
