@@ -23,7 +23,9 @@ on each wheel along the heading follows from its spin, ``Jw·θ̈_i = τ_i − r
 the heading the two wheels' rows coincide (a rigid axle), so only the sum is determined: the
 chassis and wheels' lateral momentum, ``F_L + F_R = (mc + 2mw)·v·w + mc·b·ẇ``. In a steady
 turn (free wheels, b = 0: ``v̇ = ẇ = 0``) that is the centripetal force ``m_0·v·w``
-(``m_0 = mc + 2mw``) and A runs on a circle of radius ``v/w``.
+(``m_0 = mc + 2mw``) and A runs on a circle of radius ``v/w``. Linearized about straight
+running at v, ``ẇ = −mc·b·v·w/I``: the heading is stable with the centre of mass ahead of the
+axle and unstable behind it.
 
 Tolerances (tests/tolerance.py): jourdain's ż comes from solves with W = [Y; A] (L and γ)
 and M; the closed forms divide by m and I only. The bound is ``Σ c·n·cond·eps·scale`` over
@@ -39,7 +41,7 @@ import pytest
 
 from jourdain.models.wheeled import differential_drive, skate_on_incline
 from jourdain.numeric import evaluate as tree_evaluate
-from tests.tolerance import EPS, cond, norm, solve_scale, solve_tol
+from tests.tolerance import EPS, cond, norm, solve_scale, solve_tol, state_space_eig_tol
 
 N_STATES = 10
 
@@ -247,3 +249,40 @@ def test_skate_drifts_across_the_slope() -> None:
     assert np.max(np.abs(res.y[:, 0] - x)) <= 1e-8 * scale
     assert np.max(np.abs(res.y[:, 1] - y)) <= 1e-8 * scale
     assert np.max(np.abs(res.y[:, 2] - w * t)) <= 1e-8
+
+
+@pytest.mark.parametrize("b", [0.1, -0.1])
+def test_straight_running_linearized(wheel_speeds, b: float) -> None:
+    """Straight running at speed v (wheel speeds; x, y, ψ cyclic): from the closed form,
+    ``ẇ = −mc·b·v·w/I`` to first order and ``v̇ = 0``, so with ``w = r·(θ̇_R − θ̇_L)/(2d)``
+    ``θ̈_L = −θ̈_R = mc·b·v/(2I)·(θ̇_R − θ̇_L)``: eigenvalues 0, 0, 0 and ``−mc·b·v/I``, the
+    centre of mass ahead of the axle (b > 0) keeps the cart on its heading, behind it (b < 0)
+    it turns away."""
+    s = wheel_speeds
+    p = dict(s.parameter_values, b=b)
+    v = 1.5
+    lin = s.linearize({"x_d": v, "thetaL_d": v / p["r"], "thetaR_d": v / p["r"]}).at({"b": b})
+    assert lin.names == ("thetaL", "thetaR") and set(lin.cyclic) == {"x", "y", "psi"}
+    inertia = (p["Ic"] + p["mc"] * b ** 2 + 2 * p["mw"] * p["d"] ** 2 + 2 * p["Iw"]
+               + 2 * p["Jw"] * p["d"] ** 2 / p["r"] ** 2)
+    c = p["mc"] * b * v / (2 * inertia)
+    ref = np.zeros((4, 4))
+    ref[0, 2] = ref[1, 3] = 1.0
+    ref[2:, 2:] = [[-c, c], [c, -c]]
+    # P = ∂k/∂z sums Coriolis-like terms of the size of M̃'s terms times the rates: the
+    # scale of the summed terms is max(|L|ᵀ|M_tree||L|)·‖z‖ at the nominal state; A's lower
+    # block −M̃⁻¹·P comes from solves with M̃ and W (L, γ)
+    y0 = np.zeros(5)
+    out = s.evaluate(y0, [v, 0.0, 0.0, v / p["r"], v / p["r"]], parameters=p)
+    Mt = np.asarray(tree_evaluate(s.tree, out["y"], out["yd"], 0.0, p)["M"], dtype=float)
+    aL = np.abs(out["L"])
+    terms = float(np.max(aL.T @ np.abs(Mt) @ aL)) * norm(out["z"])
+    M_t = np.atleast_2d(lin.M_tilde)
+    W = np.vstack([np.eye(5)[3:], _rows(out)])
+    scale = solve_scale(M_t, lin.A[2:], (lin.P, [terms]))
+    tol = solve_tol(M_t, scale) + 2 * solve_tol(W, scale)
+    assert np.max(np.abs(lin.A - ref)) <= tol, (lin.A, ref, tol)
+    lam, tol_lam = state_space_eig_tol(lin)
+    ref_lam = np.sort(np.array([-2 * c, 0.0, 0.0, 0.0]))
+    assert np.all(np.abs(np.sort(lam.real) - ref_lam) <= tol_lam + tol), (lam, ref_lam)
+    assert np.all(lam.imag == 0.0)
