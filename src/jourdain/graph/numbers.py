@@ -125,6 +125,11 @@ _DFLOAT = {
 }
 
 
+def _describer(node: Expr) -> Callable[[], str]:
+    """A function naming the piecewise ``node`` for a message (made only when needed)."""
+    return lambda: describe(type(node).__name__, node.args)
+
+
 @dataclass(frozen=True)
 class FloatJet:
     """Result of :func:`jet_float`: ``values`` (n,), ``jacobian`` (n, number of variables), and
@@ -206,9 +211,8 @@ def _jet_float(g: Graph, variables: Sequence[se.Symbol], values: Mapping[str, fl
             if name in _DFLOAT:
                 coeffs = [_DFLOAT[name](vals, value[k])]
             elif name in PIECEWISE:  # the branch at the point; refused at the switch
-                coeffs = float_partials(name, vals, [x is not None for x in grads],
-                                        lambda node=node: describe(type(node).__name__,
-                                                                   node.args))
+                what = _describer(node)
+                coeffs = float_partials(name, vals, [x is not None for x in grads], what)
             elif name == "atan2":
                 yy, xx = vals
                 r2 = xx * xx + yy * yy

@@ -39,9 +39,10 @@ def check_planar(kin: Kinematics) -> None:
     three random states, times and inputs (the parameters at their values)."""
     system = kin.system
     for body, bk in zip(system.bodies, kin.bodies, strict=True):
-        if getattr(body, "planar", None) is None:
+        axis = getattr(body, "planar", None)
+        if axis is None:
             continue
-        a = "xyz".index(body.planar)
+        a = "xyz".index(axis)
         across = [i for i in range(3) if i != a]
         exprs = [e for i in across for e in (*bk.J_R.rows[i], bk.omega_bar.rows[i][0])]
         exprs = [e for e in exprs if not (e.is_Number and e == 0)]
