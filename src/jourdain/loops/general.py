@@ -336,14 +336,30 @@ class GeneralEvaluator:
 
     def multipliers(self, s: dict[str, Any]) -> np.ndarray:
         """The rows' multipliers λ (contact forces along the rows' directions) from
-        ``M_tree·ÿ + k_tree − q_tree = Aᵀλ`` (rows dropped by the rank test get 0)."""
-        rows = list(self.choice.rows_v)
-        res = s["M_tree"] @ s["ydd"] + s["k_tree"] - s["q_tree"]
-        A = s["fn"]["A"][rows, :].T
-        lam_r = np.linalg.lstsq(np.real(A), np.real(res), rcond=None)[0]
-        lam = np.zeros(len(self.labels))
-        lam[rows] = lam_r
-        return lam
+        ``M_tree·ÿ + k_tree − q_tree = Aᵀλ``: the least-norm solution over all rows, so that
+        redundant rows (two wheels on one axle, both held sideways) share their force
+        evenly whatever the heading; :meth:`undetermined` names the rows whose share is
+        not fixed by the equations (statically indeterminate)."""
+        res = np.real(s["M_tree"] @ s["ydd"] + s["k_tree"] - s["q_tree"])
+        A = np.real(s["fn"]["A"])
+        if not A.size:
+            return np.zeros(0)
+        U, sv, Vt = np.linalg.svd(A.T, full_matrices=False)
+        rank = len(self.choice.rows_v)
+        inv = np.zeros_like(sv)
+        inv[:rank] = 1.0 / sv[:rank]
+        self._null = Vt[rank:]
+        return Vt.T @ (inv * (U.T @ res))
+
+    def undetermined(self) -> list[str]:
+        """Labels of the rows whose multipliers the equations leave open (they lie on a
+        redundant combination of rows; only their sum along it is the force), after
+        :meth:`multipliers`."""
+        null = getattr(self, "_null", np.zeros((0, len(self.labels))))
+        if not null.size:
+            return []
+        weight = np.sqrt(np.sum(null * null, axis=0))
+        return [lab for lab, w in zip(self.labels, weight, strict=True) if w > math.sqrt(EPS)]
 
     def initial(self, y0: Any, yd0: Any, t: float) -> np.ndarray:
         """The state x from approximate coordinates ``y0`` (independent ones held) and rates

@@ -34,7 +34,8 @@ def evaluate_general(system: System, y: Any, yd: Any = None, t: float = 0.0,
                      inputs: Sequence[float] | None = None) -> dict[str, Any]:
     """The numbers at a state of the general ``system`` (see the module docstring): keys
     ``y, yd, z, zd, ydd, speeds, independent, L, l, M, k, q, M_bar, J_bar, Q_c, labels,
-    contact_forces`` (by label), ``lambda``, ``Phi`` (holonomic rows), ``Phi_dot`` (every
+    contact_forces`` (by label; ``contacts_undetermined``: the rows whose share the equations
+    leave open, redundant rows sharing their force evenly), ``lambda``, ``Phi`` (holonomic rows), ``Phi_dot`` (every
     row's ``A·ẏ + a``), ``orthogonality`` (the largest entry of ``L̄ᵀ·Q̄_c``)."""
     if inputs is not None and len(inputs):
         raise EvaluationError(f"{system.name}: inputs are not available for systems with "
@@ -57,6 +58,7 @@ def evaluate_general(system: System, y: Any, yd: Any = None, t: float = 0.0,
         M_bar=tree["M_bar"], J_bar=J_bar, J_bar_tree=tree["J_bar"], Q_c=Q_c,
         labels=list(ev.labels), **{"lambda": lam},
         contact_forces=dict(zip(ev.labels, (float(v) for v in lam), strict=True)),
+        contacts_undetermined=ev.undetermined(),
         Phi=fn["Phi"].reshape(-1), Phi_dot=fn["A"] @ s["yd"] + fn["a"][:, 0],
         orthogonality=float(np.max(np.abs(J_bar.T @ Q_c), initial=0.0)))
     return out
