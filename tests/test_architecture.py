@@ -34,8 +34,10 @@ import jourdain
 ROOT = Path(jourdain.__file__).parent
 MAX_LINES = 400
 
-# What the model layer may import from the package: itself and the errors (jourdain.errors).
-MODEL_MAY_IMPORT = ("jourdain.model", "jourdain.errors")
+# What the model layer may import from the package: itself, the errors (jourdain.errors) and
+# the expression language that reads its strings (jourdain.io.expressions, which imports only
+# the errors; Body(mass="m") is read as a model file's mass is).
+MODEL_MAY_IMPORT = ("jourdain.model", "jourdain.errors", "jourdain.io.expressions")
 
 # The floors, lowest first (docs/architecture.md has the same table). A module belongs to the
 # floor of the longest prefix listed; a module may import from its own floor or any floor below.
@@ -44,8 +46,10 @@ FLOORS: tuple[tuple[str, ...], ...] = (
     #   differentiation) and identity maps
     ("jourdain.errors", "jourdain.version", "jourdain.identity", "jourdain.symbolic", "jourdain.graph",
      "jourdain.extras"),
-    # 1 the model: the description a user writes (pure, immutable data), and its units
-    ("jourdain.model", "jourdain.units"),
+    # 1 the model: the description a user writes (pure, immutable data), its units, and the
+    #   expression language that reads its strings (model files and the Python API alike;
+    #   it imports only jourdain.errors, though its package sits in jourdain.io)
+    ("jourdain.model", "jourdain.units", "jourdain.io.expressions"),
     # 2 the stages of the method: kinematics → Newton–Euler → projection → reactions →
     #   linearization, and what they share (kinematic measures)
     ("jourdain.measures", "jourdain.stages"),

@@ -93,7 +93,10 @@ CASES = [
     ("parameter NaN", lambda: make(params={**P, "m": float("nan")}), 'parameter "m": value nan is not finite'),
     ("name declared twice", lambda: make(params={**P, "phi": 1.0}), 'name "phi" is declared twice'),
     ("reserved name", lambda: make(params={**P, "t": 1.0}), 'parameter name "t" is reserved'),
-    ("string as mass", lambda: pendulum(mass="m*2"), 'body "bob" mass: expected a number or a SymPy/SymEngine expression'),
+    ("string as mass outside the language", lambda: pendulum(mass="m**2 if m else 0"),
+     'body "bob" mass: \'m**2 if m else 0\': unexpected'),
+    ("a list as mass", lambda: pendulum(mass=[1]), 'body "bob" mass: expected a number, a '
+     "SymPy/SymEngine expression or a string of the expression language"),
     ("generalized force on non-step coordinate", lambda: make(
         [pendulum(joint=jd.General("pivot", [jd.Rot("z", 2 * phi)], coordinates=[phi]))],
         forces=[jd.GeneralizedForce("drive", phi, 1.0)]).equations_of_motion(),

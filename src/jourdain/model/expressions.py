@@ -1,8 +1,10 @@
-"""Conversion of user input (numbers, SymPy or SymEngine expressions) into SymEngine expressions.
+"""Conversion of user input (numbers, SymPy or SymEngine expressions, strings) into SymEngine
+expressions.
 
-Strings are *not* accepted here: model files go through jourdain's own restricted parser
-(:mod:`jourdain.io`), and Python users build expressions from symbols, so nothing is ever
-parsed or evaluated as code.
+Strings (``Body(mass="m")``, ``com=(0, "-l/2", 0)``) are read by the same restricted parser as
+model files (:mod:`jourdain.io.expressions`: its grammar and whitelist of functions, never
+``eval`` or ``sympify``), so nothing is ever evaluated as code; their names become symbols,
+which the :class:`~jourdain.model.System` checks against its declarations like any other.
 """
 
 from __future__ import annotations
@@ -102,12 +104,15 @@ def _range(part: str) -> list[str]:
 
 
 def as_expr(value: object, where: str) -> Expr:
-    """Convert a number or a SymPy/SymEngine expression to a SymEngine expression.
+    """Convert a number, a SymPy/SymEngine expression or a string of the expression language
+    (:mod:`jourdain.io.expressions`, the model files' safe parser) to a SymEngine expression.
 
     ``where`` names the model element for the error message.
     """
     if isinstance(value, se.Basic):
         return finite_constants(value, where)
+    if isinstance(value, str):
+        return parse_text(value, where)
     if isinstance(value, bool):
         raise ModelError(f"{where}: expected a number or an expression, got a bool {value!r}")
     if isinstance(value, numbers.Integral):
@@ -126,9 +131,24 @@ def as_expr(value: object, where: str) -> Expr:
             raise ModelError(f"{where}: cannot convert {value!r} to SymEngine: {exc}") from exc
         return finite_constants(converted, where)
     raise ModelError(
-        f"{where}: expected a number or a SymPy/SymEngine expression, got {type(value).__name__} "
-        f"{value!r}"
+        f"{where}: expected a number, a SymPy/SymEngine expression or a string of the "
+        f"expression language, got {type(value).__name__} {value!r}"
     )
+
+
+def parse_text(text: str, where: str) -> Expr:
+    """``text`` read by the model files' expression parser (any declared-looking name becomes
+    a symbol; the System checks them); a :class:`ModelError` naming ``where`` and the column
+    otherwise."""
+    # the language is on this floor (it imports only jourdain.errors), but its package sits
+    # in jourdain.io, whose __init__ imports the model: imported when a string is first read
+    from ..io.expressions import ExpressionError, parse_expression
+
+    try:
+        return finite_constants(parse_expression(text), where)
+    except ExpressionError as exc:
+        column = f" (column {exc.column})" if exc.column else ""
+        raise ModelError(f"{where}: {text!r}: {exc}{column}") from None
 
 
 #: the magnitudes a parameter may have besides 0: the equations multiply parameters with each
