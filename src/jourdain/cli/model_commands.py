@@ -11,6 +11,7 @@ from ..analysis.reactions import check_reactions
 from ..errors import JourdainError
 from ..io import export
 from ..workflow import check_initial_state, eom_matrices, has_capability, summary
+from . import general
 from .arguments import load
 
 EXIT_OK = 0

@@ -21,6 +21,7 @@ from ..workflow import (
     reactions_at,
     require,
 )
+from . import general
 from .arguments import UsageError, load, overrides, period, state_at, suggest
 
 EXIT_OK = 0

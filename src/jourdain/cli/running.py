@@ -16,6 +16,7 @@ from ..io.report.figures import prepare_worker
 from ..io.workers import fork_workers, stop_workers
 from ..simulation.simulate import OUTPUT_SUFFIXES
 from ..workflow import require
+from . import general
 from .arguments import UsageError, load, overrides, sim_options
 from .outputs import output_file, output_folder, progress_printer, samples
 

@@ -49,7 +49,7 @@ def summary(model: Any) -> dict[str, Any]:
         "quantities": [{"name": q.name, "type": q.kind, "symbols": list(q.symbol_names),
                         "definition": q.describe()} for q in system.quantities],
         "nominal_motions": [n.name for n in model.nominal],
-        "cyclic_coordinates": [] if system.closing else list(cyclic(system)),
+        "cyclic_coordinates": [] if system.is_closed else list(cyclic(system)),
     }
 
 
