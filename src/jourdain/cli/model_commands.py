@@ -28,6 +28,8 @@ def cmd_check(args: argparse.Namespace) -> int:
             raise model.error(str(exc)) from None
     check_initial_state(model)
     s = summary(model)
+    if model.system.is_general:  # velocity constraints: the contacts, rows and speeds
+        s["contacts"] = general.check_lines(model)
     loops = model.system if model.system.closing else None
     if loops is not None:  # closing joints (jourdain.loops): the loops and their mobility
         # jourdain.loops brings SciPy's linear algebra (0.2 s): imported for loop models only
@@ -64,6 +66,8 @@ def cmd_check(args: argparse.Namespace) -> int:
     if loops is not None:
         for line in check_lines(s["loops"]):
             print(line)
+    if "contacts" in s:
+        general.print_check(s["contacts"])
     return EXIT_OK
 
 
@@ -116,6 +120,9 @@ def closure_independent(system: Any) -> list[str]:
 def cmd_eom(args: argparse.Namespace) -> int:
     model = load(args.model)
     system = model.system
+    if system.is_general:  # M, k, q in z exist in numbers only: jourdain eval
+        general.refuse(system, "eom (the equations in the speeds z exist in numbers only, "
+                       "ẏ = L·z + l at a state: jourdain eval gives M, k, q, L there)")
     mats = eom_matrices(system)
     closed = bool(system.closing)
     # the expressions are in the tree's coordinates, rates and parameters

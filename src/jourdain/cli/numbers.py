@@ -30,6 +30,8 @@ EXIT_OK = 0
 def cmd_eval(args: argparse.Namespace) -> int:
     model = load(args.model)
     system = model.system
+    if system.is_general:  # velocity constraints: the numbers in the speeds z
+        return general.cmd_eval(model, args)
     params = overrides(system, args.set)
     y, yd, t, inputs = state_at(model, args.at)
     values, extra, missing = evaluate_all(model, y, yd, t, params, inputs)
@@ -94,6 +96,8 @@ def wrench_text(system: Any, wrenches: dict[str, Any]) -> str:
 def cmd_reactions(args: argparse.Namespace) -> int:
     model = load(args.model)
     system = model.system
+    if system.is_general:  # the contact forces, by element
+        return general.cmd_reactions(model, args)
     params = overrides(system, args.set)
     y, yd, t, inputs = state_at(model, args.at)
     values = reactions_at(system, y, yd, t, params, inputs)
@@ -168,6 +172,8 @@ def display_scales(values: dict[str, np.ndarray]) -> dict[str, Any]:
 def cmd_linearize(args: argparse.Namespace) -> int:
     model = load(args.model)
     system = model.system
+    if system.is_general:  # about the file's steady motion, by the complex step
+        return general.cmd_linearize(model, args)
     require(system, "linearize", "the linearization")
 
     if args.about is not None and args.about not in [n.name for n in model.nominal]:

@@ -26,6 +26,8 @@ EXIT_OK, EXIT_MODEL, EXIT_INTERRUPTED = 0, 1, 130
 def cmd_simulate(args: argparse.Namespace) -> int:
     model = load(args.model)
     system = model.system
+    if system.is_general:  # in the state (y_i, z)
+        return general.cmd_simulate(model, args)
     require(system, "simulate", "simulation")
 
     # every option and the output file are checked before the work
