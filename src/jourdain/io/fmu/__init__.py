@@ -149,6 +149,10 @@ def export_fmu(model: Any, path: str | os.PathLike[str], *,
     """
 
     system, mf = _model_of(model)
+    if getattr(system, "is_general", False):  # never the open tree's FMU in its place
+        raise ClosedSystemError(system, "the FMU of a system with velocity constraints is not "
+                                "available yet", "simulate it with jourdain simulate or "
+                                "system.simulate")
     closed = bool(getattr(system, "closing", ()))
     if closed and reactions is not None and (isinstance(reactions, str) or list(reactions)):
         raise ClosedSystemError(system, "the FMU of a closed system gives no reaction "
