@@ -187,6 +187,9 @@ def _closed(ctx: Context, about: str | None) -> None:
 
     system = ctx.system
     ctx.closed = True
+    if system.is_general:  # velocity constraints: η and its cyclic ones from the nominal
+        _general(ctx, about)
+        return
     # the partition at the initial configuration: the linearization's coordinates
     ev = LoopEvaluator(system, ctx.y0, 0.0, None)
     ctx.independent = tuple(ev.independent_names)
@@ -202,6 +205,44 @@ def _closed(ctx: Context, about: str | None) -> None:
                                     "about a state (numbers in the parameters)",
                                     f'use about = "{EQUILIBRIUM}" or a constant state')
         ctx.nominal_state = se.Lambdify(list(system.parameter_symbols), exprs, real=True)
+
+
+def _general(ctx: Context, about: str | None) -> None:
+    """A general system's context (velocity constraints): linearized per case about the
+    model's steady motion (numbers in the parameters) by
+    :func:`jourdain.loops.general_linear.linearize_general`; η, its cyclic coordinates
+    and the nominal state's expressions from the linearization at the default parameters."""
+    import symengine as se
+
+    from ..errors import ClosedSystemError
+    from ..loops.general_linear import linearize_general
+
+    system = ctx.system
+    if about is None:
+        return
+    if about == EQUILIBRIUM:
+        raise ClosedSystemError(system, "a study of a system with velocity constraints is "
+                                "linearized about the model's steady motion",
+                                "give about = \"<nominal name>\"")
+    nominal = ctx.model.nominal_motion(about)
+    exprs = [*nominal.y, *nominal.yd]
+    if any(se.Symbol("t") in se.sympify(e).free_symbols for e in exprs) or nominal.inputs:
+        raise ClosedSystemError(system, f'the nominal motion "{about}" depends on t or has '
+                                "nominal inputs: a general system's study is linearized about "
+                                "a steady state (numbers in the parameters)")
+    ctx.nominal_state = se.Lambdify(list(system.parameter_symbols), exprs, real=True)
+    v = np.asarray(ctx.nominal_state(ctx.p0), dtype=float).reshape(-1)
+    lin = linearize_general(system, _state_mapping(system, v))
+    ctx.independent = tuple(lin.names)
+    ctx.cyclic = tuple(lin.cyclic_in_eta)
+
+
+def _state_mapping(system: Any, v: np.ndarray) -> dict[str, float]:
+    """The nominal state ``v = (y, ẏ)`` as ``{coordinate: value, "<coordinate>_d": rate}``."""
+    f = system.f
+    coords = system.coordinate_names
+    return {**dict(zip(coords, v[:f].tolist(), strict=True)),
+            **{f"{c}_d": x for c, x in zip(coords, v[f:].tolist(), strict=True)}}
 
 
 def _ensemble(ctx: Context) -> Any:

@@ -55,6 +55,7 @@ def closed_linearizations(ctx: Context, P: np.ndarray, Y: np.ndarray | None = No
     ``Q`` (n, f, f) and the state matrix ``A`` (n, 2f, 2f) in the independent coordinates,
     ``y_s`` (n, tree coordinates: the configuration linearized about) and ``errors`` (row ->
     message; those rows NaN)."""
+    from ..loops.general_linear import linearize_general
     from ..loops.linearization import equilibrium
     from ..loops.nominal import linearize_state
     from .context import FAILURES
@@ -76,7 +77,10 @@ def closed_linearizations(ctx: Context, P: np.ndarray, Y: np.ndarray | None = No
                 v = np.asarray(ctx.nominal_state(P[i]), dtype=float).reshape(-1)
                 nominal = {**dict(zip(coords, v[:ft].tolist(), strict=True)),
                            **{f"{c}_d": x for c, x in zip(coords, v[ft:].tolist(), strict=True)}}
-            lin = linearize_state(ctx.system, nominal, parameters=params)
+            if ctx.system.is_general:  # velocity constraints, about the steady motion
+                lin = linearize_general(ctx.system, nominal, params)
+            else:
+                lin = linearize_state(ctx.system, nominal, parameters=params)
             if lin.A.shape != (2 * f, 2 * f):
                 raise ValueError(f"the linearization has {lin.A.shape[0] // 2} independent "
                                  f"coordinates ({', '.join(lin.names)}), the study's "
