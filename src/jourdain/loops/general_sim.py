@@ -41,14 +41,18 @@ def simulate_general(system: System, t_span: tuple[float, float], y0: Any, yd0: 
     dependent ones solved) with the speeds taken from ``yd0`` over ``t_span``; returns
     :class:`jourdain.Results` with the tree's ``y, yd, ydd`` and, in ``constraints``, the
     rows' residuals (``Phi``: holonomic rows, ``Phi_dot``: every row's ``A·ẏ + a``) and
-    multipliers (the contact forces along the rows' directions)."""
+    multipliers (the contact forces along the rows' directions). Options: ``progress`` (a
+    callable ``progress(t, t_end)`` after each step), ``output`` (a results file, written at
+    the end or with the motion so far when interrupted)."""
     from ..simulation.results import Results
     from ..simulation.results.data import ConstraintHistories
 
     if inputs:
         raise EvaluationError(f"{system.name}: inputs are not available for systems with "
                               "velocity constraints yet")
-    unknown = sorted(set(options) - {"progress"})
+    progress = options.pop("progress", None)
+    output = options.pop("output", None)
+    unknown = sorted(set(options))
     if unknown:
         raise EvaluationError(f"simulate: unknown option(s) {', '.join(unknown)} for a system "
                               "with velocity constraints")
@@ -78,6 +82,8 @@ def simulate_general(system: System, t_span: tuple[float, float], y0: Any, yd0: 
             if solver.status == "failed":
                 status, message = "failed", f"the integrator failed at t = {solver.t:.6g}: {msg}"
                 break
+            if callable(progress):
+                progress(float(solver.t), t1)
             if te is None:
                 ts.append(solver.t)
                 xs.append(solver.y.copy())
@@ -102,6 +108,8 @@ def simulate_general(system: System, t_span: tuple[float, float], y0: Any, yd0: 
                   rtol=rtol, atol=atol, status=status, message=message, nfev=solver.nfev,
                   nsteps=len(ts), n_accepted=len(ts), n_rejected=0,
                   wall_time=time.perf_counter() - start, constraints=cons)
+    if output is not None:  # at the end, or with the motion so far when interrupted
+        res.save(output)
     return res
 
 

@@ -151,13 +151,15 @@ def simulate(system: System, t_span: tuple[float, float], y0: Any, yd0: Any,
     if getattr(system, "is_general", False):  # velocity constraints (METHOD §7)
         from ..loops.general_sim import simulate_general
 
-        if events or output is not None or first_step is not None or closed_options:
-            raise EvaluationError(f"{system.name}: events, output files, first_step and the "
-                                  "closed-loop options are not available for systems with "
-                                  "velocity constraints yet")
+        if events or first_step is not None or closed_options:
+            raise EvaluationError(f"{system.name}: events, first_step and the closed-loop "
+                                  "options are not available for systems with velocity "
+                                  "constraints yet")
         return simulate_general(system, t_span, y0, yd0, parameters=parameters,
                                 inputs=inputs, method=method, rtol=rtol, atol=atol,
-                                t_eval=t_eval, max_step=max_step)
+                                t_eval=t_eval, max_step=max_step,
+                                progress=progress if callable(progress) else None,
+                                output=output)
     if system.closing:  # a closed system moves on its constraint manifold (METHOD §7)
         from ..loops.simulate import simulate_closed
 
