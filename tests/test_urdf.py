@@ -146,8 +146,8 @@ LINK_C = """<link name="c"><inertial><mass value="1"/>
 
 @pytest.mark.parametrize("extra, match, line", [
     (LINK_C + '<joint name="j2" type="prismatic"><parent link="b"/><child link="c"/>'
-     '<axis xyz="1 0 0"/><mimic joint="j1" multiplier="2"/></joint>',
-     r'joint "j2": mimic joints \(coupled to joint "j1"\) are not supported', 10),
+     '<axis xyz="1 0 0"/><mimic joint="ghost" multiplier="2"/></joint>',
+     r'joint "j2": it mimics joint "ghost", which is not declared', 10),
     (LINK_C + '<joint name="j2" type="revolute"><parent link="b"/><child link="c"/></joint>'
      '<joint name="j3" type="revolute"><parent link="a"/><child link="c"/></joint>',
      r'joint "j3": link "c" is already the child of joint "j2"; .* closes a kinematic loop', 10),

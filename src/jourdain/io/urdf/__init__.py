@@ -39,9 +39,13 @@ A model built from a file is kept in the compile cache under a hash of the file'
 options and jourdain's source (:mod:`~jourdain.io.urdf.cache`): read again, it comes from there
 without importing yourdfpy.
 
-Not supported, each a :class:`UrdfError` naming the link or joint and the file: ``mimic``
-joints (unless ``mimic="independent"``, which makes them ordinary joints as Pinocchio does by
-default), closed loops (a link that is the child of two joints, ``<loop_joint>`` extensions),
+Mimic joints (``<mimic joint="d" multiplier="k" offset="o"/>``) are coupled: the joint turns
+(slides) by ``k·q_d + o``, a function of the coordinate of joint d, which both share
+(``mimic="coupled"``, the default; as Pinocchio's ``buildModelFromUrdf(..., mimic=True)``);
+``mimic="independent"`` makes them ordinary joints with their own coordinates (Pinocchio's
+default), ``mimic="error"`` refuses them. A mimic joint has no actuator of its own.
+
+Not supported, each a :class:`UrdfError` naming the link or joint and the file: closed loops (a link that is the child of two joints, ``<loop_joint>`` extensions),
 a joint whose parent or child link is not declared, several root links, a moving body with no
 mass anywhere below it (M would be singular), malformed XML, DTDs (entity declarations).
 """
@@ -72,7 +76,7 @@ __all__ = ["UrdfError", "UrdfGeometry", "UrdfJoint", "UrdfLink", "UrdfModel", "l
 
 
 def load_urdf(path: str | Path, *, floating_base: bool = False, gravity: float = 9.81,
-              mimic: str = "error", joint_damping: bool = False,
+              mimic: str = "coupled", joint_damping: bool = False,
               actuated: bool = True) -> UrdfModel:
     """Read a URDF file into a jourdain model (see the module docstring for the mapping).
 
@@ -82,9 +86,10 @@ def load_urdf(path: str | Path, *, floating_base: bool = False, gravity: float =
     floating_base : hang the root link from the world by a free joint (6 coordinates
         :data:`ROOT_COORDINATES`) instead of fixing it
     gravity : default value of the parameter ``g``, gravity along −z (m/s²)
-    mimic : ``"error"`` (a ``<mimic>`` joint is refused, naming it) or ``"independent"`` (a
-        mimic joint is an ordinary joint with its own coordinate, as Pinocchio's
-        ``buildModelFromUrdf`` does unless asked otherwise; the coupling is kept as data)
+    mimic : ``"coupled"`` (a ``<mimic>`` joint follows the coordinate of the joint it mimics,
+        ``k·q_d + o``: one coordinate for both), ``"independent"`` (an ordinary joint with its
+        own coordinate, as Pinocchio's ``buildModelFromUrdf`` does unless asked otherwise; the
+        coupling is kept as data) or ``"error"`` (refused, naming it)
     joint_damping : apply each joint's ``<dynamics damping>`` as a viscous generalized force
         ``−damping·ẏ`` (default: kept as data only, as Pinocchio)
     actuated : an input ``tau_<joint>`` on every revolute, continuous and prismatic joint
@@ -102,8 +107,9 @@ def load_urdf(path: str | Path, *, floating_base: bool = False, gravity: float =
         joint (a :class:`~jourdain.ModelError`).
     """
     name = str(path)
-    if mimic not in ("error", "independent"):
-        raise ModelError(f'load_urdf: mimic must be "error" or "independent", got {mimic!r}')
+    if mimic not in ("coupled", "error", "independent"):
+        raise ModelError('load_urdf: mimic must be "coupled", "independent" or "error", got '
+                         f"{mimic!r}")
     g_value = _float(gravity, "load_urdf: gravity", name, None)
     if g_value is None:
         raise ModelError("load_urdf: gravity must be a number, got None")

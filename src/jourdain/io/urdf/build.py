@@ -16,12 +16,15 @@ from ...errors import ModelError
 from ...model import (
     Body,
     Free,
+    General,
     GeneralizedForce,
     Gravity,
     Planar,
     Prismatic,
     Revolute,
+    Rot,
     RotationalSpringDamper,
+    Trans,
 )
 from ...pipeline import System  # jourdain.System: the model with its stages (issue 16)
 from ..modelfile import (
@@ -79,9 +82,10 @@ def _build(robot: Any, src: _Source, *, floating_base: bool, g: float, mimic: st
                 "loop, which is not supported (jourdain models trees)", path, line)
         if j.mimic is not None and mimic == "error":
             raise UrdfError(
-                f'joint "{j.name}": mimic joints (coupled to joint "{j.mimic.joint}") are not '
-                'supported; load_urdf(..., mimic="independent") reads it as an ordinary joint '
-                "with its own coordinate", path, src.line("mimic", j.name) or line)
+                f'joint "{j.name}": a mimic joint (coupled to joint "{j.mimic.joint}"), refused '
+                'as asked (mimic="error"); load_urdf(..., mimic="coupled") (the default) '
+                "couples it, \"independent\" reads it as an ordinary joint with its own "
+                "coordinate", path, src.line("mimic", j.name) or line)
         parent_joint[j.child] = j
         children[j.parent].append(j)
     roots = [n for n in link_names if n not in parent_joint]
@@ -160,6 +164,18 @@ def _build(robot: Any, src: _Source, *, floating_base: bool, g: float, mimic: st
         ori = None if np.array_equal(R, np.eye(3)) else [[float(x) for x in r] for r in R]
         axis_name = _AXIS_NAMES.get(common["axis"])  # "x", "-y", ... or None
         ax = axis_name or common["axis"]
+        if j.mimic is not None and mimic == "coupled":
+            if j.type not in ("revolute", "continuous", "prismatic"):
+                raise UrdfError(f'joint "{j.name}": a {j.type} joint cannot mimic another (only '
+                                "revolute, continuous and prismatic joints can)", path, jline)
+            # no coordinate of its own: the step follows the mimicked joint's (resolved below,
+            # when every joint has its coordinate)
+            body_spec[cb] = {"parent": b, "joint": None,
+                             "mimic": (j.name, jn, common["mimic"], ax, pos, ori, j.type,
+                                       jline)}
+            info[j.name] = UrdfJoint(**common, body=cb, joint=jn, coordinates=())
+            visit(j.child)
+            continue
         try:
             if j.type in ("revolute", "continuous", "prismatic"):
                 q = jn
@@ -201,6 +217,7 @@ def _build(robot: Any, src: _Source, *, floating_base: bool, g: float, mimic: st
         info[j.name] = UrdfJoint(**common, body=cb, joint=jn, coordinates=qs, input=tau)
         visit(j.child)
 
+    _couple_mimics(body_spec, info, path)
     if not coords:
         raise UrdfError("the robot has no moving joint (every joint is fixed and the base is "
                         "fixed): nothing moves; load it with floating_base=True for a free "
@@ -352,3 +369,26 @@ def _limits(j: Any, path: str, line: int | None) -> dict[str, float | None]:
                           f'joint "{j.name}" <dynamics {key}>', path, line)
     return out
 
+
+def _couple_mimics(body_spec: dict[str, dict], info: dict[str, UrdfJoint], path: str) -> None:
+    """The joints of ``<mimic joint="d" multiplier="k" offset="o">``: one step about (along)
+    their axis by ``k·q_d + o``, with ``q_d`` the coordinate of joint d, which both share (a
+    General joint that drives no coordinate of its own)."""
+    for spec in body_spec.values():
+        if spec.get("joint") is not None or "mimic" not in spec:
+            continue
+        name, jn, (leader, k, o), ax, pos, ori, kind, line = spec["mimic"]
+        target = info.get(leader)
+        if target is None or len(target.coordinates) != 1:
+            why = ("is not declared" if target is None else
+                   "is itself a mimic joint" if target.mimic is not None and not target.coordinates
+                   else "has no single coordinate (fixed, floating or planar)")
+            raise UrdfError(f'joint "{name}": it mimics joint "{leader}", which {why}; a mimic '
+                            "joint follows one revolute, continuous or prismatic joint", path,
+                            line)
+        value = k * se.Symbol(target.coordinates[0]) + o
+        step = Trans(ax, value) if kind == "prismatic" else Rot(ax, value)
+        try:
+            spec["joint"] = General(jn, [step], position=pos, orientation=ori)
+        except ModelError as exc:
+            raise UrdfError(f'joint "{name}": {exc}', path, line) from None
