@@ -18,6 +18,7 @@ from scipy.integrate import BDF, DOP853, LSODA, RK23, RK45, Radau
 from ..errors import EvaluationError, JourdainError
 from ..model import System
 from .general import GeneralEvaluator
+from .results import _work
 
 _METHODS = {"DOP853": DOP853, "RK45": RK45, "RK23": RK23, "Radau": Radau, "BDF": BDF,
             "LSODA": LSODA}
@@ -108,6 +109,8 @@ def simulate_general(system: System, t_span: tuple[float, float], y0: Any, yd0: 
                   rtol=rtol, atol=atol, status=status, message=message, nfev=solver.nfev,
                   nsteps=len(ts), n_accepted=len(ts), n_rejected=0,
                   wall_time=time.perf_counter() - start, constraints=cons)
+    if N > 1:  # W = ∫ẏᵀq dt: the contact forces do no work (Jourdain's principle)
+        res.W = _work(res, system.tree, parameters, None, system)
     if output is not None:  # at the end, or with the motion so far when interrupted
         res.save(output)
     return res

@@ -19,7 +19,7 @@ from ...workflow import has_capability, summary
 from .. import export
 from ..modelfile import ModelFile
 from ..workers import fork_workers, ignore_interrupt
-from . import loops
+from . import loops, rolling
 from .equations import (
     Display,
     cached,
@@ -47,6 +47,13 @@ def compute_sections(run: Run, sections: list[str], display: Future[Display] | N
     symbolic display (section 2) is ``run.display`` (from the cache), else the worker's
     ``display``, else computed here in turn."""
     sections.append(model_section(run))
+    if run.model.system.is_general:  # velocity constraints: numbers in z, steady motions
+        sections.append(rolling.equations_section(run))
+        sections.append(rolling.numbers_section(run))
+        sections.append(rolling.linearization_section(run))
+        sections.append(simulation_section(run))
+        sections.append(rolling.contacts_section(run, run.results))
+        return
     if run.model.system.closing:  # a closed system: its numbers, and the loops' section
         sections.append(loops.equations_section(run))
         sections.append(numbers_section(run))
@@ -117,7 +124,7 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
     display: Future[Display] | None = None
     known: Display | None = None
     try:
-        closed = bool(system.closing)  # no symbolic display of a closed system
+        closed = system.is_closed  # no symbolic display of a closed or general system
         if parallel and closed and pool is None:  # the figures' worker alone
             pool = fork_workers(prepare_worker)
         if parallel and not closed:  # the display from the cache, else from a worker
@@ -137,7 +144,8 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
         # System.evaluate's library compiled in a thread while the summary compiles the
         # integrator's M, k, q: two compilers side by side (robot arm, empty cache: its two
         # libraries 0.53 + 0.73 s one after the other, 0.79 s together)
-        build_eom_soon(system)
+        if not system.is_general:
+            build_eom_soon(system)
         summ = summary(model)  # the symbolic equations and reactions
         values = system.parameter_values
         values.update(parameters or {})
@@ -153,7 +161,7 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
         except KeyboardInterrupt:
             info.status = "interrupted"
             info.message = (f"interrupted by the user (Ctrl-C) after section {len(sections)} "
-                            f"of {SECTIONS + bool(system.closing)}; the sections after it "
+                            f"of {SECTIONS + system.is_closed}; the sections after it "
                             "are missing")
         if display is not None:  # the worker's display, and its files
             try:
@@ -195,7 +203,7 @@ def _page(run: Run, sections: list[str], t_start: float) -> str:
     info.files.insert(0, info.html)
     info.files.insert(1, run.out / "run.json")
     files = "".join(f"<li><a href='{esc(f.name)}'>{esc(f.name)}</a></li>" for f in info.files)
-    number = SECTIONS + 1 + bool(model.system.closing)  # after a closed system's "Closed loops"
+    number = SECTIONS + 1 + model.system.is_closed  # after "Closed loops" or "Contacts"
     sections.append(f"<h2>{number}. Files</h2><ul>{files}</ul>")
     body = run.figures.fill("".join(sections))
     if run.display is not None:
