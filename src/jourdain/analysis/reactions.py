@@ -93,6 +93,7 @@ def projected_reactions(lay: ReactionLayout, M_bar: np.ndarray, Q_bar: np.ndarra
     that touch each body (O(p) small products, never a 6p×6p solve); with the Cholesky factor
     C of each block, ``N̂ += (C⁻¹Q̄_b)ᵀ(C⁻¹Q̄_b)``, so N̂ is exactly symmetric.
     """
+    require_finite("in the Newton–Euler equations", M_bar=M_bar, Q_bar=Q_bar, q_c=q_c, q_e=q_e)
     lead = Q_bar.shape[:-2]
     n6, q = Q_bar.shape[-2:]
     p = n6 // 6
@@ -104,6 +105,18 @@ def projected_reactions(lay: ReactionLayout, M_bar: np.ndarray, Q_bar: np.ndarra
         cols = list(lay.touching[i])
         if not cols:
             continue
+        _body_products(M_bar, Q_bar, q_c, q_e, i, cols, singular, (N, kh, qh))
+    return 0.5 * (N + np.swapaxes(N, -1, -2)), kh, qh
+
+
+def _body_products(M_bar: np.ndarray, Q_bar: np.ndarray, q_c: np.ndarray, q_e: np.ndarray,
+                   i: int, cols: list[int], singular: set[int],
+                   out: tuple[np.ndarray, np.ndarray, np.ndarray]) -> None:
+    """Body ``i``'s terms of N̂, k̂, q̂ added to ``out`` (inf where they overflow, without a
+    warning: :func:`require_finite` names them before N̂ is factorized)."""
+    N, kh, qh = out
+    p = Q_bar.shape[-2] // 6
+    with np.errstate(over="ignore", invalid="ignore"):
         for base in (3 * i, 3 * p + 3 * i):
             rows = [base + a for a in range(3) if base + a not in singular]
             if not rows:
@@ -117,7 +130,17 @@ def projected_reactions(lay: ReactionLayout, M_bar: np.ndarray, Q_bar: np.ndarra
             N[..., ix[0], ix[1]] += np.swapaxes(B, -1, -2) @ B
             kh[..., cols] += np.einsum("...rc,...r->...c", B, bc)
             qh[..., cols] += np.einsum("...rc,...r->...c", B, be)
-    return 0.5 * (N + np.swapaxes(N, -1, -2)), kh, qh
+
+
+def require_finite(what: str, **arrays: np.ndarray) -> None:
+    """An :class:`EvaluationError` naming the arrays that hold inf or NaN: checked before
+    every factorization (LAPACK's SVD of a matrix holding inf may loop without end, deaf to
+    Ctrl-C, or fail with a LinAlgError)."""
+    bad = [k for k, v in arrays.items() if not np.isfinite(v).all()]
+    if bad:
+        raise EvaluationError(f"{', '.join(bad)} contain{'s' if len(bad) == 1 else ''} NaN or "
+                              f"inf {what} (numbers beyond the floating-point range: check the "
+                              "magnitudes of the masses, inertias, lengths and forces)")
 
 
 def solve_g(Q_bar: np.ndarray, N_hat: np.ndarray, k_hat: np.ndarray, q_hat: np.ndarray,
@@ -129,7 +152,10 @@ def solve_g(Q_bar: np.ndarray, N_hat: np.ndarray, k_hat: np.ndarray, q_hat: np.n
     Returns ``g`` (NaN where undetermined) and the names of the undetermined components.
     """
     q = N_hat.shape[0]
-    rhs = k_hat - q_hat
+    with np.errstate(over="ignore", invalid="ignore"):
+        rhs = k_hat - q_hat
+    require_finite("in the reaction equations at this state", N_hat=N_hat, k_hat_minus_q_hat=rhs,
+                   Q_bar=Q_bar, q_c=q_c, q_e=q_e)
     s = list(singular_rows)
     if not s:
         try:
@@ -164,6 +190,7 @@ def reactions_along(lay: ReactionLayout, M_bar: np.ndarray, Q_bar: np.ndarray,
     ``Q_bar``, ``q_c``, ``q_e``): one batched solve, or state by state (:func:`solve_g`) where
     bodies without inertia or redundant directions need the bordered system."""
     N, kh, qh = projected_reactions(lay, M_bar, Q_bar, q_c, q_e)
+    require_finite("along the motion", N_hat=N, k_hat=kh, q_hat=qh)
     if not lay.singular_rows:  # N̂ g = k̂ − q̂ for all states in one batched solve
         try:
             return np.linalg.solve(N, (kh - qh)[:, :, None])[:, :, 0]
@@ -194,9 +221,13 @@ def evaluate_reactions(system: System, y: Any, yd: Any, t: float = 0.0,
     Q = np.asarray(eom["Q_bar"])
     qc, qe = np.asarray(eom["q_c"]).reshape(-1), np.asarray(eom["q_e"]).reshape(-1)
     N, kh, qh = projected_reactions(lay, np.asarray(eom["M_bar"]), Q, qc, qe)
-    g, und = solve_g(Q, N, kh, qh, qc, qe, lay.singular_rows, lay.g_names)
-    # NaN marks undetermined components only; anything else not finite is an error
+    # NaN marks undetermined components only; anything else not finite is an error, found
+    # before N̂ is factorized
     bad = [k for k, v in (("N_hat", N), ("k_hat", kh), ("q_hat", qh)) if not np.isfinite(v).all()]
+    if not bad:
+        g, und = solve_g(Q, N, kh, qh, qc, qe, lay.singular_rows, lay.g_names)
+    else:
+        g, und = np.full(len(lay.g_names), np.nan), []
     determined = [i for i, n in enumerate(lay.g_names) if n not in und]
     if not np.isfinite(g[determined]).all():
         bad.append("g")
@@ -261,6 +292,7 @@ def joint_reactions(system: System, joints: str | Sequence[str], y: Any, yd: Any
     args = state_vectors(system, y, yd, t, parameters, inputs)
     info, fn = _joint_function(system, tuple(joints))
     out_ = fn(*args)
+    require_finite("at this state", **{k: np.asarray(v, float) for k, v in out_.items()})
     try:
         ydd = np.linalg.solve(np.atleast_2d(out_["M"]), (out_["q"] - out_["k"]).reshape(-1))
     except np.linalg.LinAlgError:
@@ -270,8 +302,10 @@ def joint_reactions(system: System, joints: str | Sequence[str], y: Any, yd: Any
     for k, (name, suffixes) in enumerate(info):
         if not suffixes:
             continue
-        rhs = out_[f"G0_{k}"].reshape(-1) + out_[f"Gy_{k}"] @ ydd
+        with np.errstate(over="ignore", invalid="ignore"):
+            rhs = out_[f"G0_{k}"].reshape(-1) + out_[f"Gy_{k}"] @ ydd
         EE = out_[f"EE_{k}"]
+        require_finite(f'in the reactions of joint "{name}"', ydd=ydd, rhs=rhs)
         gj, *_ = np.linalg.lstsq(EE, rhs, rcond=None)
         # directions that the others repeat (a rank-deficient Gram matrix) share their force
         _, sv, Vt = np.linalg.svd(EE)

@@ -18,9 +18,11 @@ from __future__ import annotations
 
 import os
 import sys
+import warnings
 from collections.abc import Sequence
+from typing import Any
 
-from ..errors import JourdainError
+from ..errors import JourdainError, shorten_words
 from ..workflow import EVAL_FORMAT, NotAvailable
 from .arguments import UsageError
 from .numbers import reaction_units
@@ -50,25 +52,50 @@ def main(argv: Sequence[str] | None = None) -> int:
             sys.stderr = err
 
 
+#: NumPy's floating-point warnings: the results they concern are checked for inf and NaN, and
+#: such a result is an error that names the quantity; the warning itself says nothing more
+_FLOATING_POINT = r"(overflow|invalid value|divide by zero|underflow) encountered"
+
+
 def _main(argv: Sequence[str] | None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     if args.command is None:
         parser.print_help(sys.stderr)
         return EXIT_USAGE
+    with warnings.catch_warnings():  # restores the filters and showwarning at the end
+        warnings.filterwarnings("ignore", _FLOATING_POINT, RuntimeWarning)
+        warnings.showwarning = _warning_line(args.command)
+        return _run(args)
+
+
+def _warning_line(command: str) -> Any:
+    """``warnings.showwarning`` for the command line: one line, ``jourdain <command>: warning:
+    <message>``, never the Python source file and line that issued it."""
+
+    def show(message: Warning | str, category: type[Warning], filename: str, lineno: int,
+             file: Any = None, line: str | None = None) -> None:
+        text = " ".join(str(message).split())
+        print(f"jourdain {command}: warning: {shorten_words(text)}",
+              file=file or sys.stderr)
+    return show
+
+
+def _run(args: Any) -> int:
     try:
         return int(args.func(args))
     except UsageError as exc:
-        print(f"jourdain {args.command}: usage error: {exc}", file=sys.stderr)
+        print(f"jourdain {args.command}: usage error: {shorten_words(str(exc))}",
+              file=sys.stderr)
         return EXIT_USAGE
     except NotAvailable as exc:
-        print(f"jourdain {args.command}: {exc}", file=sys.stderr)
+        print(f"jourdain {args.command}: {shorten_words(str(exc))}", file=sys.stderr)
         return EXIT_MODEL
     except JourdainError as exc:
         if isinstance(exc.__cause__, KeyboardInterrupt):  # a SciPy method's run, Ctrl-C
             print(f"jourdain {args.command}: interrupted (Ctrl-C): {exc}", file=sys.stderr)
             return EXIT_INTERRUPTED
-        print(f"jourdain {args.command}: error: {exc}", file=sys.stderr)
+        print(f"jourdain {args.command}: error: {shorten_words(str(exc))}", file=sys.stderr)
         return EXIT_MODEL
     except KeyboardInterrupt:
         print(f"jourdain {args.command}: interrupted (Ctrl-C)", file=sys.stderr)

@@ -15,6 +15,7 @@ from ..errors import EvaluationError, ModelError
 from ..io import ExpressionError, load_model, parse_expression, parse_number
 from ..io.urdf import load_urdf
 from ..model.bodies import check_values
+from ..model.expressions import magnitude_problem
 from ..simulation.simulate import check_atol, check_rtol, check_samples, check_t_end
 
 
@@ -67,6 +68,9 @@ def overrides(system: Any, sets: Sequence[str]) -> dict[str, float]:
                 raise UsageError(f'--set: "{name}" is not a parameter of the model; parameters '
                                  f"are {', '.join(params) or '(none)'}")
             out[name] = number(value, f"--set {name}")
+            why = magnitude_problem(out[name])
+            if why:
+                raise ModelError(f'with --set {name}={value}: parameter "{name}": {why}')
     if out:
         # the model's numbers at these values pass the checks made at the file's defaults
 

@@ -35,7 +35,10 @@ def cmd_check(args: argparse.Namespace) -> int:
         # jourdain.loops brings SciPy's linear algebra (0.2 s): imported for loop models only
         from ..loops.report import check_lines, loop_summary
 
-        s["loops"] = loop_summary(model)
+        try:  # the assembly at the initial state, its rank and partition
+            s["loops"] = loop_summary(model)
+        except JourdainError as exc:  # located in the file, as every error of check
+            raise model.error(f"the loops at the initial state: {exc}") from None
     if args.json:
         print(json.dumps(s, indent=2))
         return EXIT_OK
@@ -120,9 +123,8 @@ def closure_independent(system: Any) -> list[str]:
 def cmd_eom(args: argparse.Namespace) -> int:
     model = load(args.model)
     system = model.system
-    if system.is_general:  # M, k, q in z exist in numbers only: jourdain eval
-        general.refuse(system, "eom (the equations in the speeds z exist in numbers only, "
-                       "ẏ = L·z + l at a state: jourdain eval gives M, k, q, L there)")
+    if system.is_general:  # the symbolic rows and the tree's; M, k, q in z in numbers
+        return general.cmd_eom(model, args, _TITLES, _LATEX)
     mats = eom_matrices(system)
     closed = bool(system.closing)
     # the expressions are in the tree's coordinates, rates and parameters

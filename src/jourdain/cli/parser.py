@@ -8,6 +8,7 @@ import sys
 from collections.abc import Callable
 from typing import Any, NoReturn
 
+from ..errors import shorten_words
 from ..io.capabilities import SIM_METHODS
 from ..simulation import simulate as sim
 from ..study.cli import add_study_parser
@@ -26,7 +27,7 @@ class Parser(argparse.ArgumentParser):
 
     def error(self, message: str) -> NoReturn:
         self.print_usage(sys.stderr)
-        self.exit(EXIT_USAGE, f"{self.prog}: usage error: {message}\n")
+        self.exit(EXIT_USAGE, f"{self.prog}: usage error: {shorten_words(message)}\n")
 
 
 def subcommand(subs: Any, name: str, help: str, example: str, func: Callable[..., int]) -> Any:

@@ -33,6 +33,9 @@ def reactions_at(system: Any, y: Any, yd: Any, t: float, parameters: Mapping[str
     """``Q_bar, N_hat, k_hat, q_hat, g`` (and ``g_names``, ``g_undetermined``) at one state."""
     out = system.evaluate(y, yd, t=t, parameters=dict(parameters) or None,
                           inputs=dict(inputs) or None)
+    if "g" not in out:  # the reactions could not be formed (their message says why)
+        raise EvaluationError(f"the reaction forces could not be formed: "
+                              f"{out.get('reactions_error', 'no reaction forces')}")
     keys = ("Q_bar", "N_hat", "k_hat", "q_hat", "g", "g_names", "g_undetermined")
     return {k: out[k] for k in keys if k in out}
 
@@ -56,9 +59,11 @@ def state_nominal(system: Any, y: Any, yd: Any, t: float,
 
 
 def split(P: np.ndarray, Q: np.ndarray) -> dict[str, np.ndarray]:
-    """D, G, K, N: the symmetric and skew-symmetric parts of P and Q (METHOD §6)."""
-    return {"D": 0.5 * (P + P.T), "G": 0.5 * (P - P.T), "K": 0.5 * (Q + Q.T),
-            "N": 0.5 * (Q - Q.T)}
+    """D, G, K, N: the symmetric and skew-symmetric parts of P and Q (METHOD §6); an entry
+    beyond the floating-point range is inf, without a warning (the callers check)."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        return {"D": 0.5 * (P + P.T), "G": 0.5 * (P - P.T), "K": 0.5 * (Q + Q.T),
+                "N": 0.5 * (Q - Q.T)}
 
 
 def linearization_at(model: ModelFile, y: Any, yd: Any, t: float,

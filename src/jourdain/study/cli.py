@@ -60,7 +60,7 @@ def cmd_study(args: argparse.Namespace) -> int:
     spec = load_study(args.spec, model=args.model)
     t0 = time.perf_counter()
     ds = run_study(spec, args.out, workers=args.workers, scheduler=args.scheduler,
-                   quiet=args.quiet, force=args.force, pool=args.pool)
+                   quiet=args.quiet, force=args.force, pool=args.pool, force_name="--force")
     wall = time.perf_counter() - t0
     failed = int(ds.attrs["n_failed"])
     where = f" on {args.scheduler}" if args.scheduler else ""

@@ -102,7 +102,8 @@ def _blocks(spec: StudySpec) -> list[tuple[int, int]]:
 class _Parts:
     """The saved blocks of a study (``<out>.parts/``)."""
 
-    def __init__(self, out: Path, spec: StudySpec, keys: dict[str, str], force: bool) -> None:
+    def __init__(self, out: Path, spec: StudySpec, keys: dict[str, str], force: bool,
+                 force_name: str = "force=True") -> None:
         self.dir = Path(str(out) + ".parts")
         manifest = {"format": _PARTS_FORMAT, "spec_hash": spec.spec_hash,
                     "model_hash": spec.model_hash, "n_cases": spec.n_cases,
@@ -116,8 +117,8 @@ class _Parts:
             if old != manifest:
                 if not force:
                     raise StudyError(f"{self.dir} holds the saved parts of another study (or "
-                                     "another model or jourdain); delete it, or pass force=True "
-                                     "(--force) to start afresh", spec.filename)
+                                     f"another model or jourdain); delete it, or pass "
+                                     f"{force_name} to start afresh", spec.filename)
                 shutil.rmtree(self.dir)
         self.dir.mkdir(parents=True, exist_ok=True)
         if not mfile.exists():
@@ -317,7 +318,8 @@ def _run_dask(spec: StudySpec, todo: list[tuple[int, int]], scheduler: Any,
 
 def run_study(spec: StudySpec, out: str | Path | None = None, *, workers: int | None = None,
               scheduler: Any = None, quiet: bool = False, force: bool = False,
-              pool: str = "auto", on_block: Callable[[dict[str, Any]], None] | None = None) -> Any:
+              pool: str = "auto", on_block: Callable[[dict[str, Any]], None] | None = None,
+              force_name: str = "force=True") -> Any:
     """Run ``spec`` and return its results as an ``xarray.Dataset``
     (:func:`jourdain.study.dataset.to_dataset`).
 
@@ -338,6 +340,7 @@ def run_study(spec: StudySpec, out: str | Path | None = None, *, workers: int | 
     force : start afresh where ``<out>.parts/`` holds another study's parts, and replace an
         existing ``out``
     on_block : called with every block computed in this run (after it was saved)
+    force_name : how the messages name ``force`` (the command line's ``--force``)
 
     Failed cases do not stop the study: their outputs are NaN (verdict −1) and their error is
     in the ``error`` variable.
@@ -347,13 +350,13 @@ def run_study(spec: StudySpec, out: str | Path | None = None, *, workers: int | 
     if out is not None:
         out = Path(out)
         if out.exists() and not force:
-            raise StudyError(f"{out} exists; pass force=True (--force) to replace it",
+            raise StudyError(f"{out} exists; pass {force_name} to replace it",
                              spec.filename)
     ctx = context(spec)  # derives and compiles once here: errors of the model show at once
     keys = dict(ctx.keys)
     layout = output_layout(ctx)
     blocks = _blocks(spec)
-    parts = _Parts(out, spec, keys, force) if out is not None else None
+    parts = _Parts(out, spec, keys, force, force_name) if out is not None else None
     results: dict[int, dict[str, Any]] = {}
     if parts is not None:
         for s, e in blocks:

@@ -33,22 +33,30 @@ def check_initial_state(model: Any) -> None:
         out = system.evaluate(y0, yd0, 0.0, inputs=u or None)
     except JourdainError as exc:
         raise model.error(f"at the initial state: {exc}") from None
-    problem = mass_matrix_problem(system, np.asarray(out["M"], float), values)
+    problem = mass_matrix_problem(system, np.asarray(out["M"], float), values,
+                                  out.get("independent"))
     if problem:
         state = ", ".join(f"{c}={v:g}" for c, v in zip(system.coordinate_names, y0, strict=True))
         raise model.error(f"at the initial state ({state}): {problem}")
 
 
-def mass_matrix_problem(system: Any, M: np.ndarray, values: dict[str, float]) -> str | None:
+def mass_matrix_problem(system: Any, M: np.ndarray, values: dict[str, float],
+                        coordinates: Any = None) -> str | None:
     """Why M is not positive definite (None when it is): the coordinates that move no mass or
     inertia and the massless bodies they move, else the eigenvalues of a singular
-    configuration."""
-    M = 0.5 * (M + M.T)
+    configuration. ``coordinates``: the names of M's rows where they are not the system's
+    coordinates (a closed system's independent ones)."""
+    M = 0.5 * M + 0.5 * M.T  # halves first: entries near 1e308 stay finite
+    if not np.isfinite(M).all():  # never factorized (LAPACK may not return on inf)
+        return ("the mass matrix M is not finite (its entries exceed the floating-point "
+                "range): check the magnitudes of the masses, inertias and lengths")
     w = np.linalg.eigvalsh(M) if M.size else np.ones(1)
     top = max(float(w.max()), 0.0)
     if w.min() > SINGULAR_RTOL * top:
         return None
-    coords = system.coordinate_names
+    coords = list(coordinates or system.coordinate_names)
+    if len(coords) != M.shape[0]:  # a closed system's M, in coordinates not named
+        coords = [f"coordinate {i + 1}" for i in range(M.shape[0])]
     idle = [c for i, c in enumerate(coords) if not M[i, i] > SINGULAR_RTOL * top]
     if idle:
         moved: dict[str, set[str]] = {}  # body -> the coordinates that move it

@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import JourdainError
+from ..errors import EvaluationError, JourdainError
 from ..io import capabilities
 from ..numeric import evaluate
 from ..units import value_units
@@ -92,7 +92,37 @@ def evaluate_all(model: Any, y: np.ndarray, yd: np.ndarray, t: float,
     except JourdainError as exc:
         missing.update({k: f"the linearization could not be formed: {exc}"
                         for k in LINEARIZATION_NAMES})
+    check_finite(system, values, extra, t)
     return values, extra, missing
+
+
+def check_finite(system: Any, values: dict[str, np.ndarray], extra: dict[str, Any],
+                 t: float) -> None:
+    """An :class:`EvaluationError` naming every quantity that holds inf or NaN, NaN in the
+    undetermined components of g excepted (``null`` in the JSON means undetermined, never an
+    overflow): ½(Q + Qᵀ) of entries near 1e308 overflows where Q itself is finite."""
+    undetermined = set(extra.get("g_undetermined", ()))
+    names = list(extra.get("g_names", ()))
+    overflow, nan = [], []
+    for k, v in values.items():
+        a = np.asarray(v, float)
+        if k == "g" and names and a.size == len(names):
+            a = a[[n not in undetermined for n in names]]
+        if np.isinf(a).any():
+            overflow.append(k)
+        elif np.isnan(a).any():
+            nan.append(k)
+    if not (overflow or nan):
+        return
+    parts = []
+    if overflow:
+        parts.append(f"{', '.join(overflow)} overflow{'s' if len(overflow) == 1 else ''} (inf: beyond the floating-point range, "
+                     "about 1.8e308)")
+    if nan:
+        parts.append(f"{', '.join(nan)} hold{'s' if len(nan) == 1 else ''} NaN")
+    raise EvaluationError(f"{'; '.join(parts)} for {system.name!r} at t = {t:g}: the numbers of "
+                          "the model are too large (check the magnitudes of its parameters and "
+                          "constants)")
 
 
 def reactions_at(system: Any, y: Any, yd: Any, t: float, parameters: dict[str, float],

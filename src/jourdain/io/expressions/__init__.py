@@ -18,7 +18,7 @@ nothing is ever passed to ``eval``, ``exec`` or ``sympify``.
 """
 
 
-from .numbers import _number
+from .numbers import SMALLEST_NORMAL, SUBNORMAL, _number
 from .parser import parse_expression, parse_number
 from .tokens import Token, tokenize
 from .vocabulary import (
@@ -34,5 +34,6 @@ from .vocabulary import (
 )
 
 __all__ = ["CONSTANTS", "FUNCTIONS", "MAX_DEPTH", "MAX_LENGTH", "MAX_NUMBER_BITS",
-           "MAX_NUMBER_LENGTH", "MAX_NUMERIC_EXPONENT", "RESERVED_NAMES", "ExpressionError",
+           "MAX_NUMBER_LENGTH", "MAX_NUMERIC_EXPONENT", "RESERVED_NAMES", "SMALLEST_NORMAL",
+           "SUBNORMAL", "ExpressionError",
            "Token", "parse_expression", "parse_number", "tokenize", "_number"]

@@ -11,6 +11,12 @@ import symengine as se
 
 from .vocabulary import MAX_NUMBER_BITS, MAX_NUMBER_LENGTH, ExpressionError
 
+#: the smallest positive normal floating-point number; below it (down to 5e-324) numbers are
+#: subnormal: they have lost digits, and their reciprocals and products overflow
+SMALLEST_NORMAL = 2.2250738585072014e-308
+SUBNORMAL = ("a subnormal floating-point number (nonzero, below 2.2e-308: it has lost its digits "
+             "and its reciprocal overflows); write 0 or a value in other units")
+
 
 def _number(text: str) -> se.Basic:
     """Exact value of a decimal literal (``0.1`` is 1/10), a float when the exponent is huge."""
@@ -23,8 +29,12 @@ def _number(text: str) -> se.Basic:
         if value in (float("inf"), float("-inf")):
             raise ExpressionError(f"number {_short(text)} is too large for a floating-point "
                                   "number (at most about 1.8e308)")
+        if value != 0 and abs(value) < SMALLEST_NORMAL:
+            raise ExpressionError(f"number {_short(text)} is {SUBNORMAL}")
         return se.Float(value)
     frac = Fraction(text)
+    if frac and abs(frac) < SMALLEST_NORMAL:
+        raise ExpressionError(f"number {_short(text)} is {SUBNORMAL}")
     out = (se.Integer(frac.numerator) if frac.denominator == 1
            else se.Rational(frac.numerator, frac.denominator))
     why = _bad_number(out)

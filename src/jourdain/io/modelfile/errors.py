@@ -7,7 +7,7 @@ from __future__ import annotations
 import difflib
 import re
 
-from ...errors import ModelError
+from ...errors import ModelError, shorten_words
 from ..toml_positions import Path, deep_nesting, key_lines, line_of
 from .schema import _MAX_NESTING, _TOP, MAX_FILE_BYTES
 
@@ -107,6 +107,7 @@ class Locator:
                 message = message[len(prefix):]
                 break
         loc = f"{self.file}:{line}" if line else self.file
+        message = shorten_words(message)  # a value of 5 000 characters, not echoed whole
         return ModelFileError(f"{loc}: {where}: {message}", self.file, line, path, message)
 
     def missing(self, message: str) -> ModelFileError:

@@ -14,6 +14,7 @@ from typing import Any
 import symengine as se
 
 from ...errors import JourdainError, ModelError
+from ...model.expressions import magnitude_problem
 from ...pipeline import System  # jourdain.System: the model with its stages (issue 16)
 from ...simulation.simulate import (
     check_atol,
@@ -145,6 +146,9 @@ class _Loader(_Forces):
                     raise self.fail(p, f'a parameter value must be a number, got the string '
                                     f'"{spec}" (parameters are not expressions; write the number)')
                 value = self.number(spec, p)
+            why = magnitude_problem(value)
+            if why:
+                raise self.fail(p, why)
             self.params[pname] = value
 
     def read_inputs(self, data: dict) -> None:

@@ -11,7 +11,7 @@ from typing import Any
 import symengine as se
 
 from ...model.expressions import unit_axis
-from ..expressions import ExpressionError, _number, parse_expression
+from ..expressions import SMALLEST_NORMAL, SUBNORMAL, ExpressionError, _number, parse_expression
 from ..toml_positions import Path
 from .errors import Locator, _clip, _type_name
 from .schema import _CONTROL, _IDENT
@@ -75,6 +75,8 @@ class _Values(Locator):
             self.integer_in_range(value, path)
         if not math.isfinite(value):
             raise self.fail(path, f"expected a finite number, got {value}")
+        if value and abs(value) < SMALLEST_NORMAL:
+            raise self.fail(path, f"{value:g} is {SUBNORMAL}")
         if positive and value <= 0:
             raise self.fail(path, f"expected a positive number, got {value}")
         return float(value)
@@ -124,6 +126,8 @@ class _Values(Locator):
         if isinstance(value, float):
             if not math.isfinite(value):
                 raise self.fail(path, f"expected a finite number, got {value}")
+            if value and abs(value) < SMALLEST_NORMAL:
+                raise self.fail(path, f"{value:g} is {SUBNORMAL}")
             # the decimal the user wrote (0.7 is 7/10), as in expression strings
             return _number(repr(value))
         if not isinstance(value, str):
