@@ -100,3 +100,53 @@ def test_bad_input_names_the_element() -> None:
     with pytest.raises(jd.ClosedSystemError if hasattr(jd, "ClosedSystemError") else
                        ModelError, match="contact"):
         jd.kinematics(d)
+
+
+def test_a_ball_rolls_as_a_torus_of_zero_radius() -> None:
+    """A solid ball (radius ρ: ``RollingDisc(radius=0, tube_radius=ρ)``) pushed at its centre
+    by F along x: ``a = F/(m + I/ρ²) = 5F/(7m)``, the ground's friction ``−2F/7`` on it, the
+    normal force ``m·g``, the centre at height ρ whatever the orientation."""
+    x, y, z, psi, phi, theta = jd.symbols("x y z psi phi theta")
+    m, rho, g, F = jd.symbols("m rho g F")
+    ball = jd.Body("ball", "world", jd.General(
+        "free", [jd.Trans(vector=(x, y, z)), jd.Rot("z", psi), jd.Rot("x", phi),
+                 jd.Rot("y", theta)], coordinates=(x, y, z, psi, phi, theta)),
+        mass=m, inertia=(2 * m * rho**2 / 5,) * 3)
+    s = jd.System([x, y, z, psi, phi, theta], [ball],
+                  [jd.Gravity((0, 0, -g)), jd.Force("push", "ball", (F, 0, 0))],
+                  parameters={"m": 2.0, "rho": 0.11, "g": 9.81, "F": 3.0},
+                  contacts=[jd.RollingDisc("ground", "ball", 0, "y", tube_radius=rho)],
+                  independent=["x", "y", "psi", "phi", "theta"],
+                  speeds=["psi", "phi", "theta"])
+    p = s.parameter_values
+    out = s.evaluate([0.3, -0.1, 0.0, 0.2, 0.3, 0.4], np.zeros(6))
+    assert abs(out["y"][2] - p["rho"]) <= 10 * EPS * p["rho"]
+    a = np.asarray(out["ydd"])[:2]
+    along = a[0] * 1.0  # the push is along the world's x
+    ref = 5 * p["F"] / (7 * p["m"])
+    assert abs(along - ref) <= 1e3 * EPS * ref and abs(a[1]) <= 1e3 * EPS * ref
+    f = out["contact_forces"]
+    assert abs(f["ground.T1"] + 2 * p["F"] / 7) <= 1e3 * EPS * p["F"]
+    assert abs(f["ground.N"] - p["m"] * p["g"]) <= 1e3 * EPS * p["m"] * p["g"]
+
+
+def test_a_leaning_torus_touches_at_its_lowest_point() -> None:
+    """A torus wheel (R, ρ) leaning by φ has its centre at R·cos φ + ρ and the normal force
+    m·g at rest with the lean held (the centre of mass above the contact only when upright)."""
+    x, y, z, psi, phi, theta = jd.symbols("x y z psi phi theta")
+    m, R, rho, g = jd.symbols("m R rho g")
+    wheel = jd.Body("wheel", "world", jd.General(
+        "free", [jd.Trans(vector=(x, y, z)), jd.Rot("z", psi), jd.Rot("x", phi),
+                 jd.Rot("y", theta)], coordinates=(x, y, z, psi, phi, theta)),
+        mass=m, inertia=(m * R**2 / 4, m * R**2 / 2, m * R**2 / 4))
+    s = jd.System([x, y, z, psi, phi, theta], [wheel], [jd.Gravity((0, 0, -g))],
+                  parameters={"m": 1.5, "R": 0.3, "rho": 0.02, "g": 9.81},
+                  contacts=[jd.RollingDisc("tyre", "wheel", R, "y", tube_radius=rho)],
+                  independent=["x", "y", "psi", "phi", "theta"],
+                  speeds=["psi", "phi", "theta"])
+    p = s.parameter_values
+    for lean in (0.0, 0.2, -0.5):
+        out = s.evaluate([0.0, 0.0, 0.0, 0.1, lean, 0.3], np.zeros(6))
+        ref = p["R"] * np.cos(lean) + p["rho"]
+        assert abs(out["y"][2] - ref) <= 10 * EPS * ref
+        assert np.max(np.abs(out["Phi"])) <= 10 * EPS * ref

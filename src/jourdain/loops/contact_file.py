@@ -41,7 +41,7 @@ _S = TypeVar("_S", bound=System)
 
 #: keys of a [contacts.<name>] table, by its type
 _KEYS: dict[str, set[str]] = {
-    "rolling_disc": {"body", "radius", "axis", "center", "normal"},
+    "rolling_disc": {"body", "radius", "axis", "center", "normal", "tube_radius"},
     "knife_edge": {"body", "point", "direction", "normal"},
     "velocity": {"expressions"},
 }
@@ -84,6 +84,9 @@ def _contact(loader: Any, name: str, spec: Any, bodies: list[str]) -> Any:
         if "center" in spec:
             kw["center"] = loader.vector(spec["center"], (*p, "center"), params,
                                          "a disc's centre (parameters)")
+        if "tube_radius" in spec:
+            kw["tube_radius"] = loader.expr(spec["tube_radius"], (*p, "tube_radius"), params,
+                                            "a torus' tube radius (parameters)")
         return RollingDisc(name, body, radius, **kw)
     if "point" in spec:
         kw["point"] = loader.vector(spec["point"], (*p, "point"), params,

@@ -10,10 +10,10 @@ in the benchmark bicycle's).
 ==================  ===========================================================================
 element             rows
 ==================  ===========================================================================
-``RollingDisc``     a disc (a wheel with a knife-edge rim: torus of zero tube radius) of
+``RollingDisc``     a disc (a wheel with a knife-edge rim, or a torus of ``tube_radius`` ρ) of
                     ``radius`` about ``center`` in the plane normal to ``axis`` (body frame)
                     rolling on the ground without slip: its contact point is the rim's point
-                    nearest the ground, ``P = C − R·(n − (n·a)·a)/|n − (n·a)·a|``; rows
+                    nearest the ground, ``P = C − R·(n − (n·a)·a)/|n − (n·a)·a| − ρ·n``; rows
                     ``<name>.N``: ``n·P = 0`` (holonomic: the wheel touches the ground),
                     ``<name>.T1``, ``<name>.T2``: the velocity of the disc's material point at
                     P along two ground directions vanishes (velocity rows)
@@ -72,6 +72,10 @@ class RollingDisc:
         The disc's centre in the body frame (default the body frame's origin).
     normal : world axis, optional
         The ground's normal pointing to the bodies' side (default ``"z"``).
+    tube_radius : expression, optional
+        A torus: the rim's cross-section is a circle of this radius about the circle of
+        ``radius`` (a tyre's crown; 0, the default, is the knife-edge disc; ``radius = 0``
+        makes a sphere of ``tube_radius``).
     """
 
     name: str
@@ -80,9 +84,11 @@ class RollingDisc:
     axis: Vec3
     center: Vec3
     normal: Vec3
+    tube_radius: Expr = se.Integer(0)
 
     def __init__(self, name: str, body: str, radius: object, axis: object = "y", *,
-                 center: object = None, normal: object = "z") -> None:
+                 center: object = None, normal: object = "z",
+                 tube_radius: object = 0) -> None:
         set_ = object.__setattr__
         where = f'rolling disc "{_name(name, "rolling disc")}"'
         set_(self, "name", name)
@@ -91,13 +97,14 @@ class RollingDisc:
         set_(self, "axis", axis_vector(axis, f"{where} axis"))
         set_(self, "center", ZERO3 if center is None else as_vector(center, f"{where} center"))
         set_(self, "normal", _ground(normal, where))
+        set_(self, "tube_radius", as_expr(tube_radius, f"{where} tube_radius"))
 
     @property
     def bodies(self) -> tuple[str, ...]:
         return (self.body,)
 
     def symbols(self) -> set[str]:
-        return free_names([self.radius, *self.axis, *self.center])
+        return free_names([self.radius, self.tube_radius, *self.axis, *self.center])
 
 
 @dataclass(frozen=True)

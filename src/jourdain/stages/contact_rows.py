@@ -8,8 +8,10 @@ constrained direction (a force along it at the contact point, ``Q̄``'s column) 
 Rolling disc (centre C, axle a = S·axis, ground normal n, radius R): the rim's point nearest
 the ground is ``P = C − R·(n − (n·a)·a)/√(1 − (n·a)²)`` and its height ``n·P`` is the
 holonomic row; its variation is the material point's normal displacement at P, because the
-rim's tangent there is parallel to the ground (so the same force column serves). The disc
-lying flat (``n·a = ±1``) has no contact point: the evaluation reports it.
+rim's tangent there is parallel to the ground (so the same force column serves). A torus
+(tube radius ρ) touches at ``P − ρ·n`` below the centre line's lowest point, where its surface
+is parallel to the ground too. The disc lying flat (``n·a = ±1``) has no contact point: the
+evaluation reports it.
 """
 
 from __future__ import annotations
@@ -94,7 +96,7 @@ def contact_rows(kin: Kinematics, contacts: Sequence[Contact]) -> tuple[list, li
             na = _dot(nv, a)
             s = se.sqrt(1 - na * na)
             d = tuple(-(nv[i] - na * a[i]) / s for i in range(3))
-            P = _add(C, _scale(c.radius, d))
+            P = _add(_add(C, _scale(c.radius, d)), _scale(-c.tube_radius, nv))
             at: dict[str, Any] = {"body_a": c.body, "body_b": "world", "p_a": P, "p_b": P}
             hol.append(ConstraintRow(n, f"{n}.N", _dot(nv, P), "force", nv, **at))
             cols, vbar = material_velocity(kin, c.body, P, f)
