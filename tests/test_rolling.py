@@ -150,3 +150,23 @@ def test_a_leaning_torus_touches_at_its_lowest_point() -> None:
         ref = p["R"] * np.cos(lean) + p["rho"]
         assert abs(out["y"][2] - ref) <= 10 * EPS * ref
         assert np.max(np.abs(out["Phi"])) <= 10 * EPS * ref
+
+
+def test_speeds_by_definition_linearize_in_quasi_coordinates() -> None:
+    """The differential drive in its body speeds (v, w) about straight running at v: every
+    coordinate is cyclic, so the linearization is in the speeds' quasi-coordinates; the yaw
+    rate obeys I·δẇ + mc·b·v·δw = 0 (eigenvalue −mc·b·v/I), the speed is neutral."""
+    from jourdain.models.wheeled import differential_drive
+
+    s = differential_drive("body")
+    p = s.parameter_values
+    v = 1.5
+    lin = s.linearize({"x_d": v, "thetaL_d": v / p["r"], "thetaR_d": v / p["r"]})
+    assert lin.names == ("v", "w") and set(lin.cyclic) == {"x", "y", "psi", "thetaL", "thetaR"}
+    I = (p["Ic"] + p["mc"] * p["b"] ** 2 + 2 * p["mw"] * p["d"] ** 2 + 2 * p["Iw"]
+         + 2 * p["Jw"] * p["d"] ** 2 / p["r"] ** 2)
+    ref = -p["mc"] * p["b"] * v / I
+    lam = lin.eigenvalues
+    assert np.min(np.abs(lam - ref)) <= 1e3 * EPS * abs(ref)
+    assert np.sum(np.abs(lam) <= 1e3 * EPS * abs(ref)) == 3
+    assert jd.stability(lin).verdict == "marginally stable"

@@ -10,7 +10,8 @@ differences lose half the digits). With ``ż_s`` the nominal accelerations (held
 
     M̃ = M,  P = ∂(k − q)/∂z,  Q = ∂(M·ż_s + k − q)/∂y,  h = q − k − M·ż_s
 
-in the coordinates η whose rates are speeds (``speeds=[...]`` coordinate names). Coordinates
+in the coordinates η whose rates are speeds (``speeds=[...]`` coordinate names; speeds given by
+definition: their quasi-coordinates, where no coordinate acts on the equations). Coordinates
 without a speed of their own (the position on the ground, the heading of a bicycle, a wheel
 angle) must be cyclic, absent from the equations: they are left out. A speed whose coordinate
 is cyclic and which enters no other equation (a wheel's spin rate at steady rolling: the
@@ -150,9 +151,8 @@ def linearize_general(system: System, nominal: Any,
     names = system.coordinate_names
     x_names = (*(names[j] for j in ch.independent), *ch.speeds)
     if ch.speed_coordinates is None:
-        raise EvaluationError(f"{system.name}: the second-order form M̃·η̈ + P·η̇ + Q·η = h "
-                              "needs speeds that are rates of coordinates (speeds=[names]); "
-                              "the first-order Jacobian is A_x of a linearization with them")
+        return _in_quasi_coordinates(system, ch, M, Jy, Jr, h, s0, values, t, x_names,
+                                     nominal)
     pos = {j: i for i, j in enumerate(ch.independent)}
     found = [pos.get(j) for j in ch.speed_coordinates]
     if any(m is None for m in found):
@@ -201,6 +201,36 @@ def linearize_general(system: System, nominal: Any,
         system=system, t=t, parameters=dict(values),
         speeds=tuple(ch.speeds[k] for k in keep), cyclic=tuple(cyc), A_x=A_x,
         x_names=x_names, nominal=nominal)
+
+
+def _in_quasi_coordinates(system: System, ch: Any, M: np.ndarray, Jy: np.ndarray,
+                          Jr: np.ndarray, h: np.ndarray, s0: dict, values: dict, t: float,
+                          x_names: tuple, nominal: Any) -> GeneralLinearization:
+    """Speeds given by definition (not rates of coordinates): where every coordinate is
+    cyclic (the equations in z do not depend on them, as for a vehicle on flat ground), the
+    linearization is in the quasi-coordinates π of the speeds (π̇ = z): M̃ = M,
+    P = ∂(k − q)/∂z, Q = 0, and Routh's verdict is the one on the speeds alone."""
+    ni, g = len(ch.independent), len(ch.speeds)
+    names = system.coordinate_names
+    scale = max(float(np.max(np.abs(Jr), initial=0.0)), float(np.max(np.abs(M))))
+    acting = [names[ch.independent[i]] for i in range(ni)
+              if np.any(np.abs(Jr[:, i]) > ZERO_RTOL * scale)]
+    if acting:
+        raise EvaluationError(
+            f"{system.name}: the equations in the speeds {', '.join(ch.speeds)} depend on the "
+            f"coordinates {', '.join(acting)}, which have no speed of their own: the motion has "
+            "no second-order form in these speeds (give speeds=[coordinate names] for them)")
+    P = Jr[:, ni:]
+    Q = np.zeros((g, g))
+    A = np.block([[np.zeros((g, g)), np.eye(g)], [np.zeros((g, g)), -np.linalg.solve(M, P)]])
+    lam = np.linalg.eigvals(A)
+    lam = lam[np.lexsort((lam.imag, lam.real))]
+    return GeneralLinearization(
+        names=tuple(ch.speeds), y_s=np.zeros(g), z_s=np.real(s0["y"]), M_tilde=M, P=P, Q=Q,
+        h=h, D=(P + P.T) / 2, G=(P - P.T) / 2, K=Q, N=Q, A=A, eigenvalues=lam, system=system,
+        t=t, parameters=dict(values), speeds=tuple(ch.speeds),
+        cyclic=tuple(names[j] for j in ch.independent),
+        A_x=np.vstack([Jy, -np.linalg.solve(M, Jr)]), x_names=x_names, nominal=nominal)
 
 
 __all__ = ["GeneralLinearization", "linearize_general"]
