@@ -79,6 +79,7 @@ bench: $(BIN)/.installed
 	$(BIN)/python benchmarks/study.py --quick
 	$(BIN)/python benchmarks/loops.py --units --T 1
 	$(BIN)/python benchmarks/hostile_files.py --repeat 1
+	$(BIN)/python benchmarks/rolling.py --quick
 	$(BIN)/python benchmarks/per_call.py --repeat 50
 
 # the 3-D view's three.js bundle (src/jourdain/io/viewer/three_bundle.js, committed): rebuilt from
