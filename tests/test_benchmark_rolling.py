@@ -3,7 +3,7 @@ linearization of the benchmark bicycle equals the paper's matrices and Table 2, 
 runs of jourdain and of sympy + SciPy (Kane's equations lambdified) agree with each other and
 with a tight reference. No time is asserted.
 
-sympy's ``linearize`` of the bicycle takes 5–10 minutes, so the quick mode takes it only from
+sympy's ``linearize`` of the bicycle takes 3.5–7.5 minutes, so the quick mode takes it only from
 the cache a full run leaves; the tests' compile cache is empty, so here that part is left out,
 and the test checks that the output says why."""
 
