@@ -26,8 +26,9 @@ and by ``sympy.physics.mechanics`` (+ SciPy), peers in one run (issue 34, item 5
    against it first. Best of ``--repeat``. ``--profile``: cProfile's top entries of jourdain's
    run.
 
-sympy's ``linearize`` of the bicycle takes minutes (3.5–7.5 on a shared 2-core machine, with or without Table 1's
-numbers put in first); it runs in its own process under ``--timeout``. A full run stores its
+sympy's ``linearize`` of the bicycle takes minutes (3.5–7.5 on a shared 2-core machine, with
+or without Table 1's numbers put in first); it runs in its own process under ``--timeout``. A
+full run stores its
 ``A(v)`` (and its times) in jourdain's compile cache; ``--quick`` takes it from there when
 present (its times then are that earlier run's, and say so) and otherwise leaves sympy's
 linearization out, saying why. Timings from ``--quick`` are not the reported numbers.
