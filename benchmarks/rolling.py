@@ -28,10 +28,9 @@ and by ``sympy.physics.mechanics`` (+ SciPy), peers in one run (issue 34, item 5
 
 sympy's ``linearize`` of the bicycle takes minutes (3.5–7.5 on a shared 2-core machine, with
 or without Table 1's numbers put in first); it runs in its own process under ``--timeout``. A
-full run stores its
-``A(v)`` (and its times) in jourdain's compile cache; ``--quick`` takes it from there when
-present (its times then are that earlier run's, and say so) and otherwise leaves sympy's
-linearization out, saying why. Timings from ``--quick`` are not the reported numbers.
+full run stores its ``A(v)`` (and its times) in jourdain's compile cache; ``--quick`` takes it
+from there when present (its times then are that earlier run's, and say so) and otherwise
+leaves sympy's linearization out, saying why. Timings from ``--quick`` are not the reported numbers.
 
     python benchmarks/rolling.py                 # 100 speeds, 10 s run (about 7 minutes)
     python benchmarks/rolling.py --quick         # 5 speeds, a 1 s run
