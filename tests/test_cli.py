@@ -49,7 +49,10 @@ def test_example_check_and_eom(path, capsys):
     assert f"constrained directions q = {len(system.tree.reactions().g_names)}:" in out
     code, out, err = run(capsys, "eom", path)
     assert code == 0, err
-    if system.closing:  # the tree's equations with Φ, Φ_y and the multipliers, then L
+    if system.is_general:  # the tree's equations with the rows A, a and the contact forces
+        assert "A (every constraint row" in out and "M_tree" in out and "λ" in out
+        assert "M (mass matrix, f×f) =" not in out
+    elif system.closing:  # the tree's equations with Φ, Φ_y and the multipliers, then L
         assert "Φ_y" in out and "M_tree" in out and "λ" in out
         assert "M (mass matrix, f×f) =" not in out
     else:
@@ -64,9 +67,12 @@ def test_example_run_writes_a_report(path, tmp_path, capsys):
     assert f"report: {report}" in out
     text = report.read_text()
     assert "<svg" in text
-    closed = bool(load_model(path).system.closing)
+    system = load_model(path).system
+    closed = bool(system.closing)
     names = ("values.json", "simulation.csv", "model.toml")
-    if closed:  # no symbolic equations (their velocity map is numbers only); the loops' files
+    if system.is_general:  # no symbolic equations; the contacts' and the steady motion's files
+        names += ("contacts.csv",)
+    elif closed:  # no symbolic equations (their velocity map is numbers only); the loops' files
         names += ("loops.json", "loops.csv")
     else:
         assert "<math" in text

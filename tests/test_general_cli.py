@@ -1,8 +1,8 @@
 """Every command and entry point on a general system (velocity constraints, issue 34): the
 benchmark bicycle's model file gives its own numbers everywhere — the paper's eigenvalues from
 ``linearize``, the static loads from ``eval --json``, the self-stable range from ``run`` and
-``study`` — or a clean error that names the contacts (``eom``, ``fmu``); never the open
-tree's."""
+``study``, the rows from ``eom`` — or a clean error that names the contacts (``fmu``); never
+the open tree's."""
 
 from __future__ import annotations
 
@@ -79,7 +79,17 @@ def test_simulate_writes_the_motion_with_residuals_at_rounding(
     assert len(rows) > 10
 
 
-@pytest.mark.parametrize("command", [["eom"], ["fmu", "--out", "{tmp}/b.fmu"]])
+def test_eom_shows_the_rows_and_the_trees_equations(capsys: pytest.CaptureFixture) -> None:
+    code, out, err = run(capsys, "eom", BIKE, "--format", "json")
+    assert code == 0, err
+    doc = json.loads(out)
+    assert doc["contacts"] == ["rear", "front"]
+    assert doc["constraint_labels"] == ["rear.N", "front.N", "rear.T1", "rear.T2", "front.T1",
+                                        "front.T2"]
+    assert "A" in doc["matrices"] if "matrices" in doc else "A" in doc
+
+
+@pytest.mark.parametrize("command", [["fmu", "--out", "{tmp}/b.fmu"]])
 def test_what_is_not_available_is_refused_naming_the_contacts(
         capsys: pytest.CaptureFixture, tmp_path: Path, command: list[str]) -> None:
     args = [c.replace("{tmp}", str(tmp_path)) for c in command]

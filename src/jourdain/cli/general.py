@@ -16,6 +16,7 @@ import numpy as np
 
 from ..analysis.modes import stability
 from ..errors import ClosedSystemError, JourdainError
+from ..io import export
 from ..io.capabilities import write_csv
 from ..workflow.evaluation import EVAL_FORMAT, json_array
 from .arguments import overrides, sim_options, state_at
@@ -29,8 +30,77 @@ def refuse(system: Any, command: str) -> None:
     """A command not available for a general system yet: a clean error naming it."""
     raise ClosedSystemError(system, f"jourdain {command} is not available for systems with "
                             "velocity constraints yet",
-                            "check, eval, reactions, linearize and simulate are; from Python "
+                            "check, eom, eval, reactions, linearize, simulate, run and study "
+                            "are; from Python "
                             "system.evaluate, system.linearize, system.simulate")
+
+
+#: the symbolic matrices of a general system that eom shows beyond the closed system's
+TITLES = {
+    "A": "A (every constraint row at the velocity level, A·ẏ + a = 0, r×f)",
+    "a": "a (their part without ẏ, r)",
+    "Q_bar_c": "Q̄_c (the rows' constrained directions, 6p×r; J̄ᵀ·Q̄_c = Aᵀ)",
+    "Phi": "Φ (the holonomic rows, r_h)",
+}
+LATEX = {"A": "A", "a": "a"}
+
+
+def eom_lines(system: Any) -> list[str]:
+    """What a general system's symbolic matrices mean and how its equations in z follow."""
+    con = system.constraints()
+    speeds = ", ".join(n for n, _ in system.speeds) if system.speeds else "chosen by pivoting"
+    return [
+        f"{system.name}: constrained by the contact(s) {', '.join(c.name for c in system.contacts)}"
+        "; the open tree's Newton–Euler equations M̄·J̄·ÿ + q̄^c = q̄^e + Q̄·g (Q̄ = [Q̄_tree, "
+        "Q̄_c]: the tree joints' and the contact rows' constrained directions)",
+        f"  rows ({con.r}: {', '.join(con.labels)}) at the velocity level A·ẏ + a = 0; "
+        "projected with J̄ of the tree: M_tree·ÿ + k_tree = q_tree + Aᵀ·λ (λ: the contact forces)",
+        f"  speeds z ({speeds}) = Y·ẏ + b; W = [Y; A]: ẏ = L·z + l, ÿ = L·ż + γ; equations "
+        "of motion M·ż + k = q with M = Lᵀ·M_tree·L, k = Lᵀ·(k_tree + M_tree·γ), q = Lᵀ·q_tree",
+        "  M, k, q exist in numbers only (W is solved at a state): jourdain eval gives them, with "
+        "L, l, γ and the contact forces",
+    ]
+
+
+def eom_matrices(system: Any) -> dict[str, Any]:
+    """The symbolic matrices of a general system: the tree's M̄, J̄, q̄^c, q̄^e, the rows' A, a,
+    Φ, Q̄_c and the tree's projected M, k, q."""
+    eom = system.tree.equations_of_motion()
+    ne = eom.newton_euler
+    con = system.constraints()
+    return {"M_bar": ne.M_bar, "J_bar": ne.J_bar, "q_c": ne.q_c, "q_e": ne.q_e,
+            "A": con.A, "a": con.a, "Phi": con.Phi, "Q_bar_c": con.Q_bar,
+            "M_tree": eom.M, "k_tree": eom.k, "q_tree": eom.q}
+
+
+def cmd_eom(model: Any, args: argparse.Namespace, titles: dict[str, str],
+            latex: dict[str, str]) -> int:
+    """``jourdain eom`` of a general system: :func:`eom_matrices` with :func:`eom_lines`."""
+    system = model.system
+    mats = eom_matrices(system)
+    symbols = system.tree
+    lines = eom_lines(system)
+    if args.format == "json":
+        data = {"format": "jourdain-eom/1", "model": system.name,
+                "coordinates": system.coordinate_names,
+                "rates": [f"{c}_d" for c in system.coordinate_names],
+                "parameters": system.parameter_values, "inputs": system.input_names,
+                "contacts": [c.name for c in system.contacts],
+                "constraint_labels": system.constraints().labels, "equations": lines}
+        data.update(export.matrices_json(mats, symbols))
+        print(json.dumps(data, indent=1))
+        return EXIT_OK
+    if args.format == "latex":
+        text = export.latex_fragment(mats, {**latex, **LATEX}, symbols,
+                                     f"{system.name}: Newton-Euler equations of the tree, "
+                                     "constraint rows and projected equations", args.max_ops)
+        print("".join(f"% {line}\n" for line in lines) + text, end="")
+        return EXIT_OK
+    print("\n".join(lines))
+    for k, m in mats.items():
+        print(f"\n{({**titles, **TITLES})[k]} =")
+        print(export.matrix_text(m, symbols, args.max_ops))
+    return EXIT_OK
 
 
 def _evaluate(model: Any, args: argparse.Namespace) -> tuple[dict[str, Any], dict, float]:
@@ -211,5 +281,5 @@ def cmd_simulate(model: Any, args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-__all__ = ["check_lines", "cmd_eval", "cmd_linearize", "cmd_reactions", "cmd_simulate",
+__all__ = ["check_lines", "cmd_eom", "cmd_eval", "eom_lines", "eom_matrices", "cmd_linearize", "cmd_reactions", "cmd_simulate",
            "linear_result", "print_check", "refuse"]
