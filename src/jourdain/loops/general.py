@@ -90,27 +90,32 @@ class Functions:
             self.con_fn = lambdify(tree, mats)
             return
         eom = projection(newton_euler(kinematics(tree)))
-        mats.update(M=eom.M, k=eom.k, q=eom.q)
-        self.names = list(mats)
-        self.shapes = [mats[n].shape for n in self.names]
         args = [*tree.y, *tree.yd, tree.t, *tree.parameter_symbols, *tree.inputs]
-        exprs = [e for n in self.names for e in mats[n].entries()]
-        self.fn = se.Lambdify(args, exprs, real=False, cse=True)
+        self.parts = []
+        for group in (mats, {"M": eom.M, "k": eom.k, "q": eom.q}):
+            names = list(group)
+            exprs = [e for n in names for e in group[n].entries()]
+            self.parts.append((names, [group[n].shape for n in names],
+                               se.Lambdify(args, exprs, real=False, cse=True)))
 
     def __call__(self, y: np.ndarray, yd: np.ndarray, t: float, p: np.ndarray,
-                 u: np.ndarray) -> dict[str, np.ndarray]:
+                 u: np.ndarray, tree: bool = True) -> dict[str, np.ndarray]:
+        """The functions at a state; ``tree=False``: the rows' only (no M, k, q)."""
         if not self.complex:
             y = np.ascontiguousarray(y, dtype=float)
             yd = np.ascontiguousarray(yd, dtype=float)
             out = self.con_fn.split(self.con_fn.raw(y, yd, t, p, u))
-            out.update(self.tree_fn.split(self.tree_fn.raw(y, yd, t, p, u)))
+            if tree:
+                out.update(self.tree_fn.split(self.tree_fn.raw(y, yd, t, p, u)))
             return out
         x = np.concatenate([y, yd, [t], p, u]).astype(complex)
-        flat = np.asarray(self.fn(x)).reshape(-1)
-        out, i = {}, 0
-        for n, (r, c) in zip(self.names, self.shapes, strict=True):
-            out[n] = flat[i:i + r * c].reshape(r, c)
-            i += r * c
+        out = {}
+        for names, shapes, fn in self.parts if tree else self.parts[:1]:
+            flat = np.asarray(fn(x)).reshape(-1)
+            i = 0
+            for n, (r, c) in zip(names, shapes, strict=True):
+                out[n] = flat[i:i + r * c].reshape(r, c)
+                i += r * c
         return out
 
 
@@ -199,7 +204,8 @@ class GeneralEvaluator:
         if y.size != self.n:
             raise EvaluationError(f"{system.name}: {self.n} coordinates expected, got {y.size}")
         real = functions(system, False) if complex_ else self.fn
-        self.choice = choose(system, real(y, np.zeros(self.n), float(t), self.p, self.u))
+        self.choice = choose(system, real(y, np.zeros(self.n), float(t), self.p, self.u,
+                                          tree=False))
         self.y_guess = y.astype(self.dtype)
         self.max_newton = 25
         self.newton_tol = 1e-13
@@ -212,8 +218,9 @@ class GeneralEvaluator:
     def independent_names(self) -> list[str]:
         return [self.system.coordinate_names[j] for j in self.choice.independent]
 
-    def _f(self, y: np.ndarray, yd: np.ndarray, t: float) -> dict[str, np.ndarray]:
-        return self.fn(y, yd, t, self.p, self.u)
+    def _f(self, y: np.ndarray, yd: np.ndarray, t: float, tree: bool = True
+           ) -> dict[str, np.ndarray]:
+        return self.fn(y, yd, t, self.p, self.u, tree)
 
     def positions(self, yi: np.ndarray, t: float, guess: np.ndarray | None = None
                   ) -> np.ndarray:
@@ -228,7 +235,7 @@ class GeneralEvaluator:
         zero = np.zeros(self.n, dtype=self.dtype)
         last, extra = math.inf, -1
         for _ in range(self.max_newton + 1):
-            fn = self._f(y, zero, t)
+            fn = self._f(y, zero, t, tree=False)
             Phi = fn["Phi"][rows, 0]
             if extra < 0:
                 stop, res, last = _newton_stop(np.real(Phi), np.real(fn["Phi_y"][rows]),
@@ -302,7 +309,7 @@ class GeneralEvaluator:
         ni = len(self.choice.independent)
         yi, z = x[:ni], x[ni:]
         y = self.positions(yi, t)
-        fn0 = self._f(y, np.zeros(self.n, dtype=self.dtype), t)
+        fn0 = self._f(y, np.zeros(self.n, dtype=self.dtype), t, tree=False)
         W, L, l = self.velocity_map(fn0)
         yd = L @ z + l
         fn = self._f(y, yd, t)

@@ -17,11 +17,17 @@ from scipy.integrate import BDF, DOP853, LSODA, RK23, RK45, Radau
 
 from ..errors import EvaluationError, JourdainError
 from ..model import System
-from .general import GeneralEvaluator
+from ..simulation.options import C_METHODS, steps_per_call
+from ..simulation.problem import Segment
+from .general import GeneralEvaluator, functions
+from .general_kernel import GeneralKernel, supported
 from .results import _work
 
 _METHODS = {"DOP853": DOP853, "RK45": RK45, "RK23": RK23, "Radau": Radau, "BDF": BDF,
-            "LSODA": LSODA}
+            "LSODA": LSODA, "DOPRI5": RK45}
+_METHODS.update({f"scipy:{k}": v for k, v in list(_METHODS.items())})
+#: samples of a run in C without t_eval (the C integrator writes at given times)
+C_SAMPLES = 501
 
 
 def _sample(ev: GeneralEvaluator, x: np.ndarray, t: float) -> tuple:
@@ -57,6 +63,12 @@ def simulate_general(system: System, t_span: tuple[float, float], y0: Any, yd0: 
     if unknown:
         raise EvaluationError(f"simulate: unknown option(s) {', '.join(unknown)} for a system "
                               "with velocity constraints")
+    if method in C_METHODS:
+        ev = GeneralEvaluator(system, y0, float(t_span[0]), parameters)
+        if supported(ev):
+            return _simulate_c(system, ev, (float(t_span[0]), float(t_span[1])), y0, yd0,
+                               parameters, method, rtol, atol, t_eval, max_step, progress,
+                               output)
     if method not in _METHODS:
         raise EvaluationError(f'simulate: unknown method "{method}"; methods are '
                               f"{', '.join(_METHODS)}")
@@ -112,6 +124,86 @@ def simulate_general(system: System, t_span: tuple[float, float], y0: Any, yd0: 
     if N > 1:  # W = ∫ẏᵀq dt: the contact forces do no work (Jourdain's principle)
         res.W = _work(res, system.tree, parameters, None, system)
     if output is not None:  # at the end, or with the motion so far when interrupted
+        res.save(output)
+    return res
+
+
+def _multipliers(ev: GeneralEvaluator, t: np.ndarray, Y: np.ndarray, YD: np.ndarray,
+                 R: np.ndarray) -> np.ndarray:
+    """λ at every sample: the least-norm solution of ``Aᵀλ = r`` (as
+    :meth:`GeneralEvaluator.multipliers`), batched."""
+    fn = functions(ev.system).con_fn
+    if not len(t):
+        return np.zeros((0, len(ev.labels)))
+    A = fn.batch(Y, YD, t, ev.p, ev.u)["A"]
+    U, sv, Vt = np.linalg.svd(np.swapaxes(A, 1, 2), full_matrices=False)
+    rank = len(ev.choice.rows_v)
+    inv = np.zeros_like(sv)
+    inv[:, :rank] = 1.0 / sv[:, :rank]
+    return np.einsum("nji,nj->ni", Vt, inv * np.einsum("nij,ni->nj", U, R))
+
+
+def _simulate_c(system: System, ev: GeneralEvaluator, span: tuple[float, float], y0: Any,
+                yd0: Any, parameters: Mapping[str, float] | None, method: str, rtol: float,
+                atol: Any, t_eval: Any, max_step: float, progress: Any, output: Any) -> Any:
+    """The run in C (:mod:`jourdain.loops.general_kernel`): jourdain's integrator on
+    ``(y_i, ẏ_i)`` through the kernel's ``jd_accel``; the samples taken back onto the rows."""
+    from ..simulation.results import Results
+    from ..simulation.results.data import ConstraintHistories
+
+    t0, t1 = span
+    x0 = ev.initial(y0, yd0, t0)
+    s0 = ev.accelerations(x0, t0)
+    ind = list(ev.choice.independent)
+    ni = len(ind)
+    kernel = GeneralKernel(ev)
+    kernel.y[:] = np.real(s0["y"])
+    te = (np.linspace(t0, t1, C_SAMPLES) if t_eval is None
+          else np.asarray(t_eval, dtype=float).reshape(-1))
+    state = np.concatenate([s0["y"][ind], s0["yd"][ind], [0.0]])
+    start = time.perf_counter()
+    seg = Segment(ni, ev.u, kernel.tree.address, kernel.state_address, kernel.accel_address,
+                  t0, state, te, C_METHODS[method], rtol, float(np.max(atol)), max_step)
+    seg.atol[-1] = 1e300  # W out of the error norm (as the closed systems' runs)
+
+    def on_chunk(t: float) -> None:
+        if callable(progress):
+            progress(t, t1)
+
+    status, message, failure = "finished", "integrated to the end", None
+    try:
+        code = seg.run(t1, steps_per_call(ni), on_chunk)
+    except KeyboardInterrupt:  # between two calls: the samples so far are consistent
+        code, status = 0, "interrupted"
+    k = int(seg.n_out[0])
+    if status == "interrupted":
+        message = f"interrupted (Ctrl-C) at t = {float(seg.st[0]):.6g}"
+    elif code != 0:
+        status = "failed"
+        message = (f"the integration failed at t = {float(seg.fail[0]):.6g}: "
+                   f"{kernel.reason() or f'integrator code {code}'}")
+    kernel.y[:] = np.real(s0["y"])
+    smp, bad = kernel.samples(seg.out_t[:k], seg.out_x[:k, :2 * ni])
+    T = np.array(seg.out_t[:k])
+    if bad >= 0:
+        T = T[:bad]
+        smp = {key: v[:bad] for key, v in smp.items()}
+        status, message = "failed", f"no configuration at t = {float(seg.out_t[bad]):.6g}"
+    N = len(T)
+    lam = _multipliers(ev, T, smp["y"], smp["yd"], smp["r"])
+    phi = np.zeros((N, len(ev.labels)))
+    phi[:, :smp["Phi"].shape[1]] = smp["Phi"]
+    cons = ConstraintHistories(tuple(ev.labels), phi, smp["Phi_dot"], lam,
+                               ((t0, tuple(ev.independent_names)),), failure)
+    cnt = seg.cnt
+    res = Results(system, T, smp["y"], smp["yd"], smp["ydd"], np.zeros((N, 0)), np.zeros(N),
+                  {**system.parameter_values, **dict(parameters or {})}, method=method,
+                  rtol=rtol, atol=atol, status=status, message=message, nfev=int(cnt[0]),
+                  nsteps=int(cnt[1]), n_accepted=int(cnt[2]), n_rejected=int(cnt[3]),
+                  wall_time=time.perf_counter() - start, constraints=cons)
+    if N > 1:
+        res.W = _work(res, system.tree, parameters, None, system)
+    if output is not None:
         res.save(output)
     return res
 

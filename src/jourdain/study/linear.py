@@ -77,6 +77,7 @@ def closed_linearizations(ctx: Context, P: np.ndarray, Y: np.ndarray | None = No
                 v = np.asarray(ctx.nominal_state(P[i]), dtype=float).reshape(-1)
                 nominal = {**dict(zip(coords, v[:ft].tolist(), strict=True)),
                            **{f"{c}_d": x for c, x in zip(coords, v[ft:].tolist(), strict=True)}}
+            lin: Any
             if ctx.system.is_general:  # velocity constraints, about the steady motion
                 lin = linearize_general(ctx.system, nominal, params)
             else:

@@ -143,6 +143,7 @@ def linearization_section(run: Run) -> str:
                 mapping[c] = e
             if ed != 0:
                 mapping[f"{c}_d"] = ed
+        lin: Any
         try:
             lin = system.linearize(mapping)
             if run.params:
