@@ -1,8 +1,8 @@
 """Every command and entry point on a general system (velocity constraints, issue 34): the
 benchmark bicycle's model file gives its own numbers everywhere — the paper's eigenvalues from
 ``linearize``, the static loads from ``eval --json``, the self-stable range from ``run`` and
-``study``, the rows from ``eom`` — or a clean error that names the contacts (``fmu``); never
-the open tree's."""
+``study``, the rows from ``eom``, an FMU — or a clean error that names the contacts (an FMU of
+speeds given by definition); never the open tree's."""
 
 from __future__ import annotations
 
@@ -89,14 +89,22 @@ def test_eom_shows_the_rows_and_the_trees_equations(capsys: pytest.CaptureFixtur
     assert "A" in doc["matrices"] if "matrices" in doc else "A" in doc
 
 
-@pytest.mark.parametrize("command", [["fmu", "--out", "{tmp}/b.fmu"]])
-def test_what_is_not_available_is_refused_naming_the_contacts(
-        capsys: pytest.CaptureFixture, tmp_path: Path, command: list[str]) -> None:
-    args = [c.replace("{tmp}", str(tmp_path)) for c in command]
-    code, out, err = run(capsys, args[0], BIKE, *args[1:])
-    assert code == 1
-    assert "contact(s) rear, front" in err
-    assert not (tmp_path / "b.fmu").exists()
+def test_fmu_exports_the_general_system(capsys: pytest.CaptureFixture,
+                                        tmp_path: Path) -> None:
+    code, out, err = run(capsys, "fmu", BIKE, "--out", tmp_path / "b.fmu")
+    assert code == 0, err
+    assert "14 states (independent x, y, psi, phi, thetaR, delta, thetaF" in out
+    assert (tmp_path / "b.fmu").is_file()
+
+
+def test_an_fmu_of_speeds_by_definition_is_refused_naming_the_contacts(
+        tmp_path: Path) -> None:
+    from jourdain.io.fmu import export_fmu
+    from jourdain.models.rolling import chaplygin_sleigh
+
+    with pytest.raises(jd.ClosedSystemError, match="contact"):
+        export_fmu(chaplygin_sleigh(), tmp_path / "s.fmu")
+    assert not (tmp_path / "s.fmu").exists()
 
 
 def test_run_reports_the_self_stable_range(capsys: pytest.CaptureFixture,

@@ -60,6 +60,7 @@ from .binary import (
 from .description import build_description, layout, model_description
 from .sources import (
     _C_KEYWORDS,
+    _array,
     _closed_header,
     _finite,
     _model_header,
@@ -149,11 +150,8 @@ def export_fmu(model: Any, path: str | os.PathLike[str], *,
     """
 
     system, mf = _model_of(model)
-    if getattr(system, "is_general", False):  # never the open tree's FMU in its place
-        raise ClosedSystemError(system, "the FMU of a system with velocity constraints is not "
-                                "available yet", "simulate it with jourdain simulate or "
-                                "system.simulate")
-    closed = bool(getattr(system, "closing", ()))
+    general = bool(getattr(system, "is_general", False))  # velocity constraints
+    closed = bool(getattr(system, "closing", ())) or general
     if closed and reactions is not None and (isinstance(reactions, str) or list(reactions)):
         raise ClosedSystemError(system, "the FMU of a closed system gives no reaction "
                                 "outputs yet (export it without reactions)")
@@ -196,7 +194,8 @@ def export_fmu(model: Any, path: str | os.PathLike[str], *,
     coords = system.coordinate_names
     extra_out: list[tuple[str, str | None, str]] = []
     if closed:
-        closed_h, loop_src, coords, y0v, yd0v, extra_out = _closed_parts(
+        parts = _general_parts if general else _closed_parts
+        closed_h, loop_src, coords, y0v, yd0v, extra_out = parts(
             system, pvals, y0v, yd0v, float(cond_limit), units, descriptions)
         independent = tuple(coords)
     lay = layout(coords, pvals, system.input_names, chosen, y0v, yd0v, units, descriptions,
@@ -300,6 +299,58 @@ def _closed_parts(system: System, pvals: Mapping[str, float], y0v: list[float],
         out.append((f"Phi.{label}", None, f"closure residual: the constraint row {label}"))
     return (head, loop_src, coords, [float(asm.z[i]) for i in ind],
             [float(asm.zd[i]) for i in ind], out)
+
+
+def _general_parts(system: System, pvals: Mapping[str, float], y0v: list[float],
+                   yd0v: list[float], cond_limit: float, units: Mapping[str, str],
+                   descriptions: Mapping[str, str]) -> tuple:
+    """A general system's (velocity constraints) model.h part, the source of jd_loop.c
+    (:func:`jourdain.loops.general_kernel.general_source` and ``general.c``), the independent
+    coordinates with their start values and the further outputs (dependent coordinates and
+    rates, every row's residual): the partition chosen at the initial state, which the FMU
+    keeps; speeds that are rates of independent coordinates only."""
+    from ...loops.general import GeneralEvaluator
+    from ...loops.general_kernel import general_source, supported
+
+    tree = system.tree
+    try:
+        ev = GeneralEvaluator(system, y0v, 0.0, dict(pvals))
+        if not supported(ev):
+            raise ClosedSystemError(system, "the FMU of a system with velocity constraints "
+                                    "needs speeds that are rates of independent coordinates "
+                                    "(speeds=[names])")
+        s0 = ev.accelerations(ev.initial(y0v, yd0v, 0.0), 0.0)
+        con = system.constraints()
+        src = general_source(system)
+    except ClosedSystemError:
+        raise
+    except JourdainError as exc:
+        raise ModelError(f"{system.name!r} cannot be exported as an FMU: {exc}") from None
+    loop_src = (src + "\n/* ---- the FMU's adapter (jourdain/io/fmu/general.c) ---- */\n"
+                + (_HERE / "general.c").read_text())
+    ch = ev.choice
+    all_names = tree.coordinate_names
+    ind, dep = list(ch.independent), list(ch.dependent)
+    head = (_closed_header(tree.f, con.r, ind, dep, ch.rows_h, [float(v) for v in s0["y"]],
+                           ev.newton_tol, ev.max_newton, 1e300)
+            + f"#define JD_NPOS {con.Phi.shape[0]}\n#define JD_NSPD {len(ch.speeds)}\n"
+            + _array("long", "jd_rows_v", ch.rows_v)
+            + _array("long", "jd_spd", ch.speed_coordinates or ()))
+    coords = [all_names[i] for i in ind]
+    out: list[tuple[str, str | None, str]] = []
+    for i in dep:
+        c = all_names[i]
+        out.append((c, units.get(c), f"{descriptions.get(c, f'coordinate {c}')} (dependent: "
+                    "solved from the contacts' holonomic rows)"))
+    for i in dep:
+        c = all_names[i]
+        u = units.get(c)
+        out.append((f"{c}_d", f"{u}/s" if u else None, f"rate of {c} (dependent)"))
+    for k, label in enumerate(con.labels):
+        what = "Φ" if k < con.r_h else "A·ẏ + a"
+        out.append((f"Phi.{label}", None, f"residual of the row {label} ({what})"))
+    return (head, loop_src, coords, [float(s0["y"][i]) for i in ind],
+            [float(s0["yd"][i]) for i in ind], out)
 
 
 def _write_zip(out: Path, files: Mapping[str, bytes]) -> None:

@@ -146,6 +146,8 @@ static const char *jd_status_text(int status) {
                              "of the partition fixed at export (a singular position of the "
                              "mechanism, or one the independent coordinates cannot describe)";
     if (status == 13) return "M in the independent coordinates is not positive definite";
+    if (status == 15) return "the velocity rows of the contacts are singular or redundant with "
+                             "the speeds here (W = [E_z; A] singular)";
     if (status == 14) return "Newton's solution of the dependent coordinates left the branch "
                              "of the motion (a correction far beyond the first-order "
                              "prediction: near a singular position, or a step too large)";
