@@ -114,6 +114,9 @@ def test_run_reports_the_self_stable_range(capsys: pytest.CaptureFixture,
     assert "stable v range about straight: 4.2924 – 6.0243" in out
     html = (tmp_path / "rep" / "report.html").read_text(encoding="utf-8")
     assert "<h2>6. Contacts</h2>" in html
+    # the 3-D view draws the wheels: a cylinder of each disc's radius about its axle
+    assert "cylinder&quot;,&quot;size&quot;:[0.3," in html
+    assert "cylinder&quot;,&quot;size&quot;:[0.35," in html
     rows = np.loadtxt(tmp_path / "rep" / "stability-straight.csv", delimiter=",", skiprows=1)
     assert rows.shape[0] == 101
     bounds = [float(x) for x in html.split("(boundaries ")[1].split(" by")[0].split(", ")]

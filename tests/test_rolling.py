@@ -196,3 +196,18 @@ def test_the_c_kernel_runs_the_motion_of_the_numpy_path() -> None:
     assert np.max(np.abs(runs[0].y - runs[1].y)) <= 1e-7 * scale
     lam = runs[1].constraints.multipliers
     assert np.max(np.abs(runs[0].constraints.multipliers - lam)) <= 1e-6 * np.max(np.abs(lam))
+
+
+def test_the_rolling_disc_example_finds_the_critical_spin(tmp_path) -> None:
+    """examples/rolling_disc.toml: `jourdain run` gives the stable spin range from
+    Ω = √(g/(3r)) (the boundary by stability_boundary) to the sweep's end."""
+    from pathlib import Path
+
+    from jourdain.cli import main
+
+    path = Path(__file__).resolve().parents[1] / "examples" / "rolling_disc.toml"
+    assert main(["run", str(path), "--out", str(tmp_path / "r"), "--t-end", "0.5"]) == 0
+    html = (tmp_path / "r" / "report.html").read_text(encoding="utf-8")
+    bounds = [float(x) for x in html.split("(boundaries ")[1].split(" by")[0].split(", ")]
+    ref = np.sqrt(9.81 / (3 * 0.5))
+    assert len(bounds) == 1 and abs(bounds[0] - ref) <= 1e-9 * ref

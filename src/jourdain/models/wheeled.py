@@ -60,8 +60,8 @@ def differential_drive(speeds: str = "body") -> System:
     (the terms in ``b`` as Chaplygin's sleigh's). The ground's forces on the wheels: along the
     heading, from each wheel's spin ``Jw·θ̈_i = τ_i − r·F_i``, ``F_i = (τ_i − Jw·θ̈_i)/r``;
     across it, only their sum is determined (a rigid axle: the two lateral rows are one),
-    ``F_lat = (mc + 2·mw)·v·w + mc·b·ẇ`` (jourdain puts it on the lateral rows its rank test
-    keeps, which depend on the heading: the split between the wheels is not physical). Free
+    ``F_lat = (mc + 2·mw)·v·w + mc·b·ẇ`` (jourdain shares it evenly between the wheels, the
+    least-norm multipliers, and names the rows in ``contacts_undetermined``). Free
     wheels with ``b = 0`` turn steadily
     (``v̇ = ẇ = 0``) with the centripetal force ``(mc + 2·mw)·v·w``.
     """

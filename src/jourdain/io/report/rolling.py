@@ -177,17 +177,30 @@ def _sweep(run: Run, nom: Any, lin: Any) -> str:
         return ""
     top = 2.0 * float(lin.parameters[name]) or 1.0
     values = np.linspace(0.0, top, SWEEP_POINTS)
-    real, verdicts, rows = [], [], []
+    lams, verdicts = [], []
     for v in values:
-        other = lin.at({name: float(v)})
-        real.append(np.asarray(other.eigenvalues).real)
+        try:
+            other = lin.at({name: float(v)})
+        except JourdainError as exc:
+            run.info.notes.append(f"{nom.name} over {name}: {exc}")
+            return note(f"the eigenvalues over {name} are not available: {exc}")
+        lams.append(np.asarray(other.eigenvalues, complex))
         verdicts.append(stability(other).verdict)
-        rows.append([v, *np.asarray(other.eigenvalues).real, *np.asarray(other.eigenvalues).imag])
-    bounds = _stable_range(lin, name, values, verdicts)
+    # η may lose a decoupled cyclic speed at some values (a disc not spinning): NaN-padded
+    n = max(len(x) for x in lams)
+    lam = np.full((len(values), n), np.nan + 0j)
+    for i, x in enumerate(lams):
+        lam[i, :len(x)] = x
+    real = list(lam.real)
+    try:
+        bounds = _stable_range(lin, name, values, verdicts)
+    except JourdainError as exc:
+        run.info.notes.append(f"{nom.name}: stability boundary over {name}: {exc}")
+        bounds = []
     fn = run.out / f"stability-{nom.name}.csv"
-    n = len(real[0])
     head = ",".join([name, *(f"re{i}" for i in range(n)), *(f"im{i}" for i in range(n))])
-    np.savetxt(fn, np.array(rows), delimiter=",", header=head, comments="")
+    np.savetxt(fn, np.column_stack([values, lam.real, lam.imag]), delimiter=",", header=head,
+               comments="")
     run.info.files.append(fn)
     xs = np.repeat(values, n)
     fig = run.figures.add(sweep_plot, xs, np.concatenate(real), name, bounds,

@@ -22,6 +22,7 @@ if TYPE_CHECKING:
 
 from .poses import _system
 from .scene import scene
+from .visuals import contact_visuals
 
 
 @dataclass(frozen=True)
@@ -179,8 +180,14 @@ def view(results: Results | Any, *, visuals: Any = None,
 
 def model_visuals(model: Any) -> Any:
     """The visuals of a model for the ``visuals`` hook: its ``visual_geometry`` (a URDF model's
-    ``<visual>`` elements, every kind) where it has them, else its ``visuals``, else None."""
-    return getattr(model, "visual_geometry", None) or getattr(model, "visuals", None)
+    ``<visual>`` elements, every kind) where it has them, else its ``visuals``, else None; a
+    model with rolling discs has its wheels drawn as cylinders (:func:`contact_visuals`)."""
+    own = getattr(model, "visual_geometry", None) or getattr(model, "visuals", None)
+    system = getattr(model, "system", None)
+    if system is None or not getattr(system, "contacts", ()):
+        return own
+    wheels = contact_visuals(system, system.parameter_values)  # rolling discs as wheels
+    return {**wheels, **dict(own or {})}
 
 
 def report_section(results: Results, model: Any = None) -> str:

@@ -196,3 +196,28 @@ def _numeric(val: Any) -> bool:
     except (TypeError, ValueError):
         return False
     return True
+
+
+def contact_visuals(system: Any, values: Mapping[str, float]) -> dict[str, list[Visual]]:
+    """A cylinder for each rolling disc of ``system`` (its wheel drawn as what touches the
+    ground: radius ``radius + tube_radius``, width a tenth of it, about the axle at the
+    disc's centre), by body name."""
+    import symengine as se
+
+    out: dict[str, list[Visual]] = {}
+    subs = {se.Symbol(k): v for k, v in values.items()}
+    for c in getattr(system, "contacts", ()):
+        if not hasattr(c, "radius"):
+            continue
+        R = float(se.sympify(c.radius + c.tube_radius).subs(subs))
+        a = np.array([float(se.sympify(x).subs(subs)) for x in c.axis])
+        a /= np.linalg.norm(a)
+        e = np.eye(3)[0] if abs(a[0]) < 0.9 else np.eye(3)[1]
+        u = e - (e @ a) * a
+        u /= np.linalg.norm(u)
+        rot = np.column_stack([u, np.cross(a, u), a])
+        centre = tuple(float(se.sympify(x).subs(subs)) for x in c.center)
+        out.setdefault(c.body, []).append(Visual(
+            "cylinder", size=(R, 0.1 * R), position=centre,  # type: ignore[arg-type]
+            rotation=tuple(tuple(float(v) for v in row) for row in rot)))
+    return out
