@@ -232,13 +232,53 @@ int jd_gen_accel(const double *y, const double *yd, double t, const double *p,
     return 0;
 }
 
+/* the multipliers of A^T lam = r when every row is independent (the kept rows are all rows):
+ * (A A^T) lam = A r by Cholesky (mv <= n); 0, or 1 (then lam is left to the caller: NaN) */
+static int jdg_lambda(long n, long mv, const double *A, const double *r, double *G2,
+                      double *lam) {
+    for (long i = 0; i < mv; ++i) {
+        double s = 0.0;
+        for (long k = 0; k < n; ++k) s += A[i * n + k] * r[k];
+        lam[i] = s;
+        for (long j = 0; j <= i; ++j) {
+            double v = 0.0;
+            for (long k = 0; k < n; ++k) v += A[i * n + k] * A[j * n + k];
+            G2[i * mv + j] = v;
+        }
+    }
+    for (long j = 0; j < mv; ++j) {
+        double d = G2[j * mv + j];
+        for (long k = 0; k < j; ++k) d -= G2[j * mv + k] * G2[j * mv + k];
+        if (!(d > 0.0)) return 1;
+        d = sqrt(d);
+        G2[j * mv + j] = d;
+        for (long i = j + 1; i < mv; ++i) {
+            double v = G2[i * mv + j];
+            for (long k = 0; k < j; ++k) v -= G2[i * mv + k] * G2[j * mv + k];
+            G2[i * mv + j] = v / d;
+        }
+    }
+    for (long i = 0; i < mv; ++i) {
+        double v = lam[i];
+        for (long k = 0; k < i; ++k) v -= G2[i * mv + k] * lam[k];
+        lam[i] = v / G2[i * mv + i];
+    }
+    for (long i = mv - 1; i >= 0; --i) {
+        double v = lam[i];
+        for (long k = i + 1; k < mv; ++k) v -= G2[k * mv + i] * lam[k];
+        lam[i] = v / G2[i * mv + i];
+    }
+    return 0;
+}
+
 /* states x (N rows of stride sx: y_i, yd_i) at times t -> out rows: y (n), yd (n), ydd (n),
- * the residual r = M ydd + k - q (n), Phi (mh), A yd + a (mv); the index of the first that
- * failed, or -1 */
+ * the residual r = M ydd + k - q (n), Phi (mh), A yd + a (mv), the multipliers (mv; NaN
+ * where rows are redundant: the caller's least-norm solve); the index of the first that
+ * failed, or -1. G2: mv * mv doubles of scratch */
 long jd_gen_samples(jd_gen *G, long N, const double *t, const double *x, long sx,
-                    const double *u, double *out) {
+                    const double *u, double *out, double *G2) {
     long n = G->n, g = G->g, mh = G->mh, mv = G->mv, ni = G->ni;
-    long w = 4 * n + mh + mv;
+    long w = 4 * n + mh + 2 * mv;
     for (long s = 0; s < N; ++s) {
         double *o = out + s * w;
         double *ydf, *L, *gam, *tree, *zd, *vel;
@@ -269,6 +309,9 @@ long jd_gen_samples(jd_gen *G, long N, const double *t, const double *x, long sx
             for (long j = 0; j < n; ++j) v += A[i * n + j] * ydf[j];
             o[4 * n + mh + i] = v;
         }
+        double *lam = o + 4 * n + mh + mv;
+        if (n - g != mv || jdg_lambda(n, mv, A, o + 3 * n, G2, lam))
+            for (long i = 0; i < mv; ++i) lam[i] = NAN;
     }
     return -1;
 }

@@ -28,7 +28,7 @@ from ..numeric.toolchain import build, build_lock, content_key
 from ..simulation.problem import address
 from .general import GeneralEvaluator, general_constraints
 
-_VERSION = "general-c1"
+_VERSION = "general-c2"
 REASONS = {1: "Newton found no configuration with the holonomic rows satisfied",
            2: "the velocity rows are singular or redundant with the speeds (W singular)",
            3: "M in the speeds is not positive definite"}
@@ -70,7 +70,7 @@ def _general_library(system: System) -> ctypes.CDLL:
     lib.jd_gen_work.restype = lg
     lib.jd_gen_work.argtypes = [lg, lg, lg, lg]
     lib.jd_gen_samples.restype = lg
-    lib.jd_gen_samples.argtypes = [vp, lg, vp, vp, lg, vp, vp]
+    lib.jd_gen_samples.argtypes = [vp, lg, vp, vp, lg, vp, vp, vp]
     return lib
 
 
@@ -127,19 +127,23 @@ class GeneralKernel:
 
     def samples(self, t: np.ndarray, x: np.ndarray) -> tuple[dict[str, np.ndarray], int]:
         """States ``x`` (N × ≥2·n_i: y_i, ẏ_i) at ``t``: ``y, yd, ydd, r`` (the tree's residual
-        ``M·ÿ + k − q``), ``Phi``, ``Phi_dot`` (every row's ``A·ẏ + a``), N rows each, and the
-        index of the first that failed (-1: none; NaN from there)."""
+        ``M·ÿ + k − q``), ``Phi``, ``Phi_dot`` (every row's ``A·ẏ + a``), ``lam`` (the
+        multipliers where every row is independent, else NaN), N rows each, and the index of
+        the first that failed (-1: none; NaN from there)."""
         n, mh, mv = self.n, self.mh, self.mv
         t = np.ascontiguousarray(t, dtype=float)
         x = np.ascontiguousarray(x, dtype=float)
-        N, w = t.size, 4 * n + mh + mv
+        N, w = t.size, 4 * n + mh + 2 * mv
         out = np.full((N, w), np.nan)
+        scratch = np.zeros(max(mv * mv, 1))
         bad = int(self.lib.jd_gen_samples(self.state_address, N, address(t), address(x),
-                                          x.shape[1], address(self.ev.u), address(out)))
+                                          x.shape[1], address(self.ev.u), address(out),
+                                          address(scratch)))
         if bad >= 0:
             out[bad:] = np.nan
         cols = {"y": (0, n), "yd": (n, 2 * n), "ydd": (2 * n, 3 * n), "r": (3 * n, 4 * n),
-                "Phi": (4 * n, 4 * n + mh), "Phi_dot": (4 * n + mh, w)}
+                "Phi": (4 * n, 4 * n + mh), "Phi_dot": (4 * n + mh, 4 * n + mh + mv),
+                "lam": (4 * n + mh + mv, w)}
         return {k: out[:, a:b] for k, (a, b) in cols.items()}, bad
 
     def __getstate__(self) -> Any:  # ctypes structures do not pickle

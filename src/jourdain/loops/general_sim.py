@@ -190,7 +190,9 @@ def _simulate_c(system: System, ev: GeneralEvaluator, span: tuple[float, float],
         smp = {key: v[:bad] for key, v in smp.items()}
         status, message = "failed", f"no configuration at t = {float(seg.out_t[bad]):.6g}"
     N = len(T)
-    lam = _multipliers(ev, T, smp["y"], smp["yd"], smp["r"])
+    lam = smp["lam"]
+    if N and np.isnan(lam).any():  # redundant rows: the least-norm multipliers
+        lam = _multipliers(ev, T, smp["y"], smp["yd"], smp["r"])
     phi = np.zeros((N, len(ev.labels)))
     phi[:, :smp["Phi"].shape[1]] = smp["Phi"]
     cons = ConstraintHistories(tuple(ev.labels), phi, smp["Phi_dot"], lam,
@@ -201,8 +203,8 @@ def _simulate_c(system: System, ev: GeneralEvaluator, span: tuple[float, float],
                   rtol=rtol, atol=atol, status=status, message=message, nfev=int(cnt[0]),
                   nsteps=int(cnt[1]), n_accepted=int(cnt[2]), n_rejected=int(cnt[3]),
                   wall_time=time.perf_counter() - start, constraints=cons)
-    if N > 1:
-        res.W = _work(res, system.tree, parameters, None, system)
+    if N > 1:  # the power's integral along the integrator's own steps (it integrates W)
+        res.W = np.array(seg.out_x[:N, -1]) - float(state[-1])
     if output is not None:
         res.save(output)
     return res
