@@ -211,3 +211,27 @@ def test_the_rolling_disc_example_finds_the_critical_spin(tmp_path) -> None:
     bounds = [float(x) for x in html.split("(boundaries ")[1].split(" by")[0].split(", ")]
     ref = np.sqrt(9.81 / (3 * 0.5))
     assert len(bounds) == 1 and abs(bounds[0] - ref) <= 1e-9 * ref
+
+
+def test_a_top_in_body_fixed_angular_velocities() -> None:
+    """Speeds by definition on a tree (no contact): the heavy top's body-fixed angular
+    velocity components ω = J_R·ψ̇ (its kinematics' ``omega``) as z. Then M is the inertia
+    about the pivot in the body's principal axes, diag(A + m·L², A + m·L², C), and the motion
+    in z is the motion in Euler angles of the tree."""
+    from jourdain.models.classic import heavy_top
+
+    top = heavy_top()
+    omega = jd.kinematics(top)["top"].omega
+    speeds = {f"w{i + 1}": omega.rows[i][0] for i in range(3)}
+    gen = jd.System(top.coordinates, top.bodies, top.forces, dict(top.parameters),
+                    name="top in body speeds", speeds=speeds)
+    p = top.parameter_values
+    y0, yd0 = [0.2, 0.6, 0.1], [0.5, 0.3, 40.0]
+    out = gen.evaluate(y0, yd0)
+    T = p["A"] + p["m"] * p["L"] ** 2
+    ref = np.diag([T, T, p["C"]])
+    assert np.max(np.abs(out["M"] - ref)) <= 100 * EPS * T
+    a = gen.simulate((0.0, 0.5), y0, yd0, rtol=1e-11, atol=1e-12, t_eval=[0.25, 0.5])
+    b = top.simulate((0.0, 0.5), y0, yd0, rtol=1e-11, atol=1e-12, t_eval=[0.25, 0.5])
+    assert a.status == "finished" and np.max(np.abs(a.y - b.y)) <= 1e-8
+    assert np.max(np.abs(a.yd - b.yd)) <= 1e-6

@@ -107,7 +107,7 @@ class Functions:
             out = self.con_fn.split(self.con_fn.raw(y, yd, t, p, u))
             if tree:
                 out.update(self.tree_fn.split(self.tree_fn.raw(y, yd, t, p, u)))
-            return out
+            return self._shaped(out, len(y))
         x = np.concatenate([y, yd, [t], p, u]).astype(complex)
         out = {}
         for names, shapes, fn in self.parts if tree else self.parts[:1]:
@@ -116,6 +116,15 @@ class Functions:
             for n, (r, c) in zip(names, shapes, strict=True):
                 out[n] = flat[i:i + r * c].reshape(r, c)
                 i += r * c
+        return self._shaped(out, len(y))
+
+    @staticmethod
+    def _shaped(out: dict[str, np.ndarray], n: int) -> dict[str, np.ndarray]:
+        """Rows × columns also where there are no rows (a system without holonomic rows, or
+        with speeds but no contact: (0, n) and (0, 1), never (0, 0))."""
+        for k, v in out.items():
+            if v.size == 0:
+                out[k] = v.reshape(0, n if k in ("Phi_y", "A", "Y") else 1)
         return out
 
 
