@@ -157,10 +157,14 @@ def choose(system: System, fn: dict[str, np.ndarray]) -> Choice:
     f = len(names)
     bad = [k for k in ("Phi", "Phi_y", "A", "a") if not np.all(np.isfinite(fn[k]))]
     if bad:
+        labels = general_constraints(system).labels
+        rows = np.concatenate([np.isfinite(fn["A"]).all(axis=1),
+                               np.ones(len(labels) - fn["A"].shape[0], bool)])
+        named = sorted({labels[i].split(".")[0] for i in range(len(labels)) if not rows[i]})
         raise SingularConfiguration(
-            f"{system.name}: the rows of {', '.join(c.name for c in system.contacts)} are not "
-            f"defined at this state ({', '.join(bad)} not finite: a disc lying flat on the "
-            "ground has no contact point, a knife edge along the normal no direction)")
+            f"{system.name}: the rows of {', '.join(named or [c.name for c in system.contacts])}"
+            f" are not defined at this state ({', '.join(bad)} not finite: a disc lying flat on "
+            "the ground has no contact point, a knife edge along the normal no direction)")
     Pz = np.real(fn["Phi_y"])
     if Pz.shape[0]:
         part = partition(system, Pz, system.independent)
