@@ -27,6 +27,7 @@ from .forces import (
     elongation_d,
     rate,
 )
+from .friction import JointFriction
 from .joints import (
     Cylindrical,
     Fixed,
@@ -60,7 +61,7 @@ __all__ = [
     "Force", "GeneralizedForce", "Gravity", "RotationalSpringDamper", "SpringDamper", "Torque",
     "acceleration", "elongation", "elongation_d", "rate", "Bushing", "deflection", "deflection_d",
     "Quantity", "angular_velocity", "distance", "distance_rate", "point_acceleration", "position",
-    "relative_position", "relative_velocity", "velocity",
+    "relative_position", "relative_velocity", "velocity", "JointFriction",
     "Cylindrical", "Fixed", "Free", "General", "Joint", "Planar", "Prismatic", "Revolute", "Rot",
     "Spherical", "Trans", "Universal", "System",
 ]

@@ -29,6 +29,7 @@ from .forces import (
     acceleration,
     rate,
 )
+from .friction import JointFriction, check_frictions, split_frictions
 from .quantities import Quantity, quantities_in
 from .validation import force_expressions, parents_first, validate
 
@@ -65,6 +66,8 @@ class System:
         Gravity, Force, Torque, SpringDamper, GeneralizedForce (RotationalSpringDamper),
         Bushing. Their laws may use kinematic quantities
         (:mod:`jourdain.model.quantities`), found from their symbols: :attr:`quantities`.
+        :class:`~jourdain.model.friction.JointFriction` elements (friction from the reactions)
+        are kept apart, as :attr:`frictions`.
     parameters : mapping name -> default value
         Every symbol in the model other than coordinates, rates, inputs and ``t``.
     inputs : sequence of symbols or names
@@ -103,9 +106,10 @@ class System:
     independent: tuple[str, ...] | None = None
     contacts: tuple[Contact, ...] = ()
     speeds: tuple[tuple[str, se.Basic], ...] | None = None
+    frictions: tuple[JointFriction, ...] = ()
 
     def __init__(self, coordinates: Sequence[object] | str, bodies: Sequence[Body],
-                 forces: Sequence[ForceElement] = (), parameters: Mapping[str, float] | None = None,
+                 forces: Sequence[ForceElement | JointFriction] = (), parameters: Mapping[str, float] | None = None,
                  inputs: Sequence[object] | str = (), units: Mapping[str, str] | None = None,
                  name: str = "system", closing: Sequence[ClosingJoint] = (),
                  independent: Sequence[str] | None = None, contacts: Sequence[Contact] = (),
@@ -137,7 +141,7 @@ class System:
         for b in bodies:
             if not isinstance(b, Body):
                 raise ModelError(f"bodies: expected Body objects, got {type(b).__name__} {b!r}")
-        forces = list(forces)
+        forces, frictions = split_frictions(list(forces))
         for f in forces:
             if not isinstance(f, Gravity | Force | Torque | SpringDamper | GeneralizedForce
                               | Bushing):
@@ -151,6 +155,7 @@ class System:
         set_(self, "contacts", _contacts(self, contacts))
         set_(self, "independent", _independent(self, independent))
         set_(self, "speeds", _speeds(self, speeds))
+        set_(self, "frictions", check_frictions(self, frictions))
 
     def __hash__(self) -> int:
         """The hash of the fields, computed once: the memoized stages (``mkq_function(system)``
@@ -204,8 +209,9 @@ class System:
         """This tree closed by the ``closing`` joints (a new system of the same class), with
         the ``independent`` coordinates chosen (else by the partition at the initial
         configuration)."""
-        return type(self)(self.coordinates, self.bodies, self.forces, dict(self.parameters),
-                          self.inputs, dict(self.units), self.name if name is None else name,
+        return type(self)(self.coordinates, self.bodies, (*self.forces, *self.frictions),
+                          dict(self.parameters), self.inputs, dict(self.units),
+                          self.name if name is None else name,
                           closing=(*self.closing, *closing), independent=independent,
                           contacts=self.contacts, speeds=_speed_arg(self.speeds))
 

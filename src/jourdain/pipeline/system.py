@@ -17,8 +17,9 @@ from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 
+from ..analysis.friction import evaluate_friction
 from ..analysis.reactions import evaluate_keys
-from ..errors import refuse_closed
+from ..errors import ModelError, refuse_closed
 from ..model.system import System as Model
 from ..numeric import evaluate as evaluate_eom
 from ..numeric.linearization import Linearization, linearization  # with its numbers
@@ -124,6 +125,11 @@ class System(Model):
         equilibrium at rest, else central differences of the compiled M, k, q on the
         manifold); about a motion (expressions of t) or in a rheonomic system, a time-variant
         :class:`jourdain.loops.periodic.ClosedLinearization` (``jd.floquet``)."""
+        if self.frictions:
+            names = ", ".join(f.name for f in self.frictions)
+            raise ModelError(f"{self.name}: joint friction ({names}) depends on the reaction "
+                             "forces and is not linearized; system.evaluate(y, yd) gives its "
+                             "numbers at a state")
         if self.is_general:
             from ..loops.general_linear import linearize_general
 
@@ -148,7 +154,12 @@ class System(Model):
         (:func:`jourdain.analysis.reactions.evaluate_reactions`; only ``reactions_error`` where
         the model's reactions cannot be formed). ``parameters`` overrides default values by
         name; ``inputs`` gives the inputs by name (or in the order of :attr:`input_names`).
+        With joint friction, the friction forces are solved with the reactions (and are in
+        ``q_e``, ``q``, ``q_hat``, ``g``; also ``q_f``, ``ydd``, ``friction``:
+        :func:`jourdain.analysis.friction.evaluate_friction`).
         """
+        if self.frictions:
+            return evaluate_friction(self, y, yd, t, parameters, inputs)
         if self.is_general:  # velocity constraints (METHOD §7): jourdain.loops.general
             from ..loops.general_eval import evaluate_general
 

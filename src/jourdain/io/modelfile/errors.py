@@ -144,7 +144,8 @@ class Locator:
             for b, j in self.joint_of_body.items():
                 if j == m.group(1):
                     found.append((m.start(), ("bodies", b, "joint")))
-        for m in re.finditer(r'(?:force|spring-damper|torque|bushing) "(\w+)"', message):
+        for m in re.finditer(r'(?:force|spring-damper|torque|bushing|joint friction) "(\w+)"',
+                             message):
             found.append((m.start(), ("forces", m.group(1))))
         for m in re.finditer(r'quantity "(\w+)"', message):
             found.append((m.start(), ("quantities", m.group(1))))

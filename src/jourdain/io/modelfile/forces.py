@@ -16,11 +16,13 @@ from ...model import (
     Force,
     GeneralizedForce,
     Gravity,
+    JointFriction,
     RotationalSpringDamper,
     SpringDamper,
     Torque,
 )
 from ...model.forces import BUSHING_COMPONENTS
+from ...model.friction import V_EPS
 from ...model.joints import orientation_problem
 from ...model.quantities import KINDS as QUANTITY_KINDS
 from ...model.quantities import declare as declare_quantity
@@ -110,6 +112,8 @@ class _Forces(_Bodies):
                     rest_length=e("rest_length", 0), law=law)
             if ftype == "bushing":
                 return self.bushing(fname, spec, p, body, e, params, pctx, allowed)
+            if ftype == "joint_friction":
+                return self.joint_friction(fname, spec, p)
             defl = allowed | {"deflection", "deflection_d"}
             vctx = ("a generalized force (deflection, deflection_d, coordinates, rates, "
                     "parameters, inputs, t and kinematic quantities)")
@@ -142,6 +146,31 @@ class _Forces(_Bodies):
                                                    | set(self.quantity_symbols)):
             raise self.fail((*p, "coordinate"), f'"{value}" depends on no coordinate')
         return e
+
+    def joint_friction(self, fname: str, spec: dict, p: Path) -> JointFriction:
+        """A ``type = "joint_friction"`` force table: Coulomb friction in a joint from its
+        reaction forces (:mod:`jourdain.model.friction`)."""
+        joints = list(self.joint_of_body.values())
+        joint = self.string(self.require(spec, "joint", p), (*p, "joint"))
+        if joint not in joints:
+            raise self.fail((*p, "joint"), f'unknown joint "{joint}"'
+                            f"{self.suggest(joint, joints)}; joints are {', '.join(joints)}")
+        normal = self.require(spec, "normal", p)
+        items = normal if isinstance(normal, list) else [normal]
+        if not items:
+            raise self.fail((*p, "normal"), "expected a reaction component or a list of them")
+        names = [self.string(v, (*p, "normal", i) if isinstance(normal, list) else
+                             (*p, "normal")) for i, v in enumerate(items)]
+        coordinate = None
+        if "coordinate" in spec:
+            coordinate = self.coordinate(spec["coordinate"], (*p, "coordinate"), drive=False)
+        params = set(self.params)
+        ctx = "joint friction (parameters only)"
+        return JointFriction(
+            fname, joint, self.expr(self.require(spec, "mu", p), (*p, "mu"), params, ctx),
+            names, coordinate,
+            radius=self.expr(spec.get("radius", 1), (*p, "radius"), params, ctx),
+            v_eps=self.expr(spec.get("v_eps", V_EPS), (*p, "v_eps"), params, ctx))
 
     def bushing(self, fname: str, spec: dict, p: Path, body: Callable, e: Callable,
                 params: set[str], pctx: str, allowed: set[str]) -> Bushing:

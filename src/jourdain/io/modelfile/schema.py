@@ -36,6 +36,7 @@ _FORCE_KEYS: dict[str, set[str]] = {
     "rotational_spring_damper": {"coordinate", "stiffness", "damping", "rest_angle"},
     "bushing": {"body_a", "point_a", "body_b", "point_b", "frame", "stiffness", "damping",
                 "preload", "laws", "axes_a", "axes_b"},
+    "joint_friction": {"joint", "coordinate", "mu", "normal", "radius", "v_eps"},
 }
 #: keys of a [quantities.<name>] table, by its type (one point, or two points)
 _QUANTITY_KEYS_ONE = {"body", "point", "frame", "point_frame"}
