@@ -25,6 +25,11 @@ def has_capability(method: str) -> bool:
 def require(system: Any, method: str, what: str) -> Callable[..., Any]:
     """``system.<method>``; :class:`NotAvailable` naming ``what`` when this build lacks it."""
     fn = getattr(system, method, None)
+    frictions = getattr(system, "frictions", ())
+    if method == "linearize" and frictions:
+        raise NotAvailable(f"{what} is not available for joint friction "
+                           f"({', '.join(f.name for f in frictions)}): it depends on the "
+                           "reaction forces")
     if fn is None:
         raise NotAvailable(f"{what} is not available yet in this version of jourdain "
                            f"(System.{method} is missing)")

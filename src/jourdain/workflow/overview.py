@@ -45,7 +45,8 @@ def summary(model: Any) -> dict[str, Any]:
         "coordinates": system.coordinate_names, "bodies": system.body_names,
         "joints": joints, "constraints": constraints,
         "parameters": system.parameter_values, "inputs": system.input_names,
-        "forces": [{"name": f.name, "type": type(f).__name__} for f in system.forces],
+        "forces": [{"name": f.name, "type": type(f).__name__}
+                   for f in (*system.forces, *getattr(system, "frictions", ()))],
         "quantities": [{"name": q.name, "type": q.kind, "symbols": list(q.symbol_names),
                         "definition": q.describe()} for q in system.quantities],
         "nominal_motions": [n.name for n in model.nominal],
