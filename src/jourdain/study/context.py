@@ -109,6 +109,12 @@ def _build(spec: StudySpec) -> Context:
     comp = spec.compute
     if system.is_closed:
         _refuse_closed(spec, system)
+    if system.frictions and {"evaluate", "frequency_response"} & set(comp):
+        raise StudyError(f"{spec.filename}: joint friction "
+                         f"({', '.join(fr.name for fr in system.frictions)}) is solved with the "
+                         "reactions at every state: a study computes [compute.simulate] (one "
+                         "run per case) for it, not evaluate or frequency_response",
+                         spec.filename)
     if "evaluate" in comp:
         from ..numeric import dynamics_function
 
@@ -150,9 +156,9 @@ def _build(spec: StudySpec) -> Context:
             else:
                 exprs.append(se.Float(v))
         ctx.bounds = se.Lambdify(syms, exprs, real=True)
-    if "simulate" in comp and not ctx.closed:
-        # a closed system's runs are one System.simulate per case (the ensemble driver runs
-        # the tree's compiled equations only)
+    if "simulate" in comp and not ctx.closed and not system.frictions:
+        # a closed system's runs, and those with joint friction, are one System.simulate per
+        # case (the ensemble driver runs the tree's compiled equations only)
         ctx.ensemble = _ensemble(ctx)
     return ctx
 
