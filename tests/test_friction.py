@@ -317,3 +317,22 @@ def test_inputs_reach_the_friction_forces(push):
     res = s.simulate((0, 1), [0.0], [0.5], inputs={"F": push}, rtol=1e-10, atol=1e-12,
                      t_eval=[0, 0.5, 1])
     np.testing.assert_allclose(res.y[:, 0], 0.5 * res.t + a * res.t**2 / 2, rtol=1e-8)
+
+
+def test_a_study_runs_the_friction_per_case(tmp_path):
+    """A study of μ: each case is System.simulate with the friction (the ensemble driver's
+    compiled equations have none), the final positions at the closed form."""
+    pytest.importorskip("xarray")
+    pytest.importorskip("h5netcdf")
+    from jourdain.study import StudyError, loads_study, run_study
+
+    (tmp_path / "box.toml").write_text(BOX_TOML + "[simulation]\nyd0 = { x = 0.5 }\n")
+    study = ('[study]\nmodel = "box.toml"\ndesign = "grid"\n[vary.mu]\n'
+             "range = { start = 0.1, stop = 0.4, num = 4 }\n")
+    ds = run_study(loads_study(study + "[compute.simulate]\nt_end = 1.0\nsamples = 3\n"
+                               "rtol = 1e-10\natol = 1e-12\nfinal = true\n", base=tmp_path),
+                   workers=1)
+    mu = np.linspace(0.1, 0.4, 4)
+    np.testing.assert_allclose(ds.final.values[:, 0], 0.5 + (10.0 / 2.0 - mu * G) / 2, rtol=1e-8)
+    with pytest.raises(StudyError, match="joint friction"):
+        run_study(loads_study(study + "[compute.evaluate]\n", base=tmp_path), workers=1)
