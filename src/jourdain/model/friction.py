@@ -22,7 +22,10 @@ D·φ)|``, piecewise linear for single components, solved by Newton's method (ex
 signs of the normal components settle; a few steps), then ÿ from ``M·ÿ + k = q + q_f``.
 Where ``μ·r·|∂N/∂φ| ≥ 1`` the friction force is not determined by the normal force it makes
 (Painlevé's paradox): the evaluation stops with an error naming the elements. The numbers are
-:mod:`jourdain.analysis.friction`'s (``System.evaluate``, ``System.simulate``).
+:mod:`jourdain.analysis.friction`'s (``System.evaluate``, ``System.simulate``/``jd.simulate``,
+parameter studies' runs); ``System.linearize`` refuses the element, and what works on the
+symbolic equations or on the model's own compiled ones (``equations_of_motion``,
+``jd.evaluate_reactions``, ``jd.joint_reactions``) holds the other forces only.
 
 **Stick–slip: regularized.** ``sign(ċ)`` is replaced by ``tanh(ċ/v_eps)`` (``v_eps``: a
 parameter of the element, default ``1e-3`` in the coordinate's units per second). A joint at
