@@ -7,11 +7,13 @@ import argparse
 import sys
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
+from typing import Any
 
 from ..errors import JourdainError
 from ..io import capabilities as integration
 from ..io.fmu import export_fmu
-from ..io.report import write_report
+from ..io.interrupted import mark_results
+from ..io.report import mark_report, write_report
 from ..io.report.figures import prepare_worker
 from ..io.workers import fork_workers, stop_workers
 from ..simulation.simulate import OUTPUT_SUFFIXES
@@ -34,6 +36,16 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     params = overrides(system, args.set)
     opts = sim_options(model, args)
     out = output_file(args.out, args.force, OUTPUT_SUFFIXES) if args.out else None
+    try:
+        return _simulate(args, model, params, opts, out)
+    except KeyboardInterrupt:  # after the run's own handling: the file says so too
+        mark_results(out, "after the run, as its results were saved or shown")
+        raise
+
+
+def _simulate(args: argparse.Namespace, model: Any, params: dict[str, float],
+              opts: dict[str, Any], out: Path | None) -> int:
+    system = model.system
     progress = progress_printer(args.progress, f"simulating {system.name}")
     failure: JourdainError | None = None
     try:
@@ -103,6 +115,25 @@ def _run(args: argparse.Namespace, pool: ProcessPoolExecutor | None) -> int:
         study = load_study(args.study, model=model.path)
     progress = progress_printer(args.progress, f"simulating {model.system.name}")
     try:
+        info = _report(args, model, out, params, opts, study, pool, progress)
+    except KeyboardInterrupt:  # after the report's own handling: its files say so too
+        mark_report(out, model, "as the report was written or shown")
+        raise
+    if info.status == "interrupted":
+        print(f"jourdain run: {info.message}; the report holds what was computed",
+              file=sys.stderr)
+        return EXIT_INTERRUPTED
+    if info.status == "failed":
+        print(f"jourdain run: error: {info.message}", file=sys.stderr)
+        return EXIT_MODEL
+    return EXIT_OK
+
+
+def _report(args: argparse.Namespace, model: Any, out: Path, params: dict[str, float],
+            opts: dict[str, Any], study: Any, pool: ProcessPoolExecutor | None,
+            progress: Any) -> Any:
+    """The report (:func:`write_report`) and its summary on the terminal."""
+    try:
         info = write_report(model, out, parameters=params, t_end=opts.get("t_end"),
                             max_ops=args.max_ops, progress=progress or False,
                             parallel=True, study=study, figure_pool=pool)
@@ -112,14 +143,7 @@ def _run(args: argparse.Namespace, pool: ProcessPoolExecutor | None) -> int:
     for line in info.summary_lines:
         print(line)
     print(f"report: {info.html}")
-    if info.status == "interrupted":
-        print(f"jourdain run: {info.message}; the report holds what was computed",
-              file=sys.stderr)
-        return EXIT_INTERRUPTED
-    if info.status == "failed":
-        print(f"jourdain run: error: {info.message}", file=sys.stderr)
-        return EXIT_MODEL
-    return EXIT_OK
+    return info
 
 
 def cmd_fmu(args: argparse.Namespace) -> int:

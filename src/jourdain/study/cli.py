@@ -58,6 +58,15 @@ def cmd_study(args: argparse.Namespace) -> int:
     from .report import study_page
 
     spec = load_study(args.spec, model=args.model)
+    started = time.time()
+    try:
+        return _study(args, spec, study_page, run_study)
+    except KeyboardInterrupt:  # Ctrl-C: the files written so far say so
+        mark_study(args.out, args.plots, started)
+        raise
+
+
+def _study(args: argparse.Namespace, spec: Any, study_page: Any, run_study: Any) -> int:
     t0 = time.perf_counter()
     ds = run_study(spec, args.out, workers=args.workers, scheduler=args.scheduler,
                    quiet=args.quiet, force=args.force, pool=args.pool, force_name="--force")
@@ -71,3 +80,52 @@ def cmd_study(args: argparse.Namespace) -> int:
     if args.plots:
         print(f"report: {study_page(ds, args.plots)}")
     return 0
+
+
+def mark_study(out: str | None, plots: str | None, started: float) -> None:
+    """The files of a study interrupted by Ctrl-C say so: the saved parts' manifest (how many
+    blocks are kept; the same command resumes from them), and the NetCDF file and the plots'
+    index.html where this run wrote them (modified since ``started``, a ``time.time()``)."""
+    import json
+    from pathlib import Path
+
+    from ..io.interrupted import deaf_to_ctrl_c, write_text
+
+    message = "interrupted by the user (Ctrl-C)"
+    with deaf_to_ctrl_c():
+        parts = Path(f"{out}.parts") if out else None
+        if parts is not None and (parts / "manifest.json").is_file():
+            try:
+                manifest = json.loads((parts / "manifest.json").read_text())
+            except (OSError, ValueError):
+                manifest = None
+            if isinstance(manifest, dict):
+                blocks = len(list(parts.glob("block-*.npz")))
+                manifest.update(status="interrupted", message=(
+                    f"{message}; {blocks} blocks of {manifest.get('n_cases', '?')} cases saved "
+                    "here: the same command resumes from them"))
+                write_text(parts / "manifest.json", json.dumps(manifest, indent=1))
+        if out and _since(Path(out), started):
+            import h5py
+
+            try:  # NetCDF-4 is HDF5: a global attribute
+                with h5py.File(out, "r+") as h:
+                    h.attrs["status"] = "interrupted"
+                    h.attrs["message"] = f"{message} after these results were written"
+            except OSError:
+                pass
+        page = Path(plots) / "index.html" if plots else None
+        if page is not None and _since(page, started):
+            text = page.read_text(encoding="utf-8")
+            if "Interrupted:" not in text:
+                at = text.find("</h1>")
+                text = (text[:at + 5] + f"<p><b>Interrupted:</b> {message}; the plots may be "
+                        "incomplete.</p>" + text[at + 5:]) if at >= 0 else text
+                write_text(page, text)
+
+
+def _since(path: Any, started: float) -> bool:
+    try:
+        return bool(path.is_file() and path.stat().st_mtime >= started - 1.0)
+    except OSError:
+        return False

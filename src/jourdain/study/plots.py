@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from ..io.interrupted import deferred_ctrl_c
 from .spec import StudyError
 
 __all__ = ["campbell_diagram", "histograms", "stability_map", "study_plots"]
@@ -122,10 +123,11 @@ def study_plots(ds: Any, folder: str | Path, prefix: str = "") -> list[Path]:
     """Write the plots that suit the study (stability map for grids of 2+ axes, Campbell
     diagram for grids with eigenvalues, histograms for list and random designs) to ``folder``
     as ``<prefix><name>.svg`` and ``.png``; returns the paths."""
-    import matplotlib
+    with deferred_ctrl_c():  # Ctrl-C after Matplotlib's C extensions are initialized
+        import matplotlib
 
-    matplotlib.use("Agg", force=False)
-    import matplotlib.pyplot as plt
+        matplotlib.use("Agg", force=False)
+        import matplotlib.pyplot as plt
 
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)

@@ -110,9 +110,10 @@ class _Parts:
                     "block": spec.block, "keys": keys}
         mfile = self.dir / "manifest.json"
         if self.dir.exists():
-            try:
-                old = json.loads(mfile.read_text())
-            except (OSError, ValueError):
+            try:  # an interrupted run's manifest says so: the parts are the same
+                old = {k: v for k, v in json.loads(mfile.read_text()).items()
+                       if k not in ("status", "message")}
+            except (OSError, ValueError, AttributeError):
                 old = None
             if old != manifest:
                 if not force:

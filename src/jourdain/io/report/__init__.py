@@ -15,12 +15,13 @@ and :mod:`~.workers` (the forked workers of ``jourdain run``). The workflow shar
 command line is :mod:`jourdain.workflow`.
 """
 
-from .document import write_report
+from .document import mark_report, write_report
 from .equations import MAX_DISPLAY_ROWS, REPORT_SIMPLIFY_SECONDS
 from .linearization import floquet_html as _floquet_html
 from .simulation import wrench_section as _wrench_section
 from .state import RUN_FORMAT, ReportInfo, model_copy, report_files
 
-__all__ = ["write_report", "ReportInfo", "RUN_FORMAT", "model_copy", "report_files",
+__all__ = ["write_report", "mark_report", "ReportInfo", "RUN_FORMAT", "model_copy",
+           "report_files",
            "MAX_DISPLAY_ROWS", "REPORT_SIMPLIFY_SECONDS", "_floquet_html",
            "_wrench_section"]

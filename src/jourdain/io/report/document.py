@@ -14,9 +14,11 @@ from typing import Any
 
 from ...numeric import build_eom_soon
 from ...simulation.problem import build_integrator_soon
+from ...simulation.results import mark_interrupted
 from ...version import __version__
 from ...workflow import has_capability, summary
 from .. import export
+from ..interrupted import LATE, deaf_to_ctrl_c, write_text
 from ..modelfile import ModelFile
 from ..workers import fork_workers, ignore_interrupt
 from . import loops, rolling
@@ -30,7 +32,7 @@ from .equations import (
     set_pending,
 )
 from .figures import Figures, prepare_worker
-from .html import CSS, esc
+from .html import CSS, esc, note
 from .linearization import linearization_section, nominal_placeholder
 from .sections import model_section, numbers_section
 from .simulation import simulation_section
@@ -163,23 +165,36 @@ def write_report(model: ModelFile, out: Path, parameters: Mapping[str, float] | 
             info.message = (f"interrupted by the user (Ctrl-C) after section {len(sections)} "
                             f"of {SECTIONS + system.is_closed}; the sections after it "
                             "are missing")
-        if display is not None:  # the worker's display, and its files
-            try:
-                run.display = display.result()
-            except BrokenProcessPool:  # the worker's process was lost: the display here
-                run.display = cached_display(model, max_ops)
-            html, _ = equations_section(run.display, model, out)
-            sections = [html if s == _EQUATIONS else s for s in sections]
-        page = _page(run, sections, t_start)
+        try:
+            if display is not None:  # the worker's display, and its files
+                try:
+                    run.display = display.result()
+                except BrokenProcessPool:  # the worker's process was lost: the display here
+                    run.display = cached_display(model, max_ops)
+                html, _ = equations_section(run.display, model, out)
+                sections = [html if s == _EQUATIONS else s for s in sections]
+            page = _page(run, sections, t_start)
+        except KeyboardInterrupt:  # while the figures or the display were collected
+            info.status = "interrupted"
+            info.message = ("interrupted by the user (Ctrl-C) while the figures and the "
+                            "equations were collected; those not done by then are missing")
+            run.figures.abandon()
+            sections = [s.replace(_EQUATIONS, note("equations: not shown (interrupted)"))
+                        for s in sections]
+            page = _page(run, sections, t_start)
     finally:
         for worker in (pool, None if display_pool is pool else display_pool):
             if worker is not None:
                 worker.shutdown(cancel_futures=True)
-    info.html.write_text(page, encoding="utf-8")
     manifest = {"format": RUN_FORMAT, "model": system.name, "file": model.path,
                 "status": info.status, "message": info.message,
                 "files": [f.name for f in info.files], "notes": info.notes}
-    (out / "run.json").write_text(json.dumps(manifest, indent=1), encoding="utf-8")
+    with deaf_to_ctrl_c():  # the page and the manifest whole (a few milliseconds)
+        info.html.write_text(page, encoding="utf-8")
+        (out / "run.json").write_text(json.dumps(manifest, indent=1), encoding="utf-8")
+        if info.status == "interrupted" and (out / "simulation.csv").is_file():
+            # interrupted after the simulation (its figures, a study's section): it says so too
+            mark_interrupted(out / "simulation.csv", f"{info.message}; the motion is complete")
     ops = run.display.ops if run.display is not None else {}
     count = (f" with {ops['M'] + ops['k'] + ops['q']} operations"
              if all(k in ops for k in ("M", "k", "q")) else "")
@@ -200,8 +215,9 @@ def _page(run: Run, sections: list[str], t_start: float) -> str:
     """The HTML page: the sections with their figures and nominal motions filled in, the list
     of files (``report.html`` and ``run.json`` first) and the header."""
     info, model = run.info, run.model
-    info.files.insert(0, info.html)
-    info.files.insert(1, run.out / "run.json")
+    if info.html not in info.files:  # (the page again, after an interruption)
+        info.files.insert(0, info.html)
+        info.files.insert(1, run.out / "run.json")
     files = "".join(f"<li><a href='{esc(f.name)}'>{esc(f.name)}</a></li>" for f in info.files)
     number = SECTIONS + 1 + model.system.is_closed  # after "Closed loops" or "Contacts"
     sections.append(f"<h2>{number}. Files</h2><ul>{files}</ul>")
@@ -220,3 +236,41 @@ def _page(run: Run, sections: list[str], t_start: float) -> str:
             f"<meta name='viewport' content='width=device-width, initial-scale=1'>"
             f"<title>{esc(name)} — jourdain report</title><style>{CSS}</style></head>"
             f"<body>{head}{body}</body></html>")
+
+
+def mark_report(out: Path, model: ModelFile, when: str) -> None:
+    """Mark the report folder ``out`` as interrupted ``when`` (Ctrl-C after
+    :func:`write_report` handled its own: while the page and run.json were written, or the
+    summary printed): ``run.json``'s status, a banner on ``report.html`` (each written, with
+    the files found, where the interruption left none) and ``simulation.csv``'s status."""
+    out = Path(out)
+    message = LATE.format(when=when)
+    with deaf_to_ctrl_c():
+        manifest: Any = None
+        try:
+            manifest = json.loads((out / "run.json").read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            pass
+        if not isinstance(manifest, dict):
+            manifest = {"format": RUN_FORMAT, "model": model.system.name, "file": model.path,
+                        "files": sorted(p.name for p in out.iterdir() if p.is_file()),
+                        "notes": []}
+        if manifest.get("status") != "interrupted":
+            manifest.update(status="interrupted", message=message)
+        write_text(out / "run.json", json.dumps(manifest, indent=1))
+        html = out / "report.html"
+        banner = f"<p class='bad'>Interrupted: {esc(message)}.</p>"
+        try:
+            page = html.read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError):
+            page = (f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
+                    f"<title>{esc(model.system.name)} — jourdain report</title>"
+                    f"<style>{CSS}</style></head><body><h1>{esc(model.system.name)}</h1>"
+                    "</body></html>")
+        if "<p class='bad'>Interrupted:" not in page:
+            at = page.find("</h1>")
+            at = at + 5 if at >= 0 else 0
+            page = page[:at] + banner + page[at:]
+        write_text(html, page)
+        if (out / "simulation.csv").is_file():
+            mark_interrupted(out / "simulation.csv", message)

@@ -172,6 +172,15 @@ class Figures:
         self.items.append((item, draw, args))
         return key
 
+    def abandon(self) -> None:
+        """Stop waiting for the worker (Ctrl-C): the figures it has not delivered yet are
+        left out of the page with a note."""
+        for k, (item, draw, args) in enumerate(self.items):
+            if not isinstance(item, str) and not item.done():
+                item.cancel()
+                self.items[k] = ("<p class='note'>figure not drawn (interrupted)</p>", draw,
+                                 args)
+
     def fill(self, page: str) -> str:
         """``page`` with every placeholder replaced by its figure (waiting for the worker; a
         figure that the worker could not deliver, its process lost, is drawn here)."""

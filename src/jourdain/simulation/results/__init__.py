@@ -50,7 +50,7 @@ import numpy as np
 
 from ...errors import JourdainError
 from .data import PLOT_POINTS, TimeHistories
-from .files import FORMAT, VERSION, append_incremental, open_incremental
+from .files import FORMAT, VERSION, append_incremental, mark_interrupted, open_incremental
 from .plots import WithPlots
 
 
@@ -137,4 +137,4 @@ class Results(WithPlots):
 
 
 __all__ = ["FORMAT", "PLOT_POINTS", "VERSION", "Results", "TimeHistories", "append_incremental",
-           "open_incremental"]
+           "mark_interrupted", "open_incremental"]

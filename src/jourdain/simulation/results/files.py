@@ -282,3 +282,55 @@ def append_incremental(h: Any, t: np.ndarray, x: np.ndarray) -> None:
     dx.resize((m + len(t), dx.shape[1]))
     dt[m:] = t
     dx[m:] = x
+
+
+def mark_interrupted(path: str | Path, message: str) -> bool:
+    """Set the ``status`` of a results file (complete, or partial: a run that wrote as it
+    went) to ``interrupted`` with ``message``, keeping its data: for a command stopped by
+    Ctrl-C after the run's own handling (while the results were assembled or saved, or after),
+    so that no file it wrote claims ``running`` or ``finished``. A CSV is rewritten through a
+    temporary file (its rows copied, a last row cut short by the interruption dropped); HDF5
+    attributes are set in place. Returns False where ``path`` is no results file."""
+    path = Path(path)
+    text = " ".join(message.split())
+    if path.suffix.lower() != ".csv":
+        import h5py
+
+        try:
+            with h5py.File(path, "r+") as h:
+                if h.attrs.get("format") != FORMAT:
+                    return False
+                if h.attrs.get("status") != "interrupted":  # else its own message stays
+                    h.attrs["status"] = "interrupted"
+                    h.attrs["message"] = text
+        except OSError:
+            return False
+        return True
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.mark.tmp")
+    try:
+        with path.open(encoding="utf-8") as src, tmp.open("w", encoding="utf-8") as dst:
+            first = src.readline()
+            if first.rstrip("\n") != f"# format: {FORMAT}":
+                return False
+            dst.write(first)
+            width = None
+            keep = False  # interrupted already: its own message stays
+            for line in src:
+                if line.startswith("# status: "):
+                    keep = line == "# status: interrupted\n"
+                    line = "# status: interrupted\n"
+                elif line.startswith("# message: ") and not keep:
+                    line = _csv_header({"message": text}, []).splitlines()[0] + "\n"
+                elif not line.startswith("#"):
+                    if width is None:
+                        width = line.count(",")  # the column names
+                    elif not line.endswith("\n") or line.count(",") != width:
+                        continue  # a row cut short
+                dst.write(line)
+        os.replace(tmp, path)
+    except (OSError, UnicodeDecodeError):
+        return False
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+    return True
