@@ -203,6 +203,17 @@ def reactions_along(lay: ReactionLayout, M_bar: np.ndarray, Q_bar: np.ndarray,
     return g
 
 
+def _refuse_friction(system: Any) -> None:
+    """Friction that depends on the reactions couples them with ÿ: these functions of the
+    plain equations would leave it out without a word."""
+    frictions = getattr(system, "frictions", ())
+    if frictions:
+        raise EvaluationError(
+            f"{getattr(system, 'name', 'the system')!r} has joint friction "
+            f"({', '.join(f.name for f in frictions)}) that depends on the reactions: its "
+            "reactions are solved with the equations of motion by system.evaluate")
+
+
 def evaluate_reactions(system: System, y: Any, yd: Any, t: float = 0.0,
                        parameters: Mapping[str, float] | None = None,
                        inputs: Mapping[str, float] | Sequence[float] | None = None,
@@ -214,6 +225,7 @@ def evaluate_reactions(system: System, y: Any, yd: Any, t: float = 0.0,
     of undetermined components; empty for a well-posed model). ``eom``: the output of
     :func:`jourdain.numeric.evaluate` at the same state, if already at hand.
     """
+    _refuse_friction(system)
 
     lay, _ = _reactions_function(system)
     if eom is None or "Q_bar" not in eom:
@@ -282,6 +294,7 @@ def joint_reactions(system: System, joints: str | Sequence[str], y: Any, yd: Any
     Returns ``{"<joint>.<direction>": value}``; directions that others of the same joint repeat
     share their force and come back as NaN (undetermined).
     """
+    _refuse_friction(system)
 
     if isinstance(joints, str):
         joints = [joints]

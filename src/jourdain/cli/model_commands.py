@@ -157,6 +157,11 @@ def cmd_eom(args: argparse.Namespace) -> int:
         print("\n".join(closed_lines(system)))
     else:
         print(f"{system.name}: M̄·J̄·ÿ + q̄^c = q̄^e + Q̄·g  →  M·ÿ + k = q")
+    frictions = getattr(system, "frictions", ())
+    if frictions:  # they depend on the reactions: numbers only
+        print(f"  joint friction ({', '.join(f.name for f in frictions)}) is not in these "
+              "equations: it depends on the reactions and is solved with them in numbers "
+              "(jourdain eval)")
     for k, m in mats.items():
         print(f"\n{_TITLES[k]} =")
         print(export.matrix_text(m, symbols, args.max_ops))
