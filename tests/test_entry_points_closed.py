@@ -31,7 +31,7 @@ OUTCOME = {
                      "Fixed", "General", "RotationalSpringDamper", "rate", "acceleration",
                      "position", "velocity", "point_acceleration", "angular_velocity",
                      "relative_position", "relative_velocity", "distance", "distance_rate",
-                     "load_model", "load_urdf"], "builder"),
+                     "load_model", "load_urdf", "planar_inertia"], "builder"),
     **dict.fromkeys(["newton_euler", "projection", "reactions", "linearization",
                      "linearization_general", "energy", "constraints"], "stage"),
     **dict.fromkeys(["simulate", "state_space", "modes", "stability", "frequency_response",

@@ -224,8 +224,9 @@ def test_bad_nominal_motion_is_reported():
         s.linearize({"phi1": 0, "phi2": 0, "psi": 1})
     with pytest.raises(jd.ModelError, match="Omega"):
         s.linearize({"phi1": jd.symbols("Omega") * jd.t, "phi2": 0})
+    # text goes through the model files' parser (issue 38): never eval or sympify
     with pytest.raises(jd.ModelError):
-        s.linearize({"phi1": "0", "phi2": 0})  # strings are never parsed
+        s.linearize({"phi1": "__import__('os')", "phi2": 0})
     with pytest.raises(jd.ModelError):
         s.linearize({"phi1": float("nan"), "phi2": 0})
     lin = s.linearize({"phi1": 0, "phi2": 0})
