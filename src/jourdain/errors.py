@@ -78,10 +78,21 @@ class JourdainWarning(UserWarning):
     it seems to (``warnings.simplefilter("error", JourdainWarning)`` turns them into errors)."""
 
 
+class StiffnessWarning(JourdainWarning):
+    """A simulation whose method does not suit the motion: an explicit method held at its
+    stability limit by a fast motion (stiff: an implicit method steps over it), or Radau
+    resolving every oscillation of the fastest one (an explicit method takes fewer, cheaper
+    steps). ``command_line``: the same advice in the words of ``jourdain simulate``."""
+
+    def __init__(self, message: str, command_line: str = "") -> None:
+        super().__init__(message)
+        self.command_line = command_line or message
+
+
 _PACKAGE = str(Path(__file__).resolve().parent)
 
 
-def warn(message: str, category: type[Warning] = JourdainWarning) -> None:
+def warn(message: str | Warning, category: type[Warning] = JourdainWarning) -> None:
     """``warnings.warn`` attributed to the first caller outside jourdain (the user's line)."""
     frame: FrameType | None = sys._getframe(1)  # the caller of warn(), which warnings.warn calls stacklevel 2
     level = 2

@@ -75,7 +75,8 @@ def _warning_line(command: str) -> Any:
 
     def show(message: Warning | str, category: type[Warning], filename: str, lineno: int,
              file: Any = None, line: str | None = None) -> None:
-        text = " ".join(str(message).split())
+        # the advice in the command line's words where the warning has them
+        text = " ".join(str(getattr(message, "command_line", "") or message).split())
         print(f"jourdain {command}: warning: {shorten_words(text)}",
               file=file or sys.stderr)
     return show

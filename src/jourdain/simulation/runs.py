@@ -35,6 +35,7 @@ from .problem import (
     integrator_library,
 )
 from .results import append_incremental, open_incremental
+from .stiffness import StiffnessCheck
 
 
 class IntegrationError(JourdainError, RuntimeError):
@@ -153,6 +154,7 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
             old_handler = None
 
     problem = ctypes.byref(setup.problem)
+    stiffness = StiffnessCheck(lib, setup, setup.problem.method)
     try:
         if handler_due and setup.callables:
             install()
@@ -191,6 +193,7 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
                 break
             if code == _DONE:
                 break
+            stiffness.after_call(float(st[0]), float(st[1]), x.copy(), int(cnt[2]))
             if handler_due:
                 install()
             if interrupted[0]:
