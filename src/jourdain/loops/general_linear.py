@@ -33,7 +33,7 @@ import symengine as se
 from ..errors import EvaluationError
 from ..model import System
 from .general import GeneralEvaluator
-from .linearization import LoopLinearization
+from .linearization import LoopLinearization, mass_inverse
 
 #: a derivative counts as zero below this fraction of the largest entry (an identity test,
 #: as for the cyclic coordinates of trees: jourdain.analysis.cyclic.CYCLIC_RTOL)
@@ -187,13 +187,13 @@ def linearize_general(system: System, nominal: Any,
     P = Jr[np.ix_(ik, np.array(kz, dtype=int))]
     Q = Jr[np.ix_(ik, np.array(ky, dtype=int))]
     n = len(keep)
-    Minv_Q = np.linalg.solve(Mt, Q)
-    Minv_P = np.linalg.solve(Mt, P)
+    Mi = mass_inverse(system, Mt)
+    Minv_Q, Minv_P = Mi @ Q, Mi @ P
     A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv_Q, -Minv_P]])
     ev_ = np.linalg.eigvals(A)
     ev_ = ev_[np.lexsort((ev_.imag, ev_.real))]
     eta = tuple(names[ch.speed_coordinates[k]] for k in keep)
-    A_x = np.vstack([Jy, -np.linalg.solve(M, Jr)])
+    A_x = np.vstack([Jy, -mass_inverse(system, M) @ Jr])
     return GeneralLinearization(
         names=eta, y_s=np.real(s0["y"])[[ch.speed_coordinates[k] for k in keep]],
         z_s=np.real(s0["y"]), M_tilde=Mt, P=P, Q=Q, h=h[keep], D=(P + P.T) / 2,
@@ -222,7 +222,8 @@ def _in_quasi_coordinates(system: System, ch: Any, M: np.ndarray, Jy: np.ndarray
             "no second-order form in these speeds (give speeds=[coordinate names] for them)")
     P = Jr[:, ni:]
     Q = np.zeros((g, g))
-    A = np.block([[np.zeros((g, g)), np.eye(g)], [np.zeros((g, g)), -np.linalg.solve(M, P)]])
+    Mi = mass_inverse(system, M)
+    A = np.block([[np.zeros((g, g)), np.eye(g)], [np.zeros((g, g)), -Mi @ P]])
     lam = np.linalg.eigvals(A)
     lam = lam[np.lexsort((lam.imag, lam.real))]
     return GeneralLinearization(
@@ -230,7 +231,7 @@ def _in_quasi_coordinates(system: System, ch: Any, M: np.ndarray, Jy: np.ndarray
         h=h, D=(P + P.T) / 2, G=(P - P.T) / 2, K=Q, N=Q, A=A, eigenvalues=lam, system=system,
         t=t, parameters=dict(values), speeds=tuple(ch.speeds),
         cyclic=tuple(names[j] for j in ch.independent),
-        A_x=np.vstack([Jy, -np.linalg.solve(M, Jr)]), x_names=x_names, nominal=nominal)
+        A_x=np.vstack([Jy, -Mi @ Jr]), x_names=x_names, nominal=nominal)
 
 
 __all__ = ["GeneralLinearization", "linearize_general"]

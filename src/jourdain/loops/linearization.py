@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 import symengine as se
 
-from ..errors import EvaluationError
+from ..errors import EvaluationError, SingularConfiguration
 from ..model import System
 from ..model.forces import rate
 from ..numeric import CompiledFunction, lambdify
@@ -89,6 +89,23 @@ class LoopLinearization:
                           parameters=pars)
 
 
+def mass_inverse(system: Any, M: np.ndarray) -> np.ndarray:
+    """M⁻¹ of a linearization's mass matrix, by Cholesky: SingularConfiguration naming the
+    system where M is not positive definite (a mass of zero, a singular position), instead
+    of NumPy's LinAlgError."""
+    try:
+        if not np.all(np.isfinite(M)):
+            raise np.linalg.LinAlgError("not finite")
+        C = np.linalg.cholesky(M)
+    except np.linalg.LinAlgError:
+        raise SingularConfiguration(
+            f"{getattr(system, 'name', 'the system')}: M is not positive definite at the "
+            "nominal state (a massless coordinate or a singular position): no linearization "
+            "there") from None
+    Ci = np.linalg.inv(C)
+    return Ci.T @ Ci
+
+
 def linearize_loop(loop: System, z_s: Any, zd_s: Any = None, t: float = 0.0,
                    ydd_s: Any = None, parameters: Mapping[str, float] | None = None
                    ) -> LoopLinearization:
@@ -123,7 +140,7 @@ def linearize_loop(loop: System, z_s: Any, zd_s: Any = None, t: float = 0.0,
         _, rm = parts(y0, yd0 - e)
         P[:, i] = (rp - rm) / (2 * e[i])
     h = -r0 - M0 @ ydd
-    Minv = np.linalg.inv(M0)
+    Minv = mass_inverse(loop, M0)
     A = np.block([[np.zeros((f, f)), np.eye(f)], [-Minv @ Q, -Minv @ P]])
     lam = np.linalg.eigvals(A)
     order = np.lexsort((lam.imag, lam.real))
@@ -176,8 +193,8 @@ def linearize_loop_exact(loop: System, z_s: Any, t: float = 0.0,
     P = J.T @ parts["R_zd"] @ J
     Q = J.T @ (parts["R_z"] - np.einsum("i,ijk->jk", lam, H)) @ J
     h = s["q"] - s["k"]
-    A = np.block([[np.zeros((f, f)), np.eye(f)],
-                  [-np.linalg.solve(M0, Q), -np.linalg.solve(M0, P)]])
+    Minv = mass_inverse(loop, M0)
+    A = np.block([[np.zeros((f, f)), np.eye(f)], [-Minv @ Q, -Minv @ P]])
     eig = np.linalg.eigvals(A)
     order = np.lexsort((eig.imag, eig.real))
     return LoopLinearization(tuple(ev.independent_names), asm.z[ind], asm.z, M0, P, Q, h,
