@@ -73,7 +73,8 @@ def loop_source(loop: System) -> str:
     tree = loop.tree
     con = constraints(loop)
     names = argument_names(tree.y, tree.yd, tree.t, tree.parameter_symbols, tree.inputs)
-    kernel = (resources.files(__package__) / "loop_c.h").read_text()
+    kernel = (resources.files(__package__) / "dense_c.h").read_text() + (
+        resources.files(__package__) / "loop_c.h").read_text()
     return (HEADER + function_source("jd_con", [*con.Phi.entries(), *con.Phi_y.entries(),
                                                 *con.Phi_t.entries()], names)
             + function_source("jd_gam", con.c.entries(), names) + kernel)

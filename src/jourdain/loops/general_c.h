@@ -32,36 +32,15 @@ long jd_gen_work(long n, long mh, long mv, long g) {
            + 3 * n + n * n + g * g + g + 2 * g + n * g + 4 * n;
 }
 
+/* LU (dense_c.h's jdl_lu) with a singular matrix refused at rounding: a pivot below
+ * eps * r * max|A| (W of rows that are redundant with the speeds) */
 static int jdg_lu(long r, double *A, long *piv) {
     double big = 0.0;
     for (long i = 0; i < r * r; ++i) if (fabs(A[i]) > big) big = fabs(A[i]);
-    for (long k = 0; k < r; ++k) {
-        long p = k;
-        double best = fabs(A[k * r + k]);
-        for (long i = k + 1; i < r; ++i)
-            if (fabs(A[i * r + k]) > best) { best = fabs(A[i * r + k]); p = i; }
-        piv[k] = p;
-        if (!(best > 2.220446049250313e-16 * (double)r * big)) return 1;
-        if (p != k)
-            for (long j = 0; j < r; ++j) { double s = A[k * r + j]; A[k * r + j] = A[p * r + j]; A[p * r + j] = s; }
-        double inv = 1.0 / A[k * r + k];
-        for (long i = k + 1; i < r; ++i) {
-            double l = A[i * r + k] *= inv;
-            if (l != 0.0)
-                for (long j = k + 1; j < r; ++j) A[i * r + j] -= l * A[k * r + j];
-        }
-    }
+    if (jdl_lu(r, A, piv)) return 1;
+    for (long k = 0; k < r; ++k)
+        if (!(fabs(A[k * r + k]) > 2.220446049250313e-16 * (double)r * big)) return 1;
     return 0;
-}
-
-static void jdg_solve(long r, const double *A, const long *piv, double *b) {
-    for (long k = 0; k < r; ++k) if (piv[k] != k) { double s = b[k]; b[k] = b[piv[k]]; b[piv[k]] = s; }
-    for (long i = 1; i < r; ++i) { double s = b[i]; for (long k = 0; k < i; ++k) s -= A[i * r + k] * b[k]; b[i] = s; }
-    for (long i = r - 1; i >= 0; --i) {
-        double s = b[i];
-        for (long k = i + 1; k < r; ++k) s -= A[i * r + k] * b[k];
-        b[i] = s / A[i * r + i];
-    }
 }
 
 /* Newton on the kept holonomic rows for the dependent coordinates, y_i held: 0, or 1 when it
@@ -98,7 +77,7 @@ static int jdg_positions(jd_gen *G, double t, const double *u, double *buf, doub
             for (long b = 0; b < rh; ++b) Pd[a * rh + b] = Py[i * n + G->dep[b]];
         }
         if (jdg_lu(rh, Pd, G->piv)) return 1;
-        jdg_solve(rh, Pd, G->piv, s);
+        jdl_solve(rh, Pd, G->piv, s);
         double big = 0.0;
         for (long b = 0; b < rh; ++b) {
             y[G->dep[b]] -= s[b];
@@ -148,19 +127,19 @@ static int jdg_state(jd_gen *G, const double *yi, const double *ydi, double t, c
         yd[k] = z;
     }
     for (long r = 0; r < n - g; ++r) yd[g + r] = -a[G->rows_v[r]];
-    jdg_solve(n, W, G->piv, yd);
+    jdl_solve(n, W, G->piv, yd);
     for (long k = 0; k < g; ++k) {
         double *col = zero + n;  /* spare */
         memset(col, 0, n * sizeof(double));
         col[k] = 1.0;
-        jdg_solve(n, W, G->piv, col);
+        jdl_solve(n, W, G->piv, col);
         for (long i = 0; i < n; ++i) L[i * g + k] = col[i];
     }
     jd_gvel(y, yd, t, G->p, u, vel);
     const double *c = vel + mv * n + mv;
     memset(gam, 0, g * sizeof(double));
     for (long r = 0; r < n - g; ++r) gam[g + r] = -c[G->rows_v[r]];
-    jdg_solve(n, W, G->piv, gam);
+    jdl_solve(n, W, G->piv, gam);
     G->tree(y, yd, t, G->p, u, tree);
     const double *M = tree, *kk = tree + n * n, *q = kk + n;
     /* ML = M L (n x g), Mz = L^T M L, rz = L^T (q - k - M gamma) */
@@ -211,6 +190,17 @@ static int jdg_state(jd_gen *G, const double *yi, const double *ydi, double t, c
     return 0;
 }
 
+/* ydd_i = (L zd + gamma)_i of the coordinates idx (k of them; idx NULL: 0 .. k-1) */
+static void jdg_ydd(const jd_gen *G, const double *L, const double *gam, const double *zd,
+                    const long *idx, long k, double *out) {
+    for (long a = 0; a < k; ++a) {
+        long i = idx ? idx[a] : a;
+        double s = gam[i];
+        for (long j = 0; j < G->g; ++j) s += L[i * G->g + j] * zd[j];
+        out[a] = s;
+    }
+}
+
 /* the integrator's jd_accel hook: ydd_i and the power yd . q; 1 on failure, 2 on NaN */
 int jd_gen_accel(const double *y, const double *yd, double t, const double *p,
                  const double *u, double *ydd, double *power) {
@@ -218,13 +208,8 @@ int jd_gen_accel(const double *y, const double *yd, double t, const double *p,
     double *ydf, *L, *gam, *tree, *zd, *vel;
     int r = jdg_state(G, y, yd, t, u, &ydf, &L, &gam, &tree, &zd, &vel);
     if (r) return r == 1 && !isfinite(G->info[2]) ? 2 : 1;
-    long n = G->n, g = G->g;
-    for (long k = 0; k < G->ni; ++k) {
-        long i = G->ind[k];
-        double s = gam[i];
-        for (long j = 0; j < g; ++j) s += L[i * g + j] * zd[j];
-        ydd[k] = s;
-    }
+    long n = G->n;
+    jdg_ydd(G, L, gam, zd, G->ind, G->ni, ydd);
     const double *q = tree + n * n + n;
     double w = 0.0;
     for (long i = 0; i < n; ++i) w += ydf[i] * q[i];
@@ -287,11 +272,7 @@ long jd_gen_samples(jd_gen *G, long N, const double *t, const double *x, long sx
         const double *M = tree, *kk = tree + n * n, *q = kk + n;
         memcpy(o, G->y, n * sizeof(double));
         memcpy(o + n, ydf, n * sizeof(double));
-        for (long i = 0; i < n; ++i) {
-            double v = gam[i];
-            for (long j = 0; j < g; ++j) v += L[i * g + j] * zd[j];
-            o[2 * n + i] = v;
-        }
+        jdg_ydd(G, L, gam, zd, NULL, n, o + 2 * n);
         for (long i = 0; i < n; ++i) {
             double v = kk[i] - q[i];
             for (long j = 0; j < n; ++j) v += M[i * n + j] * o[2 * n + j];

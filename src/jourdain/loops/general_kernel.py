@@ -28,7 +28,7 @@ from ..numeric.toolchain import build, build_lock, content_key
 from ..simulation.problem import address
 from .general import GeneralEvaluator, general_constraints
 
-_VERSION = "general-c2"
+_VERSION = "general-c3"
 REASONS = {1: "Newton found no configuration with the holonomic rows satisfied",
            2: "the velocity rows are singular or redundant with the speeds (W singular)",
            3: "M in the speeds is not positive definite"}
@@ -49,7 +49,8 @@ def general_source(system: System) -> str:
     tree = system.tree
     con = general_constraints(system)
     names = argument_names(tree.y, tree.yd, tree.t, tree.parameter_symbols, tree.inputs)
-    kernel = (resources.files(__package__) / "general_c.h").read_text()
+    kernel = (resources.files(__package__) / "dense_c.h").read_text() + (
+        resources.files(__package__) / "general_c.h").read_text()
     return (HEADER + function_source("jd_gpos", [*con.Phi.entries(), *con.Phi_y.entries(),
                                                  *con.Phi_t.entries()], names)
             + function_source("jd_gvel", [*con.A.entries(), *con.a.entries(),

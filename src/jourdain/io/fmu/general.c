@@ -56,13 +56,9 @@ int jd_closed_dynamics(double *z, double *y_last, double *info, double *work, lo
     if (r == 1) return isfinite(gi[2]) ? 11 : 2;
     if (r == 2) return 15;
     if (r == 3) return 13;
-    for (long k = 0; k < JD_NY; ++k) {
-        long i = jd_ind[k];
-        double s = gam[i];
-        for (long j = 0; j < JD_NSPD; ++j) s += L[i * JD_NSPD + j] * zd[j];
-        ydd[k] = s;
-        if (!isfinite(s)) return 2;
-    }
+    jdg_ydd(&G, L, gam, zd, jd_ind, JD_NY, ydd);
+    for (long k = 0; k < JD_NY; ++k)
+        if (!isfinite(ydd[k])) return 2;
     for (long i = 0; i < JD_NDEP; ++i) {
         out[i] = z[jd_dep[i]];
         out[JD_NDEP + i] = ydf[jd_dep[i]];
