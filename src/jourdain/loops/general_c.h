@@ -163,29 +163,9 @@ static int jdg_state(jd_gen *G, const double *yi, const double *ydi, double t, c
         }
         rz[a1] = s;
     }
-    /* Cholesky of Mz in place (lower), then zd */
-    for (long j = 0; j < g; ++j) {
-        double d = Mz[j * g + j];
-        for (long k = 0; k < j; ++k) d -= Mz[j * g + k] * Mz[j * g + k];
-        if (!(d > 0.0)) { G->info[1] = 3; return 3; }
-        d = sqrt(d);
-        Mz[j * g + j] = d;
-        for (long i = j + 1; i < g; ++i) {
-            double s = Mz[i * g + j];
-            for (long k = 0; k < j; ++k) s -= Mz[i * g + k] * Mz[j * g + k];
-            Mz[i * g + j] = s / d;
-        }
-    }
-    for (long i = 0; i < g; ++i) {
-        double s = rz[i];
-        for (long k = 0; k < i; ++k) s -= Mz[i * g + k] * zd[k];
-        zd[i] = s / Mz[i * g + i];
-    }
-    for (long i = g - 1; i >= 0; --i) {
-        double s = zd[i];
-        for (long k = i + 1; k < g; ++k) s -= Mz[k * g + i] * zd[k];
-        zd[i] = s / Mz[i * g + i];
-    }
+    /* Cholesky of Mz, then zd */
+    if (jdl_chol(g, Mz)) { G->info[1] = 3; return 3; }
+    jdl_chol_solve(g, Mz, rz, zd);
     *out_yd = yd; *out_L = L; *out_gam = gam; *out_tree = tree; *out_zd = zd; *out_vel = vel;
     return 0;
 }
@@ -231,28 +211,8 @@ static int jdg_lambda(long n, long mv, const double *A, const double *r, double 
             G2[i * mv + j] = v;
         }
     }
-    for (long j = 0; j < mv; ++j) {
-        double d = G2[j * mv + j];
-        for (long k = 0; k < j; ++k) d -= G2[j * mv + k] * G2[j * mv + k];
-        if (!(d > 0.0)) return 1;
-        d = sqrt(d);
-        G2[j * mv + j] = d;
-        for (long i = j + 1; i < mv; ++i) {
-            double v = G2[i * mv + j];
-            for (long k = 0; k < j; ++k) v -= G2[i * mv + k] * G2[j * mv + k];
-            G2[i * mv + j] = v / d;
-        }
-    }
-    for (long i = 0; i < mv; ++i) {
-        double v = lam[i];
-        for (long k = 0; k < i; ++k) v -= G2[i * mv + k] * lam[k];
-        lam[i] = v / G2[i * mv + i];
-    }
-    for (long i = mv - 1; i >= 0; --i) {
-        double v = lam[i];
-        for (long k = i + 1; k < mv; ++k) v -= G2[k * mv + i] * lam[k];
-        lam[i] = v / G2[i * mv + i];
-    }
+    if (jdl_chol(mv, G2)) return 1;
+    jdl_chol_solve(mv, G2, lam, lam);
     return 0;
 }
 

@@ -28,7 +28,7 @@ from ..numeric.toolchain import build, build_lock, content_key
 from ..simulation.problem import address
 from .general import GeneralEvaluator, general_constraints
 
-_VERSION = "general-c3"
+_VERSION = "general-c4"
 REASONS = {1: "Newton found no configuration with the holonomic rows satisfied",
            2: "the velocity rows are singular or redundant with the speeds (W singular)",
            3: "M in the speeds is not positive definite"}

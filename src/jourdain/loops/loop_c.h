@@ -397,37 +397,6 @@ long jd_penalty_work(long n, long m) {
 }
 
 /* Cholesky factor in the lower triangle of the n x n row-major A; 1 when not positive definite */
-static int jdl_chol(long n, double *A) {
-    double dmax = 0.0;
-    for (long i = 0; i < n; ++i) if (fabs(A[i * n + i]) > dmax) dmax = fabs(A[i * n + i]);
-    for (long j = 0; j < n; ++j) {
-        double d = A[j * n + j];
-        for (long k = 0; k < j; ++k) d -= A[j * n + k] * A[j * n + k];
-        if (!(d > 1e-13 * dmax)) return 1;
-        d = sqrt(d);
-        A[j * n + j] = d;
-        for (long i = j + 1; i < n; ++i) {
-            double a = A[i * n + j];
-            for (long k = 0; k < j; ++k) a -= A[i * n + k] * A[j * n + k];
-            A[i * n + j] = a / d;
-        }
-    }
-    return 0;
-}
-
-static void jdl_chol_solve(long n, const double *C, const double *b, double *x) {
-    for (long i = 0; i < n; ++i) {
-        double a = b[i];
-        for (long k = 0; k < i; ++k) a -= C[i * n + k] * x[k];
-        x[i] = a / C[i * n + i];
-    }
-    for (long i = n - 1; i >= 0; --i) {
-        double a = x[i];
-        for (long k = i + 1; k < n; ++k) a -= C[k * n + i] * x[k];
-        x[i] = a / C[i * n + i];
-    }
-}
-
 int jd_penalty_accel(const double *z, const double *zd, double t, const double *pp,
                      const double *u, double *zdd, double *power) {
     const jd_penalty *P = (const jd_penalty *)(const void *)pp;
