@@ -5,29 +5,25 @@ its C code (``general_c.h`` and ``io/fmu/general.c``) solves the dependent coord
 rear centre's height and the pitch: Newton on the wheels' touching rows), the velocity map
 ``ẏ = L·z + l`` from the no-slip rows and the accelerations at every evaluation. FMPy
 validates its modelDescription.xml and runs it in model exchange (CVode) and co-simulation (the
-FMU's Dormand–Prince 5(4)) against System.simulate over 2 s at 5 m/s with a lean of 0.05 rad.
-
-Tolerances as in tests/test_fmu.py (TRAJ_TOL on coordinates and rates; the FMU at rtol 1e-10,
-the reference at 1e-11); the rows' residual outputs are checked at rounding of the
-coordinates' scale (1e-11: Newton's stop on the holonomic rows, the velocity rows by
-construction).
+FMU's Dormand–Prince 5(4)) against System.simulate over the model file's 5 s at 5 m/s with a
+lean of 0.05 rad, by the closed systems' comparison (tests/test_fmu_closed.py: TRAJ_TOL on
+coordinates and rates, the rows' residual outputs below 1e-11: Newton's stop on the holonomic
+rows, the velocity rows by construction).
 """
 
 from __future__ import annotations
 
-import numpy as np
 import pytest
 
 fmpy = pytest.importorskip("fmpy", reason="FMPy is in the test extra (jourdain[test])")
 
-from fmpy import read_model_description, simulate_fmu  # noqa: E402
+from fmpy import read_model_description  # noqa: E402
 from fmpy.validation import validate_fmu  # noqa: E402
 
 from jourdain.io import load_model  # noqa: E402
 from jourdain.io.fmu import export_fmu  # noqa: E402
-from tests.test_fmu import FMU_RTOL, ROOT, TRAJ_TOL, needs_cc  # noqa: E402
-
-RESIDUAL_TOL = 1e-11
+from tests.test_fmu import ROOT, needs_cc  # noqa: E402
+from tests.test_fmu_closed import _against_simulate  # noqa: E402
 
 
 @needs_cc
@@ -38,22 +34,6 @@ def test_the_bicycle_fmu_runs_the_motion_of_simulate(tmp_path) -> None:
     md = read_model_description(str(info.path))
     assert info.independent == ("x", "y", "psi", "phi", "thetaR", "delta", "thetaF")
     assert md.numberOfContinuousStates == 14
-    s, sim = mf.system, mf.simulation
-    T, dt = 2.0, 0.02
-    t = np.linspace(0.0, T, int(round(T / dt)) + 1)
-    ref = s.simulate((0.0, T), list(sim.y0), list(sim.yd0), rtol=FMU_RTOL / 10,
-                     atol=FMU_RTOL / 1000, t_eval=t)
-    assert ref.status == "finished"
-    names = list(s.coordinate_names)
-    rates = [f"{n}_d" for n in names]
     res = [v.name for v in md.modelVariables if v.name.startswith("Phi.")]
-    assert res == [f"Phi.{lab}" for lab in ref.constraints.labels]
-    for fmi_type, kw in (("ModelExchange", {"solver": "CVode"}), ("CoSimulation", {})):
-        r = simulate_fmu(str(info.path), fmi_type=fmi_type, stop_time=T, output_interval=dt,
-                         relative_tolerance=FMU_RTOL, output=names + rates + res, **kw)
-        np.testing.assert_allclose(r["time"], ref.t, rtol=0, atol=1e-12)
-        err_y = np.abs(np.column_stack([r[n] for n in names]) - ref.y).max()
-        err_yd = np.abs(np.column_stack([r[n] for n in rates]) - ref.yd).max()
-        assert err_y < TRAJ_TOL and err_yd < TRAJ_TOL, (fmi_type, err_y, err_yd)
-        assert max(np.abs(r[p]).max() for p in res) < RESIDUAL_TOL
-        assert np.ptp(r["x"]) > 5.0  # it rode on
+    assert res == [f"Phi.{lab}" for lab in mf.system.constraints().labels]
+    _against_simulate(mf, info, dt=0.02)  # model exchange and co-simulation, the file's 5 s
