@@ -72,45 +72,55 @@ def _speed_rows(system: System) -> tuple[SymMatrix, SymMatrix, SymMatrix] | None
     return SymMatrix.from_rows(Y), SymMatrix.column(b), SymMatrix.column(c)
 
 
+#: the groups of :class:`Functions`: positions (Newton), velocities (W, ẏ, γ), the tree's M, k, q
+POS, VEL, TREE = "pos", "vel", "tree"
+
+
 class Functions:
-    """The tree's ``M, k, q`` and the rows' ``Phi, Phi_y, Phi_t, A, a, c`` (and the speeds'
-    ``Y, b, cY``) at a state: compiled (real) or by SymEngine's complex evaluation."""
+    """At a state, by group: the holonomic rows' ``Phi, Phi_y, Phi_t`` (``"pos"``), every
+    row's ``A, a, c`` and the speeds' ``Y, b, cY`` (``"vel"``), the tree's ``M, k, q``
+    (``"tree"``); compiled (real) or by SymEngine's complex evaluation. Newton evaluates the
+    positions' group alone, the velocity map the velocities', so that no call computes what
+    its caller throws away."""
 
     def __init__(self, system: System, complex_: bool = False) -> None:
         tree = system.tree
         con = general_constraints(system)
-        mats = {"Phi": con.Phi, "Phi_y": con.Phi_y, "Phi_t": con.Phi_t, "A": con.A, "a": con.a,
-                "c": con.c}
+        vel = {"A": con.A, "a": con.a, "c": con.c}
         sp = _speed_rows(system)
         if sp is not None:
-            mats.update(Y=sp[0], b=sp[1], cY=sp[2])
+            vel.update(Y=sp[0], b=sp[1], cY=sp[2])
+        groups = {POS: {"Phi": con.Phi, "Phi_y": con.Phi_y, "Phi_t": con.Phi_t}, VEL: vel}
         self.complex = complex_
+        self.fns: dict[str, Any] = {}
         if not complex_:
-            self.tree_fn = mkq_function(tree)
-            self.con_fn = lambdify(tree, mats)
+            self.fns = {k: lambdify(tree, g) for k, g in groups.items()}
+            self.fns[TREE] = mkq_function(tree)
             return
         eom = projection(newton_euler(kinematics(tree)))
+        groups[TREE] = {"M": eom.M, "k": eom.k, "q": eom.q}
         args = [*tree.y, *tree.yd, tree.t, *tree.parameter_symbols, *tree.inputs]
-        self.parts = []
-        for group in (mats, {"M": eom.M, "k": eom.k, "q": eom.q}):
+        for key, group in groups.items():
             names = list(group)
             exprs = [e for n in names for e in group[n].entries()]
-            self.parts.append((names, [group[n].shape for n in names],
-                               se.Lambdify(args, exprs, real=False, cse=True)))
+            self.fns[key] = (names, [group[n].shape for n in names],
+                             se.Lambdify(args, exprs, real=False, cse=True))
 
     def __call__(self, y: np.ndarray, yd: np.ndarray, t: float, p: np.ndarray,
-                 u: np.ndarray, tree: bool = True) -> dict[str, np.ndarray]:
-        """The functions at a state; ``tree=False``: the rows' only (no M, k, q)."""
+                 u: np.ndarray, groups: tuple[str, ...] = (POS, VEL, TREE)
+                 ) -> dict[str, np.ndarray]:
+        """The functions of ``groups`` at a state."""
+        out: dict[str, np.ndarray] = {}
         if not self.complex:
             y = np.ascontiguousarray(y, dtype=float)
             yd = np.ascontiguousarray(yd, dtype=float)
-            out = self.con_fn.split(self.con_fn.raw(y, yd, t, p, u))
-            if tree:
-                out.update(self.tree_fn.split(self.tree_fn.raw(y, yd, t, p, u)))
+            for key in groups:
+                fn = self.fns[key]
+                out.update(fn.split(fn.raw(y, yd, t, p, u)))
             return self._shaped(out, len(y))
         x = np.concatenate([y, yd, [t], p, u]).astype(complex)
-        out = {}
-        for names, shapes, fn in self.parts if tree else self.parts[:1]:
+        for key in groups:
+            names, shapes, fn = self.fns[key]
             flat = np.asarray(fn(x)).reshape(-1)
             i = 0
             for n, (r, c) in zip(names, shapes, strict=True):
@@ -197,6 +207,17 @@ def choose(system: System, fn: dict[str, np.ndarray]) -> Choice:
     return Choice(ind, dep, rows_h, rows_v, tuple(f"{names[j]}_d" for j in sc), sc)
 
 
+def least_norm(A: np.ndarray, r: np.ndarray, rank: int) -> tuple[np.ndarray, np.ndarray]:
+    """The least-norm λ of ``Aᵀ·λ = r`` (A: m×n, or stacked N×m×n with r N×n), the SVD of Aᵀ
+    truncated at ``rank`` (the independent rows), and the rows' null combinations (those
+    beyond the rank: where the equations leave the multipliers open)."""
+    U, sv, Vt = np.linalg.svd(np.swapaxes(A, -1, -2), full_matrices=False)
+    inv = np.zeros_like(sv)
+    inv[..., :rank] = 1.0 / sv[..., :rank]
+    lam = np.einsum("...ji,...j->...i", Vt, inv * np.einsum("...ij,...i->...j", U, r))
+    return lam, Vt[..., rank:, :]
+
+
 class GeneralEvaluator:
     """Numbers of a general system at states ``x = (y_i, z)`` (see the module docstring), in
     real (default) or complex arithmetic."""
@@ -218,7 +239,7 @@ class GeneralEvaluator:
             raise EvaluationError(f"{system.name}: {self.n} coordinates expected, got {y.size}")
         real = functions(system, False) if complex_ else self.fn
         self.choice = choose(system, real(y, np.zeros(self.n), float(t), self.p, self.u,
-                                          tree=False))
+                                          (POS, VEL)))
         self.y_guess = y.astype(self.dtype)
         self.max_newton = 25
         self.newton_tol = 1e-13
@@ -231,9 +252,9 @@ class GeneralEvaluator:
     def independent_names(self) -> list[str]:
         return [self.system.coordinate_names[j] for j in self.choice.independent]
 
-    def _f(self, y: np.ndarray, yd: np.ndarray, t: float, tree: bool = True
+    def _f(self, y: np.ndarray, yd: np.ndarray, t: float, groups: tuple[str, ...]
            ) -> dict[str, np.ndarray]:
-        return self.fn(y, yd, t, self.p, self.u, tree)
+        return self.fn(y, yd, t, self.p, self.u, groups)
 
     def positions(self, yi: np.ndarray, t: float, guess: np.ndarray | None = None
                   ) -> np.ndarray:
@@ -248,7 +269,7 @@ class GeneralEvaluator:
         zero = np.zeros(self.n, dtype=self.dtype)
         last, extra = math.inf, -1
         for _ in range(self.max_newton + 1):
-            fn = self._f(y, zero, t, tree=False)
+            fn = self._f(y, zero, t, (POS,))
             Phi = fn["Phi"][rows, 0]
             if extra < 0:
                 stop, res, last = _newton_stop(np.real(Phi), np.real(fn["Phi_y"][rows]),
@@ -322,10 +343,10 @@ class GeneralEvaluator:
         ni = len(self.choice.independent)
         yi, z = x[:ni], x[ni:]
         y = self.positions(yi, t)
-        fn0 = self._f(y, np.zeros(self.n, dtype=self.dtype), t, tree=False)
+        fn0 = self._f(y, np.zeros(self.n, dtype=self.dtype), t, (VEL,))
         W, L, l = self.velocity_map(fn0)
         yd = L @ z + l
-        fn = self._f(y, yd, t)
+        fn = self._f(y, yd, t, (VEL, TREE))
         ch = self.choice
         cc = fn["c"][list(ch.rows_v), 0]
         cY = (np.zeros(len(z), dtype=self.dtype) if ch.speed_coordinates is not None
@@ -354,6 +375,13 @@ class GeneralEvaluator:
         s["xd"] = np.concatenate([s["yd"][list(self.choice.independent)], zd])
         return s
 
+    def residuals(self, s: dict[str, Any], t: float) -> tuple[np.ndarray, np.ndarray]:
+        """The rows' residuals at the state ``s`` of :meth:`state`: ``Φ`` of the holonomic rows
+        (r_h) and every row's ``A·ẏ + a`` (r)."""
+        fn = s["fn"]
+        Phi = self._f(s["y"], np.zeros(self.n, dtype=self.dtype), t, (POS,))["Phi"]
+        return Phi.reshape(-1), fn["A"] @ s["yd"] + fn["a"][:, 0]
+
     def multipliers(self, s: dict[str, Any]) -> np.ndarray:
         """The rows' multipliers λ (contact forces along the rows' directions) from
         ``M_tree·ÿ + k_tree − q_tree = Aᵀλ``: the least-norm solution over all rows, so that
@@ -364,12 +392,8 @@ class GeneralEvaluator:
         A = np.real(s["fn"]["A"])
         if not A.size:
             return np.zeros(0)
-        U, sv, Vt = np.linalg.svd(A.T, full_matrices=False)
-        rank = len(self.choice.rows_v)
-        inv = np.zeros_like(sv)
-        inv[:rank] = 1.0 / sv[:rank]
-        self._null = Vt[rank:]
-        return Vt.T @ (inv * (U.T @ res))
+        lam, self._null = least_norm(A, res, len(self.choice.rows_v))
+        return lam
 
     def undetermined(self) -> list[str]:
         """Labels of the rows whose multipliers the equations leave open (they lie on a
@@ -391,10 +415,10 @@ class GeneralEvaluator:
         if ch.speed_coordinates is not None:
             z = yd0[list(ch.speed_coordinates)]
         else:
-            fn = self._f(y, yd0, t)
+            fn = self._f(y, yd0, t, (VEL,))
             z = fn["Y"] @ yd0 + fn["b"][:, 0]
         return np.concatenate([y[list(ch.independent)], z])
 
 
-__all__ = ["Choice", "Functions", "GeneralEvaluator", "choose", "functions",
+__all__ = ["POS", "TREE", "VEL", "Choice", "Functions", "least_norm", "GeneralEvaluator", "choose", "functions",
            "general_constraints"]

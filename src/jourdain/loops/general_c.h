@@ -1,7 +1,7 @@
 /* jourdain, velocity constraints: the right-hand side of a general system in C
- * (jourdain/loops/general_kernel.py appends this to the generated jd_gpos: Phi, Phi_y, Phi_t of
- * the holonomic rows, and jd_gvel: A, a, c of every row). The integrator's state is the
- * independent coordinates y_i and their rates; the speeds z are the rates of the speed
+ * (jourdain/loops/general_kernel.py appends this to the generated jd_gpos: Phi, Phi_y, Phi_t
+ * of the holonomic rows, jd_gvel: A, a of every row, jd_gacc: their c, and dense_c.h). The
+ * integrator's state is the independent coordinates y_i and their rates; the speeds z are the rates of the speed
  * coordinates among them. One call: Newton on Phi = 0 for the dependent coordinates (warm
  * started from the last solution), W = [E_z; A_kept] by LU with partial pivoting,
  * yd = W^-1 [z; -a], L = W^-1 [E; 0], gamma = -W^-1 [0; c], the tree's M, k, q,
@@ -135,8 +135,8 @@ static int jdg_state(jd_gen *G, const double *yi, const double *ydi, double t, c
         jdl_solve(n, W, G->piv, col);
         for (long i = 0; i < n; ++i) L[i * g + k] = col[i];
     }
-    jd_gvel(y, yd, t, G->p, u, vel);
-    const double *c = vel + mv * n + mv;
+    double *c = vel + mv * n + mv;
+    jd_gacc(y, yd, t, G->p, u, c);
     memset(gam, 0, g * sizeof(double));
     for (long r = 0; r < n - g; ++r) gam[g + r] = -c[G->rows_v[r]];
     jdl_solve(n, W, G->piv, gam);

@@ -44,7 +44,7 @@ def evaluate_general(system: System, y: Any, yd: Any = None, t: float = 0.0,
     x = ev.initial(y, yd, t)
     s = ev.accelerations(x, t)
     lam = ev.multipliers(s)
-    fn = s["fn"]
+    Phi, Phi_dot = ev.residuals(s, t)
     tree = tree_evaluate(system.tree, s["y"], s["yd"], t, parameters,
                          [0.0] * len(system.tree.inputs) if system.tree.inputs else None)
     p = ev.p
@@ -59,7 +59,7 @@ def evaluate_general(system: System, y: Any, yd: Any = None, t: float = 0.0,
         labels=list(ev.labels), **{"lambda": lam},
         contact_forces=dict(zip(ev.labels, (float(v) for v in lam), strict=True)),
         contacts_undetermined=ev.undetermined(),
-        Phi=fn["Phi"].reshape(-1), Phi_dot=fn["A"] @ s["yd"] + fn["a"][:, 0],
+        Phi=Phi, Phi_dot=Phi_dot,
         orthogonality=float(np.max(np.abs(J_bar.T @ Q_c), initial=0.0)))
     return out
 

@@ -1,5 +1,6 @@
 """The compiled right-hand side of a general system (velocity constraints): generated C for
-the holonomic rows ``Φ, Φ_y, Φ_t`` (``jd_gpos``) and every row's ``A, a, c`` (``jd_gvel``),
+the holonomic rows ``Φ, Φ_y, Φ_t`` (``jd_gpos``), every row's ``A, a`` (``jd_gvel``) and ``c``
+(``jd_gacc``, the only one that needs ``ẏ``),
 joined with the hand-written kernel of ``general_c.h`` (Newton on the dependent coordinates,
 ``W = [E_z; A]`` by LU, ``ẏ = L·z + l``, γ, ``M_z = LᵀM_tree·L`` by Cholesky), which calls the
 tree's compiled ``M, k, q`` (:func:`jourdain.numeric.mkq_function`) through a function pointer.
@@ -28,7 +29,7 @@ from ..numeric.toolchain import build, build_lock, content_key
 from ..simulation.problem import address
 from .general import GeneralEvaluator, general_constraints
 
-_VERSION = "general-c4"
+_VERSION = "general-c5"
 REASONS = {1: "Newton found no configuration with the holonomic rows satisfied",
            2: "the velocity rows are singular or redundant with the speeds (W singular)",
            3: "M in the speeds is not positive definite"}
@@ -45,7 +46,8 @@ class _Gen(ctypes.Structure):
 
 
 def general_source(system: System) -> str:
-    """The C source of ``system``'s kernel: ``jd_gpos``, ``jd_gvel`` and ``general_c.h``."""
+    """The C source of ``system``'s kernel: ``jd_gpos``, ``jd_gvel``, ``jd_gacc``, then
+    ``dense_c.h`` and ``general_c.h``."""
     tree = system.tree
     con = general_constraints(system)
     names = argument_names(tree.y, tree.yd, tree.t, tree.parameter_symbols, tree.inputs)
@@ -53,8 +55,8 @@ def general_source(system: System) -> str:
         resources.files(__package__) / "general_c.h").read_text()
     return (HEADER + function_source("jd_gpos", [*con.Phi.entries(), *con.Phi_y.entries(),
                                                  *con.Phi_t.entries()], names)
-            + function_source("jd_gvel", [*con.A.entries(), *con.a.entries(),
-                                          *con.c.entries()], names) + kernel)
+            + function_source("jd_gvel", [*con.A.entries(), *con.a.entries()], names)
+            + function_source("jd_gacc", con.c.entries(), names) + kernel)
 
 
 def general_library(system: System) -> ctypes.CDLL:

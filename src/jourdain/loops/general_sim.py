@@ -19,7 +19,7 @@ from ..errors import EvaluationError, JourdainError
 from ..model import System
 from ..simulation.options import C_METHODS, steps_per_call
 from ..simulation.problem import Segment
-from .general import GeneralEvaluator, functions
+from .general import VEL, GeneralEvaluator, functions, least_norm
 from .general_kernel import GeneralKernel, supported
 from .results import _work
 
@@ -32,11 +32,9 @@ C_SAMPLES = 501
 
 def _sample(ev: GeneralEvaluator, x: np.ndarray, t: float) -> tuple:
     s = ev.accelerations(x, t)
-    fn = s["fn"]
     phi = np.zeros(len(ev.labels))
-    hol = fn["Phi"].reshape(-1)
+    hol, phid = ev.residuals(s, t)
     phi[:hol.size] = hol
-    phid = fn["A"] @ s["yd"] + fn["a"][:, 0]
     return s["y"], s["yd"], s["ydd"], phi, phid, ev.multipliers(s)
 
 
@@ -132,15 +130,10 @@ def _multipliers(ev: GeneralEvaluator, t: np.ndarray, Y: np.ndarray, YD: np.ndar
                  R: np.ndarray) -> np.ndarray:
     """λ at every sample: the least-norm solution of ``Aᵀλ = r`` (as
     :meth:`GeneralEvaluator.multipliers`), batched."""
-    fn = functions(ev.system).con_fn
     if not len(t):
         return np.zeros((0, len(ev.labels)))
-    A = fn.batch(Y, YD, t, ev.p, ev.u)["A"]
-    U, sv, Vt = np.linalg.svd(np.swapaxes(A, 1, 2), full_matrices=False)
-    rank = len(ev.choice.rows_v)
-    inv = np.zeros_like(sv)
-    inv[:, :rank] = 1.0 / sv[:, :rank]
-    return np.einsum("nji,nj->ni", Vt, inv * np.einsum("nij,ni->nj", U, R))
+    A = functions(ev.system).fns[VEL].batch(Y, YD, t, ev.p, ev.u)["A"]
+    return least_norm(A, R, len(ev.choice.rows_v))[0]
 
 
 def _simulate_c(system: System, ev: GeneralEvaluator, span: tuple[float, float], y0: Any,

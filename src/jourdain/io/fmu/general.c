@@ -1,9 +1,9 @@
 /* FMI adapter of jourdain's kernel for velocity constraints (jourdain.io.fmu, a system with
    contacts whose speeds are rates of independent coordinates).
 
-   jd_loop.c is the generated jd_gpos (Φ, Φ_y, Φ_t of the holonomic rows) and jd_gvel (A, a, c
-   of every row), the hand-written kernel general_c.h of jourdain.loops (Newton on the
-   holonomic rows, W = [E_z; A] by LU, ẏ = L·z + l, γ, M_z = LᵀM_tree·L by Cholesky) and this
+   jd_loop.c is the generated jd_gpos (Φ, Φ_y, Φ_t of the holonomic rows), jd_gvel (A, a of
+   every row) and jd_gacc (their c), dense_c.h and the hand-written kernel general_c.h of
+   jourdain.loops (Newton on the holonomic rows, W = [E_z; A] by LU, ẏ = L·z + l, γ, M_z = LᵀM_tree·L by Cholesky) and this
    file, which runs the kernel in the partition fixed at export (model.h: jd_ind, jd_dep,
    jd_rows, jd_rows_v, jd_spd) with the tree's compiled M, k, q (jd_fn of jd_engine.c). It
    gives the interface of closed.c (model.h defines JD_CLOSED): the states are the independent
