@@ -21,7 +21,8 @@ from ..errors import EvaluationError
 from ..model import System
 from ..numeric import CompiledFunction, lambdify
 from ..numeric import evaluate as tree_evaluate
-from .general import GeneralEvaluator, general_constraints
+from .general import GeneralEvaluator
+from .general_choice import general_constraints
 
 
 @lru_cache(maxsize=16)

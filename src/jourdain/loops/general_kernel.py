@@ -27,7 +27,8 @@ from ..numeric import mkq_function
 from ..numeric.ccode import HEADER, argument_names, function_source
 from ..numeric.toolchain import build, build_lock, content_key
 from ..simulation.problem import address
-from .general import GeneralEvaluator, general_constraints
+from .general import GeneralEvaluator
+from .general_choice import general_constraints
 
 _VERSION = "general-c5"
 REASONS = {1: "Newton found no configuration with the holonomic rows satisfied",

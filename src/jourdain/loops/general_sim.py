@@ -19,7 +19,8 @@ from ..errors import EvaluationError, JourdainError
 from ..model import System
 from ..simulation.options import C_METHODS, steps_per_call
 from ..simulation.problem import Segment
-from .general import VEL, GeneralEvaluator, functions, least_norm
+from .general import VEL, GeneralEvaluator, functions
+from .general_choice import least_norm
 from .general_kernel import GeneralKernel, supported
 from .results import _work
 

@@ -309,7 +309,8 @@ def _general_parts(system: System, pvals: Mapping[str, float], y0v: list[float],
     coordinates with their start values and the further outputs (dependent coordinates and
     rates, every row's residual): the partition chosen at the initial state, which the FMU
     keeps; speeds that are rates of independent coordinates only."""
-    from ...loops.general import GeneralEvaluator, general_constraints
+    from ...loops.general import GeneralEvaluator
+    from ...loops.general_choice import general_constraints
     from ...loops.general_kernel import general_source, supported
 
     tree = system.tree
