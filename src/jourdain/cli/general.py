@@ -17,7 +17,7 @@ import numpy as np
 from ..analysis.modes import stability
 from ..errors import ClosedSystemError, JourdainError
 from ..io import export
-from ..io.capabilities import write_csv
+from ..io.capabilities import steady_mapping, write_csv
 from ..workflow.evaluation import EVAL_FORMAT, json_array
 from .arguments import overrides, sim_options, state_at
 from .outputs import output_file, samples
@@ -203,12 +203,7 @@ def linear_result(model: Any, about: str | None, params: dict[str, float]) -> An
     if not model.nominal:
         raise model.error("linearize: the model has no [nominal.<name>] steady motion")
     nom = next((n for n in model.nominal if n.name == about), model.nominal[0])
-    mapping: dict[str, Any] = {}
-    for name, e, ed in zip(system.coordinate_names, nom.y, nom.yd, strict=True):
-        if e != 0:
-            mapping[name] = e
-        if ed != 0:
-            mapping[f"{name}_d"] = ed
+    mapping = steady_mapping(system, nom)
     try:
         lin = system.linearize(mapping).at(params) if params else system.linearize(mapping)
     except JourdainError as exc:

@@ -97,6 +97,19 @@ def nominal_mapping(system: Any, nominal: NominalMotion) -> dict[str, se.Basic]:
     return {**dict(zip(system.coordinate_names, nominal.y, strict=True)), **dict(nominal.inputs)}
 
 
+def steady_mapping(system: Any, nominal: NominalMotion) -> dict[str, se.Basic]:
+    """A steady motion of a general system (velocity constraints) as
+    :meth:`System.linearize` takes it: ``{coordinate: y_s, "<coordinate>_d": ẏ_s}``, the
+    entries that are not 0 (expressions of the parameters)."""
+    out: dict[str, se.Basic] = {}
+    for name, e, ed in zip(system.coordinate_names, nominal.y, nominal.yd, strict=True):
+        if e != 0:
+            out[name] = e
+        if ed != 0:
+            out[f"{name}_d"] = ed
+    return out
+
+
 def linear_analysis(model: ModelFile, about: str | None,
                     parameters: Mapping[str, float] | None = None, t: float = 0.0,
                     period: Any = None) -> dict[str, Any]:

@@ -238,12 +238,12 @@ def _general(ctx: Context, about: str | None) -> None:
                                 "a steady state (numbers in the parameters)")
     ctx.nominal_state = se.Lambdify(list(system.parameter_symbols), exprs, real=True)
     v = np.asarray(ctx.nominal_state(ctx.p0), dtype=float).reshape(-1)
-    lin = linearize_general(system, _state_mapping(system, v))
+    lin = linearize_general(system, state_mapping(system, v))
     ctx.independent = tuple(lin.names)
     ctx.cyclic = tuple(lin.cyclic_in_eta)
 
 
-def _state_mapping(system: Any, v: np.ndarray) -> dict[str, float]:
+def state_mapping(system: Any, v: np.ndarray) -> dict[str, float]:
     """The nominal state ``v = (y, ẏ)`` as ``{coordinate: value, "<coordinate>_d": rate}``."""
     f = system.f
     coords = system.coordinate_names

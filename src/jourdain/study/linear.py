@@ -58,14 +58,14 @@ def closed_linearizations(ctx: Context, P: np.ndarray, Y: np.ndarray | None = No
     from ..loops.general_linear import linearize_general
     from ..loops.linearization import equilibrium
     from ..loops.nominal import linearize_state
-    from .context import FAILURES
+    from .context import FAILURES, state_mapping
 
     n, f, ft = len(P), ctx.f_linear, ctx.system.f
     out: dict[str, Any] = {"M_tilde": np.full((n, f, f), np.nan), "P": np.full((n, f, f), np.nan),
                            "Q": np.full((n, f, f), np.nan),
                            "A": np.full((n, 2 * f, 2 * f), np.nan),
                            "y_s": np.full((n, ft), np.nan), "errors": {}}
-    names, coords = ctx.parameter_names, ctx.system.coordinate_names
+    names = ctx.parameter_names
     for i in range(n):
         params = dict(zip(names, P[i].tolist(), strict=True))
         try:
@@ -75,8 +75,7 @@ def closed_linearizations(ctx: Context, P: np.ndarray, Y: np.ndarray | None = No
                 nominal = equilibrium(ctx.system, guess, parameters=params)
             else:
                 v = np.asarray(ctx.nominal_state(P[i]), dtype=float).reshape(-1)
-                nominal = {**dict(zip(coords, v[:ft].tolist(), strict=True)),
-                           **{f"{c}_d": x for c, x in zip(coords, v[ft:].tolist(), strict=True)}}
+                nominal = state_mapping(ctx.system, v)
             lin: Any
             if ctx.system.is_general:  # velocity constraints, about the steady motion
                 lin = linearize_general(ctx.system, nominal, params)

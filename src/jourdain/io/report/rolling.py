@@ -25,6 +25,7 @@ from ...analysis.modes import UNSTABLE, stability
 from ...analysis.sweep import stability_boundary
 from ...errors import JourdainError
 from ...model.validation import force_expressions
+from ..capabilities import steady_mapping
 from .figures import eigen_plot, plot_axes, svg, time_plot
 from .html import SYM, esc, html_table, mathml, matrix_table, note, numstr, snap
 from .state import Run
@@ -137,12 +138,7 @@ def linearization_section(run: Run) -> str:
     if not model.nominal:
         return "".join(s) + note("the model has no [nominal.<name>] steady motion")
     for nom in model.nominal:
-        mapping: dict[str, Any] = {}
-        for c, e, ed in zip(system.coordinate_names, nom.y, nom.yd, strict=True):
-            if e != 0:
-                mapping[c] = e
-            if ed != 0:
-                mapping[f"{c}_d"] = ed
+        mapping = steady_mapping(system, nom)
         lin: Any
         try:
             lin = system.linearize(mapping)
