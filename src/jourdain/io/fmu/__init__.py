@@ -286,19 +286,28 @@ def _closed_parts(system: System, pvals: Mapping[str, float], y0v: list[float],
     head = _closed_header(tree.f, len(con.labels), ind, dep, part.rows,
                           [float(v) for v in asm.z], ev.newton_tol, ev.max_newton, cond_limit)
     coords = [all_names[i] for i in ind]
-    out: list[tuple[str, str | None, str]] = []
-    for i in dep:
-        c = all_names[i]
-        text = descriptions.get(c, f"coordinate {c}")
-        out.append((c, units.get(c), f"{text} (dependent: solved from the closure)"))
-    for i in dep:
-        c = all_names[i]
-        u = units.get(c)
-        out.append((f"{c}_d", f"{u}/s" if u else None, f"rate of {c} (dependent)"))
+    out = _dependent_outputs(all_names, dep, units, descriptions, "the closure")
     for label in con.labels:
         out.append((f"Phi.{label}", None, f"closure residual: the constraint row {label}"))
     return (head, loop_src, coords, [float(asm.z[i]) for i in ind],
             [float(asm.zd[i]) for i in ind], out)
+
+
+def _dependent_outputs(names: Sequence[str], dep: Sequence[int], units: Mapping[str, str],
+                       descriptions: Mapping[str, str], source: str
+                       ) -> list[tuple[str, str | None, str]]:
+    """The FMU's outputs of the dependent coordinates and their rates (solved from
+    ``source``), as (name, unit, description)."""
+    out: list[tuple[str, str | None, str]] = []
+    for i in dep:
+        c = names[i]
+        text = descriptions.get(c, f"coordinate {c}")
+        out.append((c, units.get(c), f"{text} (dependent: solved from {source})"))
+    for i in dep:
+        c = names[i]
+        u = units.get(c)
+        out.append((f"{c}_d", f"{u}/s" if u else None, f"rate of {c} (dependent)"))
+    return out
 
 
 def _general_parts(system: System, pvals: Mapping[str, float], y0v: list[float],
@@ -338,15 +347,8 @@ def _general_parts(system: System, pvals: Mapping[str, float], y0v: list[float],
             + _array("long", "jd_rows_v", ch.rows_v)
             + _array("long", "jd_spd", ch.speed_coordinates or ()))
     coords = [all_names[i] for i in ind]
-    out: list[tuple[str, str | None, str]] = []
-    for i in dep:
-        c = all_names[i]
-        out.append((c, units.get(c), f"{descriptions.get(c, f'coordinate {c}')} (dependent: "
-                    "solved from the contacts' holonomic rows)"))
-    for i in dep:
-        c = all_names[i]
-        u = units.get(c)
-        out.append((f"{c}_d", f"{u}/s" if u else None, f"rate of {c} (dependent)"))
+    out = _dependent_outputs(all_names, dep, units, descriptions,
+                             "the contacts' holonomic rows")
     for k, label in enumerate(con.labels):
         what = "Φ" if k < con.r_h else "A·ẏ + a"
         out.append((f"Phi.{label}", None, f"residual of the row {label} ({what})"))
