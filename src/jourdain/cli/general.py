@@ -2,8 +2,9 @@
 ``eval`` (``--json``: the ``jourdain-eval/1`` document with the speeds, L, L̄ and the contact
 forces), ``reactions`` (contact forces by element, normal and tangential), ``linearize`` (about
 the file's nominal steady motion: M̃, P, Q, D, G, K, N, eigenvalues, the verdict, the cyclic
-coordinates left out) and ``simulate``. Each command calls this module's function for a system
-with contacts instead of the tree's path, so none of them can give the open tree's numbers.
+coordinates left out) and ``eom``. Each command calls this module's function for a system
+with contacts instead of the tree's path, so none of them can give the open tree's numbers;
+``simulate`` shares the tree's path (``System.simulate`` runs the general system).
 """
 
 from __future__ import annotations
@@ -17,13 +18,11 @@ import numpy as np
 from ..analysis.modes import stability
 from ..errors import ClosedSystemError, JourdainError
 from ..io import export
-from ..io.capabilities import steady_mapping, write_csv
+from ..io.capabilities import steady_mapping
 from ..workflow.evaluation import EVAL_FORMAT, json_array
-from .arguments import overrides, sim_options, state_at
-from .outputs import output_file, samples
+from .arguments import overrides, state_at
 
-EXIT_OK, EXIT_INTERRUPTED = 0, 130
-OUTPUT_SUFFIXES = (".csv",)
+EXIT_OK = 0
 
 
 def refuse(system: Any, command: str) -> None:
@@ -237,44 +236,5 @@ def cmd_linearize(model: Any, args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def cmd_simulate(model: Any, args: argparse.Namespace) -> int:
-    system = model.system
-    params = overrides(system, args.set)
-    opts = sim_options(model, args)
-    out = output_file(args.out, args.force, OUTPUT_SUFFIXES) if args.out else None
-    if opts.get("inputs"):
-        raise JourdainError(f"{system.name}: inputs are not available for systems with "
-                            "velocity constraints yet")
-    sim = model.simulation
-    t_end = float(opts.get("t_end", sim.t_end))
-    n = int(opts.get("samples", sim.samples))
-    y0 = opts.get("y0", sim.y0 if len(sim.y0) else np.zeros(system.f))
-    yd0 = opts.get("yd0", sim.yd0 if len(sim.yd0) else np.zeros(system.f))
-    try:
-        res = system.simulate((0.0, t_end), y0, yd0, parameters=params or None,
-                              method=opts.get("method", sim.method),
-                              rtol=float(opts.get("rtol", sim.rtol)),
-                              atol=opts.get("atol", sim.atol),
-                              t_eval=np.linspace(0.0, t_end, n))
-    except JourdainError as exc:
-        raise model.error(str(exc)) from None
-    if out:
-        write_csv(res, system, out)
-    span = f"t = {res.t[0]:g} … {res.t[-1]:g}"
-    print((f"wrote {out} " if out else f"{system.name}: simulated ") +
-          f"({samples(len(res.t))}, {span}" + ("" if res.status == "finished" else
-                                                f"; {res.status}") + ")")
-    c = res.constraints
-    print(f"  residuals along the run: max |Φ| = {np.abs(c.Phi).max(initial=0.0):.3e}, "
-          f"max |A·ẏ + a| = {np.abs(c.Phi_dot).max(initial=0.0):.3e}")
-    print("final state: " + ", ".join(f"{n}={v:.6g}" for n, v in
-                                      zip(system.coordinate_names, res.y[-1], strict=True)))
-    if res.status == "interrupted":
-        return EXIT_INTERRUPTED
-    if res.status == "failed":
-        raise JourdainError(f"{system.name}: {res.message}")
-    return EXIT_OK
-
-
-__all__ = ["check_lines", "cmd_eom", "cmd_eval", "eom_lines", "eom_matrices", "cmd_linearize", "cmd_reactions", "cmd_simulate",
+__all__ = ["check_lines", "cmd_eom", "cmd_eval", "eom_lines", "eom_matrices", "cmd_linearize", "cmd_reactions",
            "linear_result", "print_check", "refuse"]

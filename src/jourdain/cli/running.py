@@ -18,7 +18,6 @@ from ..io.report.figures import prepare_worker
 from ..io.workers import fork_workers, stop_workers
 from ..simulation.simulate import OUTPUT_SUFFIXES
 from ..workflow import require
-from . import general
 from .arguments import UsageError, load, overrides, sim_options
 from .outputs import output_file, output_folder, progress_printer, samples
 
@@ -28,8 +27,6 @@ EXIT_OK, EXIT_MODEL, EXIT_INTERRUPTED = 0, 1, 130
 def cmd_simulate(args: argparse.Namespace) -> int:
     model = load(args.model)
     system = model.system
-    if system.is_general:  # in the state (y_i, z)
-        return general.cmd_simulate(model, args)
     require(system, "simulate", "simulation")
 
     # every option and the output file are checked before the work
@@ -71,6 +68,10 @@ def _simulate(args: argparse.Namespace, model: Any, params: dict[str, float],
               + ("" if res.status == "finished" else f"; {res.status}") + ")")
     else:
         print(f"{system.name}: simulated {span} ({samples(len(res.t))})")
+    if res.constraints is not None:  # closing joints' or contacts' rows
+        phi, phid = res.closure_residual
+        print(f"  residuals along the run: max |Φ| = {phi:.3e}, max |Φ̇| (A·ẏ + a) = "
+              f"{phid:.3e}")
     where = ("final {}: " if res.status == "finished" else f"{{}} at t = {res.t[-1]:g}: ").format
     print(where("state") + ", ".join(f"{n}={v:.6g}" for n, v in
                                      zip(names, res.y[-1], strict=True)))
