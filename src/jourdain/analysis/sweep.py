@@ -100,29 +100,33 @@ def _boundary_numeric(lin: Any, parameter: str, a: float, b: float,
         return st.verdict, st.max_real_part
 
     va, vb = analyse(a), analyse(b)
-    ua, ub = va[0] == UNSTABLE, vb[0] == UNSTABLE
+    ua = va[0] == UNSTABLE
+    _check_bracket(parameter, a, b, ua, vb[0] == UNSTABLE)
+
+    def narrow(tol: float) -> None:  # bisection on the verdict, to tol of the bracket
+        nonlocal a, b, va, vb
+        while abs(b - a) > tol * max(1.0, abs(a), abs(b)):
+            mid = 0.5 * (a + b)
+            vm = analyse(mid)
+            if (vm[0] == UNSTABLE) == ua:
+                a, va = mid, vm
+            else:
+                b, vb = mid, vm
+
+    narrow(max(1e-3, rtol))
+    if va[1] * vb[1] < 0:
+        return float(brentq(lambda v: analyse(v)[1], a, b, xtol=1e-14,
+                            rtol=max(rtol * 1e-4, 4 * np.finfo(float).eps)))
+    narrow(rtol)
+    return 0.5 * (a + b)
+
+
+def _check_bracket(parameter: str, a: float, b: float, ua: bool, ub: bool) -> None:
+    """EvaluationError where both ends of the bracket have the same verdict."""
     if ua == ub:
         word = "unstable" if ua else "stable"
         raise EvaluationError(f'stability_boundary: the system is {word} at both {parameter} = '
                               f"{a} and {parameter} = {b}; give a bracket where it changes")
-    while abs(b - a) > max(1e-3, rtol) * max(1.0, abs(a), abs(b)):
-        mid = 0.5 * (a + b)
-        vm = analyse(mid)
-        if (vm[0] == UNSTABLE) == ua:
-            a, va = mid, vm
-        else:
-            b, vb = mid, vm
-    if va[1] * vb[1] < 0:
-        return float(brentq(lambda v: analyse(v)[1], a, b, xtol=1e-14,
-                            rtol=max(rtol * 1e-4, 4 * np.finfo(float).eps)))
-    lo, hi = a, b
-    while abs(hi - lo) > rtol * max(1.0, abs(lo), abs(hi)):
-        mid = 0.5 * (lo + hi)
-        if (analyse(mid)[0] == UNSTABLE) == ua:
-            lo = mid
-        else:
-            hi = mid
-    return 0.5 * (lo + hi)
 
 
 def stability_boundary(lin: Linearization | CompiledLinearization, parameter: str,
@@ -157,10 +161,7 @@ def stability_boundary(lin: Linearization | CompiledLinearization, parameter: st
     a, b = float(lower), float(upper)
     va, vb = analyse(a)[0], analyse(b)[0]
     ua, ub = va == UNSTABLE, vb == UNSTABLE
-    if ua == ub:
-        word = "unstable" if ua else "stable"
-        raise EvaluationError(f'stability_boundary: the system is {word} at both {parameter} = '
-                              f"{a} and {parameter} = {b}; give a bracket where it changes")
+    _check_bracket(parameter, a, b, ua, ub)
     # the evaluated point nearest to the boundary that was asymptotically stable
     asym = a if va == ASYMPTOTICALLY_STABLE else b if vb == ASYMPTOTICALLY_STABLE else None
     while abs(b - a) > rtol * max(1.0, abs(a), abs(b)):
