@@ -33,10 +33,8 @@ C_SAMPLES = 501
 
 def _sample(ev: GeneralEvaluator, x: np.ndarray, t: float) -> tuple:
     s = ev.accelerations(x, t)
-    phi = np.zeros(len(ev.labels))
     hol, phid = ev.residuals(s, t)
-    phi[:hol.size] = hol
-    return s["y"], s["yd"], s["ydd"], phi, phid, ev.multipliers(s)
+    return s["y"], s["yd"], s["ydd"], hol, phid, ev.multipliers(s)
 
 
 def simulate_general(system: System, t_span: tuple[float, float], y0: Any, yd0: Any = None,
@@ -50,9 +48,6 @@ def simulate_general(system: System, t_span: tuple[float, float], y0: Any, yd0: 
     multipliers (the contact forces along the rows' directions). Options: ``progress`` (a
     callable ``progress(t, t_end)`` after each step), ``output`` (a results file, written at
     the end or with the motion so far when interrupted)."""
-    from ..simulation.results import Results
-    from ..simulation.results.data import ConstraintHistories
-
     if inputs:
         raise EvaluationError(f"{system.name}: inputs are not available for systems with "
                               "velocity constraints yet")
@@ -62,17 +57,14 @@ def simulate_general(system: System, t_span: tuple[float, float], y0: Any, yd0: 
     if unknown:
         raise EvaluationError(f"simulate: unknown option(s) {', '.join(unknown)} for a system "
                               "with velocity constraints")
-    if method in C_METHODS:
-        ev = GeneralEvaluator(system, y0, float(t_span[0]), parameters)
-        if supported(ev):
-            return _simulate_c(system, ev, (float(t_span[0]), float(t_span[1])), y0, yd0,
-                               parameters, method, rtol, atol, t_eval, max_step, progress,
-                               output)
-    if method not in _METHODS:
+    if method not in C_METHODS and method not in _METHODS:
         raise EvaluationError(f'simulate: unknown method "{method}"; methods are '
                               f"{', '.join(_METHODS)}")
     t0, t1 = float(t_span[0]), float(t_span[1])
     ev = GeneralEvaluator(system, y0, t0, parameters)
+    run = _Run(system, ev, t0, parameters, method, rtol, atol, output)
+    if method in C_METHODS and supported(ev):
+        return _simulate_c(run, (t0, t1), y0, yd0, t_eval, max_step, progress)
     x0 = ev.initial(y0, yd0, t0)
 
     def rhs(t: float, x: np.ndarray) -> np.ndarray:
@@ -112,19 +104,49 @@ def simulate_general(system: System, t_span: tuple[float, float], y0: Any, yd0: 
         status, message, failure = "failed", str(exc), exc
     samples = [_sample(ev, x, t) for t, x in zip(ts, xs, strict=True)]
     Y, YD, YDD, PHI, PHID, LAM = (np.array([s[i] for s in samples]) for i in range(6))
-    cons = ConstraintHistories(tuple(ev.labels), PHI, PHID, LAM,
-                               ((t0, tuple(ev.independent_names)),), failure)
-    N = len(ts)
-    res = Results(system, np.array(ts), Y, YD, YDD, np.zeros((N, 0)), np.zeros(N),
-                  {**system.parameter_values, **dict(parameters or {})}, method=method,
-                  rtol=rtol, atol=atol, status=status, message=message, nfev=solver.nfev,
-                  nsteps=len(ts), n_accepted=len(ts), n_rejected=0,
-                  wall_time=time.perf_counter() - start, constraints=cons)
-    if N > 1:  # W = ∫ẏᵀq dt: the contact forces do no work (Jourdain's principle)
-        res.W = _work(res, system.tree, parameters, None, system)
-    if output is not None:  # at the end, or with the motion so far when interrupted
-        res.save(output)
-    return res
+    return run.results(np.array(ts), Y, YD, YDD, PHI, PHID, LAM, status, message, failure,
+                       (solver.nfev, len(ts), len(ts), 0), start)
+
+
+class _Run:
+    """What a general run's results are made of besides the motion (the system, its
+    evaluator, the settings and the output file): :meth:`results` builds them."""
+
+    def __init__(self, system: System, ev: GeneralEvaluator, t0: float,
+                 parameters: Mapping[str, float] | None, method: str, rtol: float, atol: Any,
+                 output: Any) -> None:
+        self.system, self.ev, self.t0, self.parameters = system, ev, t0, parameters
+        self.method, self.rtol, self.atol, self.output = method, rtol, atol, output
+
+    def results(self, T: np.ndarray, Y: np.ndarray, YD: np.ndarray, YDD: np.ndarray,
+                PHI: np.ndarray, PHID: np.ndarray, LAM: np.ndarray, status: str, message: str,
+                failure: BaseException | None, counts: tuple[int, int, int, int], start: float,
+                W: np.ndarray | None = None) -> Any:
+        """:class:`jourdain.Results` of the samples (``PHI`` of the holonomic rows, padded to
+        every row), ``counts`` = (right-hand sides, steps, accepted, rejected); ``W`` the
+        integrator's, else ``∫ẏᵀq dt`` over the samples (the contact forces do no work:
+        Jourdain's principle); written to the output file where one was asked for."""
+        from ..simulation.results import Results
+        from ..simulation.results.data import ConstraintHistories
+
+        ev, N = self.ev, len(T)
+        phi = np.zeros((N, len(ev.labels)))
+        if N:
+            phi[:, :PHI.shape[1]] = PHI
+        cons = ConstraintHistories(tuple(ev.labels), phi, PHID, LAM,
+                                   ((self.t0, tuple(ev.independent_names)),), failure)
+        res = Results(self.system, T, Y, YD, YDD, np.zeros((N, 0)), np.zeros(N),
+                      {**self.system.parameter_values, **dict(self.parameters or {})},
+                      method=self.method, rtol=self.rtol, atol=self.atol, status=status,
+                      message=message, nfev=int(counts[0]), nsteps=int(counts[1]),
+                      n_accepted=int(counts[2]), n_rejected=int(counts[3]),
+                      wall_time=time.perf_counter() - start, constraints=cons)
+        if N > 1:
+            res.W = W if W is not None else _work(res, self.system.tree, self.parameters,
+                                                  None, self.system)
+        if self.output is not None:  # at the end, or with the motion so far (interrupted)
+            res.save(self.output)
+        return res
 
 
 def _multipliers(ev: GeneralEvaluator, t: np.ndarray, Y: np.ndarray, YD: np.ndarray,
@@ -137,14 +159,11 @@ def _multipliers(ev: GeneralEvaluator, t: np.ndarray, Y: np.ndarray, YD: np.ndar
     return least_norm(A, R, len(ev.choice.rows_v))[0]
 
 
-def _simulate_c(system: System, ev: GeneralEvaluator, span: tuple[float, float], y0: Any,
-                yd0: Any, parameters: Mapping[str, float] | None, method: str, rtol: float,
-                atol: Any, t_eval: Any, max_step: float, progress: Any, output: Any) -> Any:
+def _simulate_c(run: _Run, span: tuple[float, float], y0: Any, yd0: Any, t_eval: Any,
+                max_step: float, progress: Any) -> Any:
     """The run in C (:mod:`jourdain.loops.general_kernel`): jourdain's integrator on
     ``(y_i, ẏ_i)`` through the kernel's ``jd_accel``; the samples taken back onto the rows."""
-    from ..simulation.results import Results
-    from ..simulation.results.data import ConstraintHistories
-
+    ev = run.ev
     t0, t1 = span
     x0 = ev.initial(y0, yd0, t0)
     s0 = ev.accelerations(x0, t0)
@@ -157,14 +176,15 @@ def _simulate_c(system: System, ev: GeneralEvaluator, span: tuple[float, float],
     state = np.concatenate([s0["y"][ind], s0["yd"][ind], [0.0]])
     start = time.perf_counter()
     seg = Segment(ni, ev.u, kernel.tree.address, kernel.state_address, kernel.accel_address,
-                  t0, state, te, C_METHODS[method], rtol, float(np.max(atol)), max_step)
+                  t0, state, te, C_METHODS[run.method], run.rtol, float(np.max(run.atol)),
+                  max_step)
     seg.atol[-1] = 1e300  # W out of the error norm (as the closed systems' runs)
 
     def on_chunk(t: float) -> None:
         if callable(progress):
             progress(t, t1)
 
-    status, message, failure = "finished", "integrated to the end", None
+    status, message = "finished", "integrated to the end"
     try:
         code = seg.run(t1, steps_per_call(ni), on_chunk)
     except KeyboardInterrupt:  # between two calls: the samples so far are consistent
@@ -183,25 +203,14 @@ def _simulate_c(system: System, ev: GeneralEvaluator, span: tuple[float, float],
         T = T[:bad]
         smp = {key: v[:bad] for key, v in smp.items()}
         status, message = "failed", f"no configuration at t = {float(seg.out_t[bad]):.6g}"
-    N = len(T)
     lam = smp["lam"]
-    if N and np.isnan(lam).any():  # redundant rows: the least-norm multipliers
+    if len(T) and np.isnan(lam).any():  # redundant rows: the least-norm multipliers
         lam = _multipliers(ev, T, smp["y"], smp["yd"], smp["r"])
-    phi = np.zeros((N, len(ev.labels)))
-    phi[:, :smp["Phi"].shape[1]] = smp["Phi"]
-    cons = ConstraintHistories(tuple(ev.labels), phi, smp["Phi_dot"], lam,
-                               ((t0, tuple(ev.independent_names)),), failure)
-    cnt = seg.cnt
-    res = Results(system, T, smp["y"], smp["yd"], smp["ydd"], np.zeros((N, 0)), np.zeros(N),
-                  {**system.parameter_values, **dict(parameters or {})}, method=method,
-                  rtol=rtol, atol=atol, status=status, message=message, nfev=int(cnt[0]),
-                  nsteps=int(cnt[1]), n_accepted=int(cnt[2]), n_rejected=int(cnt[3]),
-                  wall_time=time.perf_counter() - start, constraints=cons)
-    if N > 1:  # the power's integral along the integrator's own steps (it integrates W)
-        res.W = np.array(seg.out_x[:N, -1]) - float(state[-1])
-    if output is not None:
-        res.save(output)
-    return res
+    # W: the power's integral along the integrator's own steps (it integrates W)
+    c = [int(v) for v in seg.cnt[:4]]
+    return run.results(T, smp["y"], smp["yd"], smp["ydd"], smp["Phi"], smp["Phi_dot"], lam,
+                       status, message, None, (c[0], c[1], c[2], c[3]), start,
+                       W=np.array(seg.out_x[:len(T), -1]) - float(state[-1]))
 
 
 __all__ = ["simulate_general"]
