@@ -39,7 +39,7 @@ from ..stages.newton_euler import newton_euler
 from ..stages.projection import projection
 from ..symbolic import SymMatrix
 from .evaluator import _newton_stop
-from .general_choice import choose, general_constraints, least_norm
+from .general_choice import Choice, choose, general_constraints, least_norm
 
 EPS = float(np.finfo(float).eps)
 
@@ -139,7 +139,7 @@ class GeneralEvaluator:
 
     def __init__(self, system: System, y0: Any, t: float = 0.0,
                  parameters: Mapping[str, float] | None = None, inputs: Any = None,
-                 complex_: bool = False) -> None:
+                 complex_: bool = False, choice: Choice | None = None) -> None:
         tree = system.tree
         self.system = system
         self.n = tree.f
@@ -152,9 +152,11 @@ class GeneralEvaluator:
         y = np.asarray(y0, dtype=float).reshape(-1)
         if y.size != self.n:
             raise EvaluationError(f"{system.name}: {self.n} coordinates expected, got {y.size}")
-        real = functions(system, False) if complex_ else self.fn
-        self.choice = choose(system, real(y, np.zeros(self.n), float(t), self.p, self.u,
-                                          (POS, VEL)))
+        if choice is None:  # the partition at y0
+            real = functions(system, False) if complex_ else self.fn
+            choice = choose(system, real(y, np.zeros(self.n), float(t), self.p, self.u,
+                                         (POS, VEL)))
+        self.choice = choice
         self.y_guess = y.astype(self.dtype)
         self.max_newton = 25
         self.newton_tol = 1e-13

@@ -128,8 +128,7 @@ def linearize_general(system: System, nominal: Any,
     s0 = ev.accelerations(x0, t)
     ch = ev.choice
     zd_s = np.array([acc.get(n, 0.0) for n in ch.speeds])
-    evc = GeneralEvaluator(system, s0["y"], t, values, complex_=True)
-    evc.choice = ch
+    evc = GeneralEvaluator(system, s0["y"], t, values, complex_=True, choice=ch)
     yref = s0["y"].astype(complex)
     ni, g = len(ch.independent), len(ch.speeds)
     nx = ni + g

@@ -49,7 +49,11 @@ def _ground_axes(n: Vec3) -> tuple[Vec3, Vec3]:
 
 def material_velocity(kin: Kinematics, body: str, P: Vec3, f: int) -> tuple[list[Expr], Vec3]:
     """The velocity of ``body``'s material point at the inertial point ``P`` (an expression of
-    y, t): its columns over ẏ (inertial, one 3-vector per coordinate) and its rheonomic part."""
+    y, t): its columns over ẏ (inertial, one 3-vector per coordinate) and its rheonomic part.
+    Not :meth:`BodyKinematics.point`, which takes a point fixed in the body: a contact point
+    moves over the body, and its arm from the body's origin is formed inertially here
+    (``(S·J_R)×(P − r_O)``) instead of as ``S·(J_R × Sᵀ·(P − r_O))``, whose products of S
+    would be left unsimplified in the generated code."""
     bk = kin[body]
     S: Any = bk.S.rows
     rO = tuple(bk.r_O.rows[i][0] for i in range(3))
