@@ -29,24 +29,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-BASE = """[model]
-name = "hostile"
-[coordinates]
-phi = "rad"
-[parameters]
-m1 = 1.0
-l1 = 1.0
-g = 9.81
-[bodies.rod]
-parent = "world"
-mass = "m1"
-com = [0, "-l1/2", 0]
-inertia = { rod = { length = "l1", axis = "y" } }
-joint = { type = "revolute", coordinate = "phi", axis = "z" }
-[forces.gravity]
-type = "gravity"
-g = [0, "-g", 0]
-"""
+# the model file of tests/test_hostile_modelfiles.py (the same hostile cases, timed here)
+from tests.test_hostile_modelfiles import BASE  # noqa: E402
 
 
 def best(fn: Callable[[], object], repeat: int) -> float:
