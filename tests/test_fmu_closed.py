@@ -29,14 +29,14 @@ fmpy = pytest.importorskip("fmpy", reason="FMPy is in the test extra (jourdain[t
 
 from fmpy import extract, read_model_description, simulate_fmu  # noqa: E402
 from fmpy.fmi1 import FMICallException  # noqa: E402
-from fmpy.fmi2 import FMU2Model, FMU2Slave  # noqa: E402
+from fmpy.fmi2 import FMU2Model  # noqa: E402
 from fmpy.validation import validate_fmu  # noqa: E402
 
 from jourdain.cli import main  # noqa: E402
 from jourdain.errors import ModelError  # noqa: E402
 from jourdain.io import load_model  # noqa: E402
 from jourdain.io.fmu import export_fmu  # noqa: E402
-from tests.test_fmu import FMU_RTOL, ROOT, TRAJ_TOL, needs_cc  # noqa: E402
+from tests.test_fmu import FMU_RTOL, ROOT, TRAJ_TOL, needs_cc, state_roundtrip  # noqa: E402
 
 PHI_TOL = 1e-11  # see the module docstring
 
@@ -151,33 +151,7 @@ def test_state_restore(four_bar: tuple) -> None:
     """fmi2Get/SetFMUstate and serialization keep the loop kernel's state (Newton's start): a
     re-run from a saved state repeats (to Newton's tolerance: the restored kernel starts
     without the first-order prediction)."""
-    _, info = four_bar
-    md = read_model_description(str(info.path))
-    vr = [v.valueReference for v in md.modelVariables if v.name in ("theta2", "theta3_d")]
-    fmu = FMU2Slave(guid=md.guid, unzipDirectory=extract(str(info.path)),
-                    modelIdentifier=info.model_identifier, instanceName="cs")
-    fmu.instantiate()
-    try:
-        fmu.setupExperiment(tolerance=1e-9, startTime=0.0)
-        fmu.enterInitializationMode()
-        fmu.exitInitializationMode()
-        fmu.doStep(0.0, 0.5)
-        state = fmu.getFMUState()
-        blob = fmu.serializeFMUState(state)
-        fmu.doStep(0.5, 0.5)
-        first = np.array(fmu.getReal(vr))
-        restored = fmu.deSerializeFMUstate(blob)
-        fmu.setFMUstate(restored)
-        fmu.doStep(0.5, 0.5)
-        np.testing.assert_allclose(fmu.getReal(vr), first, rtol=0, atol=1e-11)
-        fmu.setFMUstate(state)
-        fmu.doStep(0.5, 0.5)
-        np.testing.assert_allclose(fmu.getReal(vr), first, rtol=0, atol=1e-11)
-        fmu.freeFMUstate(restored)
-        fmu.freeFMUstate(state)
-        fmu.terminate()
-    finally:
-        fmu.freeInstance()
+    state_roundtrip(four_bar[1], ("theta2", "theta3_d"), atol=1e-11)
 
 
 def test_reactions_refused_and_cli(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
