@@ -21,7 +21,6 @@ friction forces as state-feedback inputs, computed from the state at every evalu
 
 from __future__ import annotations
 
-import inspect
 import numbers
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
@@ -36,6 +35,7 @@ from ..model.expressions import as_expr, values_at
 from ..model.forces import GeneralizedForce
 from ..numeric import evaluate as evaluate_eom
 from ..numeric import lambdify, parameter_vector, state_vectors
+from ..simulation.problem import takes_state  # the integrator's rule for an input law
 from ..symbolic import SymMatrix
 from .reactions import ReactionLayout, _reactions_function, evaluate_keys, projected_reactions
 from .reactions import solve_g as _solve_g
@@ -295,22 +295,12 @@ def _one_input(system: System, name: str, v: Any, p: np.ndarray
         return lambda t, y, yd: float(np.interp(t, tt, vv))
     if callable(v) and not isinstance(v, se.Basic):
         fn = v
-        if _takes_state(fn):
+        if takes_state(fn):
             return lambda t, y, yd: float(fn(t, y.copy(), yd.copy()))
         return lambda t, y, yd: float(fn(t))
     compiled = lambdify(system, {"u": SymMatrix.column([as_expr(v, f'input "{name}"')])})
     zero = np.zeros(len(system.inputs))
     return lambda t, y, yd: float(compiled(y, yd, t, p, zero)["u"][0, 0])
-
-
-def _takes_state(fn: Callable[..., Any]) -> bool:
-    """True for ``u(t, y, yd)``, False for ``u(t)`` (as the integrator decides)."""
-    try:
-        params = inspect.signature(fn).parameters.values()
-    except (TypeError, ValueError):
-        return False
-    positional = [p for p in params if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)]
-    return len(positional) >= 3 or any(p.kind == p.VAR_POSITIONAL for p in params)
 
 
 __all__ = ["FrictionModel", "FrictionState", "evaluate_friction", "friction_inputs",

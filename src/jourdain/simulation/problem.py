@@ -258,7 +258,7 @@ class _Setup:
             elif callable(v) and not isinstance(v, se.Basic):
                 self.u_kind[i] = 3
                 self.callables[i] = v
-                self.feedback[i] = _takes_state(v)
+                self.feedback[i] = takes_state(v)
             else:
                 try:
                     e = as_expr(v, f'input "{name}"')
@@ -378,7 +378,7 @@ def _allowed_symbols(system: System) -> set[str]:
     return {"t", *names, *(f"{n}_d" for n in names), *(k for k, _ in system.parameters)}
 
 
-def _takes_state(fn: Callable[..., Any]) -> bool:
+def takes_state(fn: Callable[..., Any]) -> bool:
     """True for ``u(t, y, yd)`` (state feedback), False for ``u(t)``."""
     try:
         params = inspect.signature(fn).parameters.values()
