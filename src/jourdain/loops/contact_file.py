@@ -50,11 +50,7 @@ _KEYS: dict[str, set[str]] = {
 def _contact(loader: Any, name: str, spec: Any, bodies: list[str]) -> Any:
     p = ("contacts", name)
     spec = loader.table(spec, p, what=f"a table [contacts.{name}]")
-    kind = loader.string(loader.require(spec, "type", p), (*p, "type"))
-    if kind not in _KEYS:
-        raise loader.fail((*p, "type"), f'unknown contact type "{kind}"'
-                          f"{loader.suggest(kind, list(_KEYS))}; expected one of "
-                          f"{', '.join(_KEYS)}")
+    kind = loader.kind(spec, p, _KEYS, "contact")
     loader.table(spec, p, _KEYS[kind] | {"type"})
     params = set(loader.params)
     if kind == "velocity":

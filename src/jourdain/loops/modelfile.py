@@ -48,11 +48,7 @@ def read_loops(loader: Any, data: dict, system: _S) -> _S:
     for name, spec in tbl.items():
         jp = (*p, name)
         spec = loader.table(spec, jp, what=f'a table [closing_joints.{name}]')
-        kind = loader.string(loader.require(spec, "type", jp), (*jp, "type"))
-        if kind not in KINDS:
-            raise loader.fail((*jp, "type"), f'unknown closing joint type "{kind}"'
-                              f"{loader.suggest(kind, list(KINDS))}; expected one of "
-                              f"{', '.join(KINDS)}")
+        kind = loader.kind(spec, jp, KINDS, "closing joint")
         loader.table(spec, jp, _KEYS[kind] | {"type"})
         kw: dict[str, Any] = {}
         if kind == "constraint":

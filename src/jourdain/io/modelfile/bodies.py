@@ -169,11 +169,7 @@ class _Bodies(_Values):
     def joint(self, value: object, p: Path, bname: str) -> Any:
         spec = self.table(value, p, what='a joint table such as { type = "revolute", '
                           'coordinate = "phi", axis = "z" }')
-        jtype = self.string(self.require(spec, "type", p), (*p, "type")).lower()
-        if jtype not in _JOINT_KEYS:
-            raise self.fail((*p, "type"), f'unknown joint type "{jtype}"'
-                            f"{self.suggest(jtype, list(_JOINT_KEYS))}; expected one of "
-                            f"{', '.join(_JOINT_KEYS)}")
+        jtype = self.kind(spec, p, _JOINT_KEYS, "joint", lower=True)
         self.table(spec, p, _JOINT_KEYS[jtype] | _JOINT_COMMON)
         jname = self.name(spec.get("name", bname), (*p, "name"), "joint")
         if jname in self.joint_of_body.values():

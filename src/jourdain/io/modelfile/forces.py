@@ -47,11 +47,7 @@ class _Forces(_Bodies):
     def force(self, fname: str, spec: object, p: Path) -> Any:
         self.name(fname, p, "force")
         spec = self.table(spec, p, what='a force table with a "type"')
-        ftype = self.string(self.require(spec, "type", p), (*p, "type")).lower()
-        if ftype not in _FORCE_KEYS:
-            raise self.fail((*p, "type"), f'unknown force type "{ftype}"'
-                            f"{self.suggest(ftype, list(_FORCE_KEYS))}; expected one of "
-                            f"{', '.join(_FORCE_KEYS)}")
+        ftype = self.kind(spec, p, _FORCE_KEYS, "force", lower=True)
         self.table(spec, p, _FORCE_KEYS[ftype] | {"type", "description"})
         rates = {f"{c}_d" for c in self.coords}
         allowed = (set(self.coords) | rates | set(self.params) | set(self.inputs) | {"t"}
@@ -240,11 +236,7 @@ class _Forces(_Bodies):
             p: Path = (*path, qname)
             self.name(qname, p, "quantity")
             spec = self.table(spec, p, what='a quantity table with a "type"')
-            kind = self.string(self.require(spec, "type", p), (*p, "type")).lower()
-            if kind not in QUANTITY_KINDS:
-                raise self.fail((*p, "type"), f'unknown quantity type "{kind}"'
-                                f"{self.suggest(kind, list(QUANTITY_KINDS))}; expected one of "
-                                f"{', '.join(QUANTITY_KINDS)}")
+            kind = self.kind(spec, p, QUANTITY_KINDS, "quantity", lower=True)
             two = QUANTITY_KINDS[kind][1]
             self.table(spec, p, (_QUANTITY_KEYS_TWO if two else _QUANTITY_KEYS_ONE)
                        | {"type", "description"})

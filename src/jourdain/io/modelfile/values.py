@@ -5,7 +5,7 @@ vectors, axes and matrices, each checked and located (file, line, key path) when
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Container, Mapping
+from collections.abc import Callable, Container, Iterable, Mapping
 from typing import Any
 
 import symengine as se
@@ -54,6 +54,19 @@ class _Values(Locator):
         if not isinstance(value, str):
             raise self.fail(path, f"expected a string, got {_type_name(value)}")
         return value
+
+    def kind(self, spec: Mapping[str, object], path: Path, kinds: Iterable[str], what: str,
+             lower: bool = False) -> str:
+        """The ``type`` of the table ``spec`` at ``path``, one of ``kinds`` (a located error
+        with a suggestion otherwise): forces, joints, quantities, closing joints, contacts."""
+        kind = self.string(self.require(spec, "type", path), (*path, "type"))
+        kind = kind.lower() if lower else kind
+        options = list(kinds)
+        if kind not in options:
+            raise self.fail((*path, "type"), f'unknown {what} type "{kind}"'
+                            f"{self.suggest(kind, options)}; expected one of "
+                            f"{', '.join(options)}")
+        return kind
 
     def line_string(self, value: object, path: Path) -> str:
         """A string of one line: no line breaks or other control characters (a model's name
