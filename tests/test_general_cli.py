@@ -149,3 +149,46 @@ def test_python_entry_points_never_use_the_open_tree() -> None:
     res = jd.simulate(s, (0.0, 0.2), [0, 0, -0.3, 0, 0.05, 0, 0, 0, 0],
                       [0, 0, 0, 0, 0, 0, -5 / 0.3, 0, 0])
     assert res.constraints is not None and "rear.T1" in res.constraints.labels
+
+
+def test_every_public_function_handles_or_refuses_a_general_system() -> None:
+    """The walk of tests/test_entry_points_closed.py on the bicycle: the functions of the
+    tree's numbers refuse it naming the contacts; the analyses of a linearization (sweep and
+    stability_boundary linearizing anew per value) and the viewer give its results."""
+    import symengine as se
+
+    from tests.test_entry_points_closed import OUTCOME
+
+    s = jd.load_model(BIKE).system
+    n = s.coordinate_names
+    y0 = np.zeros(9)
+    y0[n.index("zc")] = -0.3
+    yd0 = np.zeros(9)
+    yd0[n.index("thetaR")] = -5 / 0.3
+    lin = s.linearize({"zc": -se.Symbol("rR"), "thetaR_d": -se.Symbol("v") / se.Symbol("rR")})
+    refused = {
+        "kinematics": lambda: jd.kinematics(s),
+        "evaluate_reactions": lambda: jd.evaluate_reactions(s, y0, yd0),
+        "joint_reactions": lambda: jd.joint_reactions(s, "H", y0, yd0),
+        "joint_wrenches": lambda: jd.joint_wrenches(s, np.zeros(15), y0),
+        "linearize_numeric": lambda: jd.linearize_numeric(s, {"zc": -0.3}),
+        "floquet": lambda: jd.floquet(lin, 1.0),
+        "cyclic_coordinates": lambda: jd.cyclic_coordinates(s),
+        "find_equilibrium": lambda: jd.find_equilibrium(s, y0),
+        "find_equilibria": lambda: jd.find_equilibria(s, [y0]),
+        "state_feedback": lambda: jd.state_feedback(s, np.zeros((0, 2)), {"zc": -0.3}),
+    }
+    handled = {"sweep", "stability_boundary"}
+    assert set(refused) | handled == {k for k, v in OUTCOME.items() if v == "refused"}
+    for name, call in refused.items():
+        with pytest.raises(jd.ClosedSystemError, match="contact"):
+            call()
+        assert name
+    sw = jd.sweep(lin, "v", [3.0, 5.0, 7.0])
+    assert sw.verdicts == ("unstable", "asymptotically stable", "unstable")
+    assert abs(jd.stability_boundary(lin, "v", 3.0, 5.0) - WEAVE) <= 1e-10 * WEAVE
+    assert jd.state_space(lin).A.shape == (4, 4) and len(jd.modes(lin).eigenvalues) == 4
+    assert jd.frequency_response(lin, np.array([1.0]), excitation="h").response.shape == (
+        1, 2, 2)
+    assert jd.to_control(lin) is not None
+    assert jd.view(s.simulate((0.0, 0.1), y0, yd0)) is not None

@@ -7,7 +7,7 @@ evaluates numbers; a :class:`~jourdain.CompiledLinearization` makes long sweeps 
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -63,7 +63,12 @@ def sweep(lin: Linearization | CompiledLinearization, parameter: str,
           parameters: Mapping[str, float] | None = None) -> Sweep:
     """Eigenvalues and stability verdicts over ``values`` of ``parameter`` (other parameters at
     their defaults, overridden by ``parameters``); the verdicts in Routh's sense where the
-    system has cyclic coordinates (:func:`jourdain.analysis.stability`)."""
+    system has cyclic coordinates (:func:`jourdain.analysis.stability`). A general system's
+    linearization (numbers about a steady motion) is taken anew at each value (``lin.at``);
+    where its coordinates change along the sweep (a decoupled cyclic speed left out at some
+    values), the missing eigenvalues are NaN."""
+    if callable(getattr(lin, "at", None)):
+        return _sweep_numeric(lin, parameter, values, parameters)
     refuse_closed(getattr(lin, "system", None), "sweeps need the symbolic linearization, which "
                   "closed systems do not have: linearize the closed system at each value "
                   "(System.linearize with parameters) or use a study (jourdain study)")
@@ -84,6 +89,33 @@ def sweep(lin: Linearization | CompiledLinearization, parameter: str,
     return Sweep(parameter, vals, np.array(eigs), np.array(maxre), tuple(verdicts))
 
 
+def _numeric_at(lin: Any, parameter: str, parameters: Mapping[str, float] | None
+                ) -> Callable[[float], Any]:
+    """The linearization of a general system at a value of ``parameter`` (checked)."""
+    names = list(dict(lin.parameters or {}))
+    if parameter not in names:
+        raise EvaluationError(f'unknown parameter "{parameter}"; parameters are {names}')
+    return lambda v: lin.at({**(parameters or {}), parameter: float(v)})
+
+
+def _sweep_numeric(lin: Any, parameter: str, values: Sequence[float] | np.ndarray,
+                   parameters: Mapping[str, float] | None) -> Sweep:
+    """:func:`sweep` of a general system's linearization (see there)."""
+    at = _numeric_at(lin, parameter, parameters)
+    vals = np.asarray(values, dtype=float).reshape(-1)
+    lams, verdicts = [], []
+    for v in vals:
+        other = at(v)
+        lam = np.asarray(other.eigenvalues, complex)
+        lams.append(lam[np.lexsort((lam.real, lam.imag))])
+        verdicts.append(stability(other).verdict)
+    eigs = np.full((len(vals), max((len(x) for x in lams), default=0)), np.nan + 0j)
+    for i, x in enumerate(lams):
+        eigs[i, :len(x)] = x
+    return Sweep(parameter, vals, eigs, np.nanmax(eigs.real, axis=1, initial=-np.inf),
+                 tuple(verdicts))
+
+
 def _boundary_numeric(lin: Any, parameter: str, a: float, b: float,
                       parameters: Mapping[str, float] | None, rtol: float) -> float:
     """:func:`stability_boundary` of a linearization that is numbers about a nominal state
@@ -92,11 +124,10 @@ def _boundary_numeric(lin: Any, parameter: str, a: float, b: float,
     Brent's method on the largest real part (to ``rtol`` and rounding)."""
     from scipy.optimize import brentq
 
-    if parameter not in dict(lin.parameters or {}):
-        raise EvaluationError(f'stability_boundary: unknown parameter "{parameter}"')
+    at = _numeric_at(lin, parameter, parameters)
 
     def analyse(v: float) -> tuple[str, float]:
-        st = stability(lin.at({**(parameters or {}), parameter: float(v)}))
+        st = stability(at(v))
         return st.verdict, st.max_real_part
 
     va, vb = analyse(a), analyse(b)

@@ -16,13 +16,14 @@ the same sections as a tree's, with the general system's numbers, plus section 6
 from __future__ import annotations
 
 import json
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 import symengine as se
 
 from ...analysis.modes import UNSTABLE, stability
-from ...analysis.sweep import stability_boundary
+from ...analysis.sweep import stability_boundary, sweep
 from ...errors import JourdainError
 from ...model.validation import force_expressions
 from ..capabilities import steady_mapping
@@ -117,7 +118,7 @@ def sweep_plot(values: np.ndarray, real: np.ndarray, name: str, bounds: list[flo
     return svg(fig)
 
 
-def _stable_range(lin: Any, name: str, values: np.ndarray, verdicts: list[str]
+def _stable_range(lin: Any, name: str, values: np.ndarray, verdicts: Sequence[str]
                   ) -> list[float]:
     """The boundaries of the stability verdict over ``values``, each to 1e-10 by
     :func:`jourdain.stability_boundary`."""
@@ -173,20 +174,13 @@ def _sweep(run: Run, nom: Any, lin: Any) -> str:
         return ""
     top = 2.0 * float(lin.parameters[name]) or 1.0
     values = np.linspace(0.0, top, SWEEP_POINTS)
-    lams, verdicts = [], []
-    for v in values:
-        try:
-            other = lin.at({name: float(v)})
-        except JourdainError as exc:
-            run.info.notes.append(f"{nom.name} over {name}: {exc}")
-            return note(f"the eigenvalues over {name} are not available: {exc}")
-        lams.append(np.asarray(other.eigenvalues, complex))
-        verdicts.append(stability(other).verdict)
-    # η may lose a decoupled cyclic speed at some values (a disc not spinning): NaN-padded
-    n = max(len(x) for x in lams)
-    lam = np.full((len(values), n), np.nan + 0j)
-    for i, x in enumerate(lams):
-        lam[i, :len(x)] = x
+    try:  # η may lose a decoupled cyclic speed at some values (a disc not spinning): NaN
+        sw = sweep(lin, name, values)
+    except JourdainError as exc:
+        run.info.notes.append(f"{nom.name} over {name}: {exc}")
+        return note(f"the eigenvalues over {name} are not available: {exc}")
+    lam, verdicts = sw.eigenvalues, sw.verdicts
+    n = lam.shape[1]
     real = list(lam.real)
     try:
         bounds = _stable_range(lin, name, values, verdicts)
