@@ -16,7 +16,7 @@ import symengine as se
 
 from ..model import Body, General, Gravity, Planar, Revolute, Rot, Trans, symbols
 from ..model.contacts import KnifeEdge, RollingDisc
-from ..model.forces import GeneralizedForce
+from ..model.forces import GeneralizedForce, RotationalSpringDamper
 from ..pipeline import System
 
 #: default data of :func:`differential_drive` (SI units)
@@ -122,4 +122,26 @@ def skate_on_incline() -> System:
                   speeds={"u": se.cos(psi) * xd + se.sin(psi) * yd, "w": psid})
 
 
-__all__ = ["DIFFERENTIAL_DRIVE", "SKATE", "differential_drive", "skate_on_incline"]
+def snake(n: int) -> System:
+    """A wheeled snake robot: ``n`` links of length ``l`` in the ground plane (the first on a
+    planar joint ``x, y, psi``, each next on a revolute joint ``q<i>`` at the end of the one
+    before, joined by torsion springs ``k``), each on a knife edge (a passive wheel pair) at
+    ``a`` along it: f = n + 2 coordinates, n velocity rows, 2 speeds (the partition's). The
+    large general system of the cross-check (``benchmarks/rolling_crosscheck.py``)."""
+    x, y, psi = symbols("x y psi")
+    qs = [symbols(f"q{i}") for i in range(1, n)]
+    m, inertia, length, a, k = symbols("m I l a k")
+    bodies = [Body("b0", "world", Planar("base", (x, y, psi)), mass=m, com=(length / 2, 0, 0),
+                   inertia=(inertia, inertia, inertia))]
+    for i, q in enumerate(qs, 1):
+        bodies.append(Body(f"b{i}", f"b{i - 1}", Revolute(f"j{i}", q, "z",
+                                                         position=(length, 0, 0)),
+                           mass=m, com=(length / 2, 0, 0), inertia=(inertia, inertia, inertia)))
+    return System([x, y, psi, *qs], bodies,
+                  [RotationalSpringDamper(f"s{i}", q, k) for i, q in enumerate(qs, 1)],
+                  parameters={"m": 1.0, "I": 0.1, "l": 0.5, "a": 0.2, "k": 2.0},
+                  name=f"snake of {n} links",
+                  contacts=[KnifeEdge(f"edge{i}", f"b{i}", (a, 0, 0), "x") for i in range(n)])
+
+
+__all__ = ["DIFFERENTIAL_DRIVE", "SKATE", "differential_drive", "skate_on_incline", "snake"]
