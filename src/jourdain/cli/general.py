@@ -16,22 +16,13 @@ from typing import Any
 import numpy as np
 
 from ..analysis.modes import stability
-from ..errors import ClosedSystemError, JourdainError
+from ..errors import JourdainError
 from ..io import export
 from ..io.capabilities import steady_mapping
 from ..workflow.evaluation import EVAL_FORMAT, json_array
 from .arguments import overrides, state_at
 
 EXIT_OK = 0
-
-
-def refuse(system: Any, command: str) -> None:
-    """A command not available for a general system yet: a clean error naming it."""
-    raise ClosedSystemError(system, f"jourdain {command} is not available for systems with "
-                            "velocity constraints yet",
-                            "check, eom, eval, reactions, linearize, simulate, run and study "
-                            "are; from Python "
-                            "system.evaluate, system.linearize, system.simulate")
 
 
 #: the symbolic matrices of a general system that eom shows beyond the closed system's
@@ -236,5 +227,5 @@ def cmd_linearize(model: Any, args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-__all__ = ["check_lines", "cmd_eom", "cmd_eval", "eom_lines", "eom_matrices", "cmd_linearize", "cmd_reactions",
-           "linear_result", "print_check", "refuse"]
+__all__ = ["check_lines", "cmd_eom", "cmd_eval", "cmd_linearize", "cmd_reactions", "eom_lines",
+           "eom_matrices", "linear_result", "print_check"]
