@@ -10,7 +10,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from ..errors import AssemblyError, ModelError, SingularConfiguration
+from ..errors import AssemblyError, ClosedSystemError, ModelError, SingularConfiguration
 from ..model import System
 from ..numeric import CompiledFunction, lambdify
 from ..stages.constraints import Constraints
@@ -25,8 +25,6 @@ def constraints(loop: System) -> Constraints:
     on the tree's kinematics), kept by the system; ModelError when its closing joints give no
     row."""
     if getattr(loop, "is_general", False):
-        from ..errors import ClosedSystemError
-
         raise ClosedSystemError(loop, "the numbers of closed systems (holonomic rows, "
                                 "ẏ_i as velocities) do not apply; its velocity constraints "
                                 "need the general path (jourdain.loops.general)")
