@@ -28,6 +28,7 @@ PACKAGES = {
     "fmu": ["fmpy"],
     "control": ["control"],
     "study": ["xarray", "h5netcdf", "netCDF4", "dask", "distributed"],
+    "casadi": ["casadi"],
 }
 
 
@@ -87,8 +88,9 @@ def test_study_without_the_study_extra(blocked, what, tmp_path):
 
 def test_python_api_without_the_extras(tmp_path):
     """From Python: MissingDependency (an ImportError and a JourdainError) naming the extra,
-    for python-control, labelled results (xarray) and URDF."""
-    proc = without(PACKAGES["control"] + PACKAGES["study"] + PACKAGES["urdf"], f"""
+    for python-control, labelled results (xarray), URDF and CasADi."""
+    proc = without(PACKAGES["control"] + PACKAGES["study"] + PACKAGES["urdf"]
+                   + PACKAGES["casadi"], f"""
         import jourdain as jd
         from jourdain.extras import MissingDependency
         from jourdain.io.urdf import load_urdf
@@ -99,7 +101,8 @@ def test_python_api_without_the_extras(tmp_path):
         res = s.simulate((0, 0.1), [0.1, 0], [0, 0])
         for call, extra in ((lambda: jd.to_control(ss), "control"),
                             (res.to_xarray, "study"),
-                            (lambda: load_urdf({str(EXAMPLES / 'planar_arm.urdf')!r}), "urdf")):
+                            (lambda: load_urdf({str(EXAMPLES / 'planar_arm.urdf')!r}), "urdf"),
+                            (lambda: jd.to_casadi(s), "casadi")):
             try:
                 call()
             except MissingDependency as exc:

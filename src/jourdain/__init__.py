@@ -53,6 +53,7 @@ from .errors import (
     SingularMassMatrix,
 )
 from .io import ModelFile, ModelFileError, load_model
+from .io.casadi import CasadiDynamics, to_casadi
 from .io.urdf import load_urdf
 from .io.viewer import MeshVisual, View, view
 from .model import (
@@ -159,6 +160,8 @@ __all__ = [
     "to_control", "state_feedback",
     # files and views (jourdain.io)
     "load_model", "ModelFile", "ModelFileError", "load_urdf", "view", "View", "MeshVisual",
+    # optimal control: the equations of motion as CasADi functions (jourdain.io.casadi)
+    "to_casadi", "CasadiDynamics",
     # errors (jourdain.errors)
     "JourdainError", "ModelError", "EvaluationError", "SingularMassMatrix", "JourdainWarning",
     "ClosedSystemError", "AssemblyError", "SingularConfiguration",

@@ -23,6 +23,7 @@ EXTRAS: dict[str, str] = {
     "fmu": "FMU export (the FMI 2.0 headers of FMPy)",
     "control": "python-control (jourdain.analysis.to_control, state_feedback)",
     "study": "parameter studies (xarray, h5netcdf; dask.distributed for clusters)",
+    "casadi": "CasADi (jourdain.to_casadi: the equations of motion for optimal control)",
     "docs": "the documentation site (make docs)",
 }
 
