@@ -1,0 +1,205 @@
+"""First derivatives of the dynamics per state, compiled (issue 37): for model-predictive
+control, trajectory optimization and estimation.
+
+* inverse dynamics ``τ(y, ẏ, ÿ, u) = M·ÿ + k − q`` (the generalized force that, added to q,
+  makes ÿ happen; with gravity only and no inputs Pinocchio's ``rnea``) with ``∂τ/∂y``,
+  ``∂τ/∂ẏ``, ``∂τ/∂ÿ = M`` and ``∂τ/∂u``;
+* forward dynamics ``ÿ = M⁻¹(q − k)`` with ``∂ÿ/∂y = −M⁻¹·∂τ/∂y`` (at that ÿ), ``∂ÿ/∂ẏ``,
+  ``∂ÿ/∂u``.
+
+The derivatives are exact (to rounding): the kinematic recursion of :mod:`.recursive` runs in
+forward mode with prefix tangents (:mod:`.derivative_source`, ``derivative_engine.h``), in C
+generated for the model and compiled once (cached on disk like every library of jourdain).
+``M`` comes from the recursion's own library, linked into the same one. Many states go in one
+call (the loop runs in C). The C entry points (``jd_inverse_derivatives``,
+``jd_forward_derivatives`` and their ``_batch``) are documented in
+:func:`jourdain.io.export.export_c` 's header when exported.
+
+Trees only: a closed system (closing joints, contacts, generalized velocities of its own) is
+refused by name (:class:`jourdain.errors.ClosedSystemError`); its dynamics in independent
+coordinates are :meth:`jourdain.System.linearize`'s (complex step) for now.
+"""
+
+from __future__ import annotations
+
+import ctypes
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from functools import lru_cache
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..errors import EvaluationError, SingularMassMatrix, refuse_closed
+from .compiled import _GENERATOR_VERSION
+from .derivative_source import derivative_layout
+from .recursive import recursive_units
+from .state import parameter_vector, time_value
+from .toolchain import build, content_key
+
+if TYPE_CHECKING:
+    from ..model.system import System
+
+
+@dataclass(frozen=True)
+class ForwardDerivatives:
+    """``ydd = M⁻¹(q − k)`` and its derivatives ``ydd_y = ∂ÿ/∂y``, ``ydd_yd = ∂ÿ/∂ẏ``,
+    ``ydd_u = ∂ÿ/∂u`` (row i, column j: ∂ÿ_i/∂x_j); a leading axis per state for a batch."""
+
+    ydd: np.ndarray
+    ydd_y: np.ndarray
+    ydd_yd: np.ndarray
+    ydd_u: np.ndarray
+
+
+@dataclass(frozen=True)
+class InverseDerivatives:
+    """``tau = M·ÿ + k − q`` and its derivatives ``tau_y``, ``tau_yd``, ``tau_ydd`` (= M) and
+    ``tau_u``; a leading axis per state for a batch."""
+
+    tau: np.ndarray
+    tau_y: np.ndarray
+    tau_yd: np.ndarray
+    tau_ydd: np.ndarray
+    tau_u: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
+class Derivatives:
+    """The compiled derivatives of one system: :meth:`forward`, :meth:`inverse`."""
+
+    system: Any
+    lib: Any
+    key: str
+
+    @property
+    def f(self) -> int:
+        return int(self.system.f)
+
+    @property
+    def n_u(self) -> int:
+        return len(self.system.inputs)
+
+    def inverse(self, y: Any, yd: Any, ydd: Any, u: Any = None, t: Any = 0.0,
+                parameters: Mapping[str, float] | None = None) -> InverseDerivatives:
+        """τ and its derivatives at one state (``y``, ``yd``, ``ydd`` of shape (f,)) or at
+        ``n`` states (shape (n, f); ``u`` (n_u,) shared or (n, n_u); ``t`` a number or (n,))."""
+        f, nu = self.f, self.n_u
+        n, one, Y, YD, T, P, U, us = self._states(y, yd, u, t, parameters)
+        YDD = _array(ydd, n, f, "ydd")
+        size = f + 3 * f * f + f * nu
+        out = np.empty((n, size))
+        status = ctypes.c_int(0)
+        bad = self.lib.jd_inverse_derivatives_batch(
+            n, Y.ctypes.data, YD.ctypes.data, YDD.ctypes.data, T.ctypes.data, P.ctypes.data,
+            0, U.ctypes.data, us, out.ctypes.data, ctypes.byref(status))
+        self._check(bad, status.value, Y, T)
+        FF = f * f
+        res = InverseDerivatives(
+            tau=out[:, :f], tau_y=out[:, f:f + FF].reshape(n, f, f),
+            tau_yd=out[:, f + FF:f + 2 * FF].reshape(n, f, f),
+            tau_u=out[:, f + 2 * FF:f + 2 * FF + f * nu].reshape(n, f, nu),
+            tau_ydd=out[:, f + 2 * FF + f * nu:].reshape(n, f, f))
+        return _first(res) if one else res
+
+    def forward(self, y: Any, yd: Any, u: Any = None, t: Any = 0.0,
+                parameters: Mapping[str, float] | None = None) -> ForwardDerivatives:
+        """ÿ and its derivatives at one state or at ``n`` states (as :meth:`inverse`);
+        :class:`SingularMassMatrix` names the first state where M is not positive definite."""
+        f, nu = self.f, self.n_u
+        n, one, Y, YD, T, P, U, us = self._states(y, yd, u, t, parameters)
+        size = f + 2 * f * f + f * nu
+        out = np.empty((n, size))
+        status = ctypes.c_int(0)
+        bad = self.lib.jd_forward_derivatives_batch(
+            n, Y.ctypes.data, YD.ctypes.data, T.ctypes.data, P.ctypes.data, 0,
+            U.ctypes.data, us, out.ctypes.data, ctypes.byref(status))
+        self._check(bad, status.value, Y, T)
+        FF = f * f
+        res = ForwardDerivatives(
+            ydd=out[:, :f], ydd_y=out[:, f:f + FF].reshape(n, f, f),
+            ydd_yd=out[:, f + FF:f + 2 * FF].reshape(n, f, f),
+            ydd_u=out[:, f + 2 * FF:].reshape(n, f, nu))
+        return _first(res) if one else res
+
+    def _states(self, y: Any, yd: Any, u: Any, t: Any,
+                parameters: Mapping[str, float] | None) -> tuple:
+        f, nu = self.f, self.n_u
+        Yr = np.asarray(y, dtype=float)
+        one = Yr.ndim <= 1
+        n = 1 if one else Yr.shape[0]
+        Y = _array(y, n, f, "y")
+        YD = _array(yd, n, f, "yd")
+        T = np.ascontiguousarray(np.broadcast_to(np.asarray(t, dtype=float), (n,)))
+        if not np.all(np.isfinite(T)):
+            raise EvaluationError("t contains NaN or inf")
+        P = parameter_vector(self.system, parameters)
+        P = np.ascontiguousarray(P if P.size else np.zeros(1))
+        if nu == 0:
+            if u is not None and np.asarray(u).size:
+                raise EvaluationError(f"{self.system.name or 'the model'} has no inputs")
+            return n, one, Y, YD, T, P, np.zeros(1), 0
+        if u is None:
+            raise EvaluationError(f"inputs {self.system.input_names} must be given")
+        Ua = np.asarray(u, dtype=float)
+        if Ua.ndim <= 1:
+            U = _array(Ua, 1, nu, "u")[0]
+            us = 0
+        else:
+            U = _array(Ua, n, nu, "u")
+            us = nu
+        return n, one, Y, YD, T, P, np.ascontiguousarray(U), us
+
+    def _check(self, bad: int, status: int, Y: np.ndarray, T: np.ndarray) -> None:
+        if bad < 0:
+            return
+        where = f"state {bad}: t = {T[bad]}, y = {Y[bad].tolist()}"
+        if status == 1:
+            raise SingularMassMatrix(f"M is not positive definite at {where}")
+        if status == 3:
+            raise MemoryError("no memory for the derivatives' work arrays")
+        raise EvaluationError(f"the dynamics or their derivatives are not finite at {where}")
+
+
+def _array(x: Any, n: int, m: int, what: str) -> np.ndarray:
+    try:
+        a = np.ascontiguousarray(np.asarray(x, dtype=float).reshape(n, m))
+    except (TypeError, ValueError):
+        raise EvaluationError(f"{what} must have shape ({m},) or ({n}, {m}), got "
+                              f"{np.shape(x)}") from None
+    if not np.all(np.isfinite(a)):
+        raise EvaluationError(f"{what} contains NaN or inf")
+    return a
+
+
+def _first(res: Any) -> Any:
+    return type(res)(**{k: v[0] for k, v in vars(res).items()})
+
+
+def derivative_units(system: System) -> tuple[str, ...]:
+    """The translation units of the derivatives' library: the recursion (``jd_fn``: M, k, q)
+    and the derivative unit."""
+    local, engine = recursive_units(system)
+    return local, engine, derivative_layout(system).source
+
+
+@lru_cache(maxsize=16)
+def derivatives(system: System) -> Derivatives:
+    """The compiled first derivatives of ``system``'s forward and inverse dynamics (memoized
+    per system; the library is cached on disk). Trees only (:class:`ClosedSystemError`)."""
+    refuse_closed(system, "the derivatives of the dynamics cover trees",
+                  "linearize the closed system with system.linearize (complex step)")
+    units = derivative_units(system)
+    key = content_key(_GENERATOR_VERSION, "derivatives", *units)
+    lib = build(key, units)
+    vp, lg = ctypes.c_void_p, ctypes.c_long
+    lib.jd_inverse_derivatives_batch.restype = lg
+    lib.jd_inverse_derivatives_batch.argtypes = [lg, vp, vp, vp, vp, vp, lg, vp, lg, vp, vp]
+    lib.jd_forward_derivatives_batch.restype = lg
+    lib.jd_forward_derivatives_batch.argtypes = [lg, vp, vp, vp, vp, lg, vp, lg, vp, vp]
+    return Derivatives(system, lib, key)
+
+
+__all__ = ["Derivatives", "ForwardDerivatives", "InverseDerivatives", "derivatives",
+           "derivative_units"]
+_ = (Sequence, time_value)
