@@ -105,6 +105,7 @@ from .model import (
 )
 from .model.closing import ClosingJoint
 from .model.contacts import KnifeEdge, RollingDisc, VelocityConstraint
+from .numeric.derivatives import Derivatives, derivatives
 from .numeric.linearization import (  # the stage's results with their numbers (issue 16)
     CompiledLinearization,
     GeneralLinearization,
@@ -160,8 +161,9 @@ __all__ = [
     "to_control", "state_feedback",
     # files and views (jourdain.io)
     "load_model", "ModelFile", "ModelFileError", "load_urdf", "view", "View", "MeshVisual",
-    # optimal control: the equations of motion as CasADi functions (jourdain.io.casadi)
-    "to_casadi", "CasadiDynamics",
+    # optimal control: the equations of motion as CasADi functions (jourdain.io.casadi), the
+    # compiled derivatives of the dynamics per state (jourdain.numeric.derivatives)
+    "to_casadi", "CasadiDynamics", "derivatives", "Derivatives",
     # errors (jourdain.errors)
     "JourdainError", "ModelError", "EvaluationError", "SingularMassMatrix", "JourdainWarning",
     "ClosedSystemError", "AssemblyError", "SingularConfiguration",

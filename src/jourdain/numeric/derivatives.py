@@ -23,7 +23,7 @@ coordinates are :meth:`jourdain.System.linearize`'s (complex step) for now.
 from __future__ import annotations
 
 import ctypes
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import TYPE_CHECKING, Any
@@ -34,7 +34,7 @@ from ..errors import EvaluationError, SingularMassMatrix, refuse_closed
 from .compiled import _GENERATOR_VERSION
 from .derivative_source import derivative_layout
 from .recursive import recursive_units
-from .state import parameter_vector, time_value
+from .state import parameter_vector
 from .toolchain import build, content_key
 
 if TYPE_CHECKING:
@@ -183,12 +183,16 @@ def derivative_units(system: System) -> tuple[str, ...]:
     return local, engine, derivative_layout(system).source
 
 
-@lru_cache(maxsize=16)
 def derivatives(system: System) -> Derivatives:
     """The compiled first derivatives of ``system``'s forward and inverse dynamics (memoized
     per system; the library is cached on disk). Trees only (:class:`ClosedSystemError`)."""
     refuse_closed(system, "the derivatives of the dynamics cover trees",
                   "linearize the closed system with system.linearize (complex step)")
+    return _compiled(system)
+
+
+@lru_cache(maxsize=16)
+def _compiled(system: System) -> Derivatives:
     units = derivative_units(system)
     key = content_key(_GENERATOR_VERSION, "derivatives", *units)
     lib = build(key, units)
@@ -202,4 +206,3 @@ def derivatives(system: System) -> Derivatives:
 
 __all__ = ["Derivatives", "ForwardDerivatives", "InverseDerivatives", "derivatives",
            "derivative_units"]
-_ = (Sequence, time_value)

@@ -22,6 +22,7 @@ from ..analysis.reactions import evaluate_keys
 from ..errors import ModelError, refuse_closed
 from ..model.system import System as Model
 from ..numeric import evaluate as evaluate_eom
+from ..numeric.derivatives import Derivatives, derivatives
 from ..numeric.linearization import Linearization, linearization  # with its numbers
 from ..simulation.results import Results
 from ..simulation.simulate import DEFAULT_ATOL, DEFAULT_METHOD, DEFAULT_RTOL, simulate
@@ -53,7 +54,8 @@ class System(Model):
     True
 
     Methods: :meth:`kinematics`, :meth:`newton_euler`, :meth:`equations_of_motion`,
-    :meth:`reactions` (symbolic, kept), :meth:`linearize`, :meth:`evaluate`, :meth:`simulate`.
+    :meth:`reactions` (symbolic, kept), :meth:`linearize`, :meth:`evaluate`, :meth:`simulate`,
+    :meth:`derivatives`.
     Equal to another ``jourdain.System`` with the same description; the kept stages take no
     part in equality, hashing or pickling.
     """
@@ -173,6 +175,13 @@ class System(Model):
         eom: dict[str, np.ndarray] = dict(out)
         out.update(evaluate_keys(self, y, yd, t, parameters, inputs, eom=eom))
         return out
+
+    def derivatives(self) -> Derivatives:
+        """The compiled first derivatives of the forward and inverse dynamics per state
+        (:func:`jourdain.numeric.derivatives.derivatives`: ``.forward(y, yd, u)`` gives ÿ,
+        ∂ÿ/∂y, ∂ÿ/∂ẏ, ∂ÿ/∂u; ``.inverse(y, yd, ydd, u)`` gives τ = M·ÿ + k − q and its
+        derivatives; one state or a batch). Trees only."""
+        return derivatives(self)
 
     def simulate(self, t_span: tuple[float, float], y0: Any, yd0: Any,
                  parameters: Mapping[str, float] | None = None,
