@@ -33,12 +33,13 @@ and by the chain rule, with ``∂_j = ∂/∂y_j``, ``D_q, D_v`` Pinocchio's ``d
     ∂τ_j/∂ẏ  = Tᵀ·(D_v·T + M_p·∂c/∂ẏ)
     ∂τ_j/∂ÿ  = Tᵀ·M_p·T = M
 
-**Forward dynamics** (no inputs: τ_p = 0): ``ÿ = T⁻¹·(a_p − c)``, ``a_p = aba(q, T·ẏ, 0)``, and
-with ``A_q, A_v`` Pinocchio's ``ddq_dq, ddq_dv``:
+**Forward dynamics** under a generalized force ``τ_j`` held fixed (jourdain's ``B·u`` of
+inputs; 0 without): ``ÿ = T⁻¹·(a_p − c)``, ``a_p = aba(q, T·ẏ, τ_p)``, ``τ_p = T⁻ᵀ·τ_j``, so
+``∂_jτ_p = −T⁻ᵀ·(∂_jT)ᵀ·τ_p``, and with ``A_q, A_v`` Pinocchio's ``ddq_dq, ddq_dv``:
 
-    ∂ÿ/∂y_j = T⁻¹·(A_q·T[:, j] + A_v·(∂_jT)·ẏ − ∂_jc − (∂_jT)·ÿ)
+    ∂ÿ/∂y_j = T⁻¹·(A_q·T[:, j] + A_v·(∂_jT)·ẏ + M_p⁻¹·∂_jτ_p − ∂_jc − (∂_jT)·ÿ)
     ∂ÿ/∂ẏ  = T⁻¹·(A_v·T − ∂c/∂ẏ)
-    M⁻¹     = T⁻¹·M_p⁻¹·T⁻ᵀ
+    ∂ÿ/∂τ_j = M⁻¹ = T⁻¹·M_p⁻¹·T⁻ᵀ     (so ∂ÿ/∂u = M⁻¹·B)
 
 ``∂_jT``, ``∂_jc`` and ``∂c/∂ẏ`` come from the closed forms of T and c by the complex step
 ``∂g/∂x_j = Im g(x + i·h·e_j)/h`` (:func:`complex_step`): no subtraction, so exact to rounding
@@ -127,21 +128,26 @@ def inverse_dynamics(model: Any, data: Any, chart: Chart, ydd: np.ndarray) -> di
             "tau_ydd": T.T @ Mp @ T, "M_p": Mp}
 
 
-def forward_dynamics(model: Any, data: Any, chart: Chart) -> dict[str, np.ndarray]:
-    """``ydd, ydd_y, ydd_yd, Minv`` of ``ÿ = M⁻¹(q − k)`` (no inputs) in jourdain's
-    coordinates from ``pin.computeABADerivatives`` at τ_p = 0 (module docstring)."""
+def forward_dynamics(model: Any, data: Any, chart: Chart, tau: np.ndarray | None = None
+                     ) -> dict[str, np.ndarray]:
+    """``ydd, ydd_y, ydd_yd, Minv`` of ``ÿ = M⁻¹(q − k + τ)`` in jourdain's coordinates from
+    ``pin.computeABADerivatives`` (module docstring); ``tau`` (f,) a generalized force in
+    jourdain's coordinates held fixed (``B·u``; None: 0). ``Minv`` is ``∂ÿ/∂τ``."""
     import pinocchio as pin
 
     T, T_y, yd = chart.T, chart.T_y, chart.yd
     nv = T.shape[0]
-    a_p = pin.aba(model, data, chart.q, chart.v, np.zeros(nv)).copy()
-    Aq, Av, Minv_p = (np.array(x) for x in pin.computeABADerivatives(
-        model, data, chart.q, chart.v, np.zeros(nv)))
     Tinv = np.linalg.inv(T)
+    tau_p = np.zeros(nv) if tau is None else Tinv.T @ np.asarray(tau, dtype=float)
+    a_p = pin.aba(model, data, chart.q, chart.v, tau_p).copy()
+    Aq, Av, Minv_p = (np.array(x) for x in pin.computeABADerivatives(
+        model, data, chart.q, chart.v, tau_p))
     ydd = Tinv @ (a_p - chart.c)
     Ty_yd = np.einsum("ikj,k->ij", T_y, yd)
     Ty_ydd = np.einsum("ikj,k->ij", T_y, ydd)
-    return {"ydd": ydd, "ydd_y": Tinv @ (Aq @ T + Av @ Ty_yd - chart.c_y - Ty_ydd),
+    tau_p_y = -Tinv.T @ np.einsum("ikj,i->kj", T_y, tau_p)  # column j: ∂_jτ_p
+    return {"ydd": ydd,
+            "ydd_y": Tinv @ (Aq @ T + Av @ Ty_yd + Minv_p @ tau_p_y - chart.c_y - Ty_ydd),
             "ydd_yd": Tinv @ (Av @ T - chart.c_yd), "Minv": Tinv @ Minv_p @ Tinv.T,
             "Minv_p": Minv_p}
 
