@@ -29,13 +29,18 @@ terms τ is summed from):
 
 * τ, ∂τ/∂u: evaluated directly, ``eval_tol(6p, S_τ)``; M: ``eval_tol(6p, max |J̄|ᵀ|M̄||J̄|)``.
 * ∂τ/∂y, ∂τ/∂ẏ: evaluated directly (sums over the bodies of products, as τ), ``eval_tol(6p,
-  scale)`` with the scale the largest entry of Pinocchio's matrix plus ``S_τ`` for ∂τ/∂y (a
-  rotation by an angle changes each term of τ by its own size, so the terms of ∂τ/∂y are of the
-  size of the terms of τ, whatever their sum cancels to).
-* ÿ: two solves with M, ``2·ydd_tol``; ``∂ÿ/∂x = −M⁻¹·∂τ/∂x`` (at that ÿ): ``solve_tol(M,
-  solve_scale(M, ∂ÿ/∂x, terms))`` once per side, the terms being ∂τ/∂x and, for x = y,
-  ``cond(M)·(∂M/∂y)·ÿ`` (the error of ÿ, relative ``cond(M)·eps``, enters through ∂M/∂y);
-  ``∂ÿ/∂u = M⁻¹B``: terms B.
+  scale)``, the scale the largest entry of Pinocchio's matrix plus, for ∂τ/∂y, ``S_τ`` (a
+  rotation by an angle changes each term of τ by its own size, whatever their sum cancels to)
+  and, for ∂τ/∂ẏ, ``2·max(|J̄|ᵀ|q̄^c|)/max|ẏ|`` (q̄^c is quadratic in ẏ).
+* ÿ: two solves with M, ``2·ydd_tol``. ``∂ÿ/∂x = −M⁻¹·∂τ/∂x`` at that ÿ: Pinocchio's ∂ÿ/∂y is
+  first moved from its ÿ to jourdain's (``− M⁻¹·(∂M/∂y)·(ÿ_j − ÿ_p)``, by its own RNEA
+  derivatives), else the difference of the two ÿ, ``cond(M)·eps`` relative, would enter
+  amplified by ``cond(M)`` again; then ``solve_tol(M, solve_scale(M, ∂ÿ/∂x, (∂τ/∂x,)))`` once
+  per side; ``∂ÿ/∂u = M⁻¹B``: terms B.
+* The same as residuals (backward errors, no condition number: tight where cond(M) is large):
+  Pinocchio's τ at jourdain's ÿ is B·u, and ``M·∂ÿ/∂x = −∂τ/∂x`` with Pinocchio's M and ∂τ/∂x
+  at jourdain's ÿ: ``residual_bound`` plus the evaluation errors of ∂τ/∂x and of M (times the
+  column sums of ``|∂ÿ/∂x|``).
 * Central differences ``(f(x + h) − f(x − h))/2h`` with ``h = eps^(1/3)·max(1, |x|)``: the
   truncation error ``h²|f'''|/6`` estimated by Richardson, ``(D(2h) − D(h))/3`` (twice that
   allowed), plus the rounding of f divided by h (f's own bound: ``eval_tol`` for τ,
