@@ -19,82 +19,123 @@
    J_R 3, J_T 3, then their nonzero first derivatives, which jdd_spread_at puts in place. */
 
 typedef struct { double *x; double *d[2]; int n[2]; } jdd_t;
+#define JDD_BODY_ROWS 40
+#include <string.h>
 
-/* r = A x (A 3x3 row-major); rows of r's tangents n[b]; missing tangents count as zero */
-static void jdd_mv(jdd_t A, jdd_t x, jdd_t r, int transpose) {
-    double v[3];
-    for (int a = 0; a < 3; ++a) {
-        v[a] = 0.0;
-        for (int s = 0; s < 3; ++s) v[a] += (transpose ? A.x[3 * s + a] : A.x[3 * a + s]) * x.x[s];
-    }
+#if defined(__GNUC__)
+#define JDD_INLINE static inline __attribute__((always_inline))
+#else
+#define JDD_INLINE static inline
+#endif
+
+/* r = A x or Aᵀ x (A 3x3 row-major). Each block's loop runs over the variables once, the
+   3x3 product inside; tangents shorter than r's count as zero beyond their end */
+JDD_INLINE void jdd_mv(jdd_t A, jdd_t x, jdd_t r, int transpose) {
+    int e[9];
+    for (int a = 0; a < 3; ++a)
+        for (int s = 0; s < 3; ++s) e[3 * a + s] = transpose ? 3 * s + a : 3 * a + s;
+    double E[9], v[3];
+    for (int k = 0; k < 9; ++k) E[k] = A.x[e[k]];
+    const double x0 = x.x[0], x1 = x.x[1], x2 = x.x[2];
+    for (int a = 0; a < 3; ++a) v[a] = E[3 * a] * x0 + E[3 * a + 1] * x1 + E[3 * a + 2] * x2;
     for (int b = 0; b < 2; ++b) {
-        int n = r.n[b], na = A.n[b] < n ? A.n[b] : n, nx = x.n[b] < n ? x.n[b] : n;
+        const int n = r.n[b];
         if (!n) continue;
-        double *dr = r.d[b];
-        for (int a = 0; a < 3; ++a) {
-            double *o = dr + a * n;
-            for (int k = 0; k < n; ++k) o[k] = 0.0;
-            for (int s = 0; s < 3; ++s) {
-                int e = transpose ? 3 * s + a : 3 * a + s;
-                double Ae = A.x[e], xs = x.x[s];
-                const double *dA = A.d[b] + e * A.n[b], *dx = x.d[b] + s * x.n[b];
-                for (int k = 0; k < na; ++k) o[k] += dA[k] * xs;
-                for (int k = 0; k < nx; ++k) o[k] += Ae * dx[k];
-            }
+        const int sa = A.n[b], sx = x.n[b], na = sa < n ? sa : n, nx = sx < n ? sx : n;
+        double *o0 = r.d[b], *o1 = o0 + n, *o2 = o1 + n;
+        const double *dA = A.d[b], *dx0 = x.d[b], *dx1 = dx0 + sx, *dx2 = dx1 + sx;
+        const double *a0 = dA + e[0] * sa, *a1 = dA + e[1] * sa, *a2 = dA + e[2] * sa;
+        const double *a3 = dA + e[3] * sa, *a4 = dA + e[4] * sa, *a5 = dA + e[5] * sa;
+        const double *a6 = dA + e[6] * sa, *a7 = dA + e[7] * sa, *a8 = dA + e[8] * sa;
+        const int m = na < nx ? na : nx;
+        int k = 0;
+        for (; k < m; ++k) {
+            const double p0 = dx0[k], p1 = dx1[k], p2 = dx2[k];
+            o0[k] = a0[k] * x0 + a1[k] * x1 + a2[k] * x2 + E[0] * p0 + E[1] * p1 + E[2] * p2;
+            o1[k] = a3[k] * x0 + a4[k] * x1 + a5[k] * x2 + E[3] * p0 + E[4] * p1 + E[5] * p2;
+            o2[k] = a6[k] * x0 + a7[k] * x1 + a8[k] * x2 + E[6] * p0 + E[7] * p1 + E[8] * p2;
         }
+        for (; k < na; ++k) {
+            o0[k] = a0[k] * x0 + a1[k] * x1 + a2[k] * x2;
+            o1[k] = a3[k] * x0 + a4[k] * x1 + a5[k] * x2;
+            o2[k] = a6[k] * x0 + a7[k] * x1 + a8[k] * x2;
+        }
+        for (; k < nx; ++k) {
+            const double p0 = dx0[k], p1 = dx1[k], p2 = dx2[k];
+            o0[k] = E[0] * p0 + E[1] * p1 + E[2] * p2;
+            o1[k] = E[3] * p0 + E[4] * p1 + E[5] * p2;
+            o2[k] = E[6] * p0 + E[7] * p1 + E[8] * p2;
+        }
+        for (; k < n; ++k) { o0[k] = 0.0; o1[k] = 0.0; o2[k] = 0.0; }
     }
-    for (int a = 0; a < 3; ++a) r.x[a] = v[a];
+    r.x[0] = v[0]; r.x[1] = v[1]; r.x[2] = v[2];
 }
 
-/* r = A B (3x3) */
-static void jdd_mm(jdd_t A, jdd_t B, jdd_t r) {
+/* r = A B (3x3): column by column, r e_c = A (B e_c) */
+JDD_INLINE void jdd_mm(jdd_t A, jdd_t B, jdd_t r) {
     double v[9];
     for (int a = 0; a < 3; ++a)
         for (int c = 0; c < 3; ++c)
             v[3 * a + c] = A.x[3 * a] * B.x[c] + A.x[3 * a + 1] * B.x[3 + c]
                            + A.x[3 * a + 2] * B.x[6 + c];
     for (int b = 0; b < 2; ++b) {
-        int n = r.n[b], na = A.n[b] < n ? A.n[b] : n, nb = B.n[b] < n ? B.n[b] : n;
+        const int n = r.n[b];
         if (!n) continue;
+        const int sa = A.n[b], sb = B.n[b], na = sa < n ? sa : n, nb = sb < n ? sb : n;
         for (int a = 0; a < 3; ++a)
             for (int c = 0; c < 3; ++c) {
                 double *o = r.d[b] + (3 * a + c) * n;
-                for (int k = 0; k < n; ++k) o[k] = 0.0;
-                for (int s = 0; s < 3; ++s) {
-                    double As = A.x[3 * a + s], Bs = B.x[3 * s + c];
-                    const double *dA = A.d[b] + (3 * a + s) * A.n[b];
-                    const double *dB = B.d[b] + (3 * s + c) * B.n[b];
-                    for (int k = 0; k < na; ++k) o[k] += dA[k] * Bs;
-                    for (int k = 0; k < nb; ++k) o[k] += As * dB[k];
-                }
+                const double A0 = A.x[3 * a], A1 = A.x[3 * a + 1], A2 = A.x[3 * a + 2];
+                const double B0 = B.x[c], B1 = B.x[3 + c], B2 = B.x[6 + c];
+                const double *dA0 = A.d[b] + (3 * a) * sa, *dA1 = dA0 + sa, *dA2 = dA1 + sa;
+                const double *dB0 = B.d[b] + c * sb, *dB1 = dB0 + 3 * sb, *dB2 = dB1 + 3 * sb;
+                const int m = na < nb ? na : nb;
+                int k = 0;
+                for (; k < m; ++k)
+                    o[k] = dA0[k] * B0 + dA1[k] * B1 + dA2[k] * B2
+                           + A0 * dB0[k] + A1 * dB1[k] + A2 * dB2[k];
+                for (; k < na; ++k) o[k] = dA0[k] * B0 + dA1[k] * B1 + dA2[k] * B2;
+                for (; k < nb; ++k) o[k] = A0 * dB0[k] + A1 * dB1[k] + A2 * dB2[k];
+                for (; k < n; ++k) o[k] = 0.0;
             }
     }
     for (int a = 0; a < 9; ++a) r.x[a] = v[a];
 }
 
 /* r = x × y */
-static void jdd_cross(jdd_t x, jdd_t y, jdd_t r) {
-    static const int P[3] = {1, 2, 0}, Q[3] = {2, 0, 1};
-    double v[3];
-    for (int a = 0; a < 3; ++a) v[a] = x.x[P[a]] * y.x[Q[a]] - x.x[Q[a]] * y.x[P[a]];
+JDD_INLINE void jdd_cross(jdd_t x, jdd_t y, jdd_t r) {
+    const double x0 = x.x[0], x1 = x.x[1], x2 = x.x[2], y0 = y.x[0], y1 = y.x[1], y2 = y.x[2];
     for (int b = 0; b < 2; ++b) {
-        int n = r.n[b], nx = x.n[b] < n ? x.n[b] : n, ny = y.n[b] < n ? y.n[b] : n;
+        const int n = r.n[b];
         if (!n) continue;
-        for (int a = 0; a < 3; ++a) {
-            double *o = r.d[b] + a * n;
-            double yq = y.x[Q[a]], yp = y.x[P[a]], xp = x.x[P[a]], xq = x.x[Q[a]];
-            const double *dxp = x.d[b] + P[a] * x.n[b], *dxq = x.d[b] + Q[a] * x.n[b];
-            const double *dyp = y.d[b] + P[a] * y.n[b], *dyq = y.d[b] + Q[a] * y.n[b];
-            for (int k = 0; k < n; ++k) o[k] = 0.0;
-            for (int k = 0; k < nx; ++k) o[k] += dxp[k] * yq - dxq[k] * yp;
-            for (int k = 0; k < ny; ++k) o[k] += xp * dyq[k] - xq * dyp[k];
+        const int sx = x.n[b], sy = y.n[b], nx = sx < n ? sx : n, ny = sy < n ? sy : n;
+        double *o0 = r.d[b], *o1 = o0 + n, *o2 = o1 + n;
+        const double *dx0 = x.d[b], *dx1 = dx0 + sx, *dx2 = dx1 + sx;
+        const double *dy0 = y.d[b], *dy1 = dy0 + sy, *dy2 = dy1 + sy;
+        const int m = nx < ny ? nx : ny;
+        int k = 0;
+        for (; k < m; ++k) {
+            o0[k] = dx1[k] * y2 - dx2[k] * y1 + x1 * dy2[k] - x2 * dy1[k];
+            o1[k] = dx2[k] * y0 - dx0[k] * y2 + x2 * dy0[k] - x0 * dy2[k];
+            o2[k] = dx0[k] * y1 - dx1[k] * y0 + x0 * dy1[k] - x1 * dy0[k];
         }
+        for (; k < nx; ++k) {
+            o0[k] = dx1[k] * y2 - dx2[k] * y1;
+            o1[k] = dx2[k] * y0 - dx0[k] * y2;
+            o2[k] = dx0[k] * y1 - dx1[k] * y0;
+        }
+        for (; k < ny; ++k) {
+            o0[k] = x1 * dy2[k] - x2 * dy1[k];
+            o1[k] = x2 * dy0[k] - x0 * dy2[k];
+            o2[k] = x0 * dy1[k] - x1 * dy0[k];
+        }
+        for (; k < n; ++k) { o0[k] = 0.0; o1[k] = 0.0; o2[k] = 0.0; }
     }
-    for (int a = 0; a < 3; ++a) r.x[a] = v[a];
+    r.x[0] = x1 * y2 - x2 * y1; r.x[1] = x2 * y0 - x0 * y2; r.x[2] = x0 * y1 - x1 * y0;
 }
 
 /* r += c x (c a number), r's tangents at least as long as x's */
-static void jdd_axpy(double c, jdd_t x, jdd_t r, int rows) {
+JDD_INLINE void jdd_axpy(double c, jdd_t x, jdd_t r, int rows) {
     for (int a = 0; a < rows; ++a) r.x[a] += c * x.x[a];
     for (int b = 0; b < 2; ++b) {
         int n = r.n[b], nx = x.n[b], m = nx < n ? nx : n;
@@ -107,7 +148,7 @@ static void jdd_axpy(double c, jdd_t x, jdd_t r, int rows) {
 }
 
 /* r = x (r's tangents at least as long; the rest zero) */
-static void jdd_copy(jdd_t x, jdd_t r, int rows) {
+JDD_INLINE void jdd_copy(jdd_t x, jdd_t r, int rows) {
     for (int a = 0; a < rows; ++a) r.x[a] = x.x[a];
     for (int b = 0; b < 2; ++b) {
         int n = r.n[b], nx = x.n[b], m = nx < n ? nx : n;
@@ -124,18 +165,23 @@ static void jdd_copy(jdd_t x, jdd_t r, int rows) {
 enum { JQ_R, JQ_O, JQ_W, JQ_V, JQ_AL, JQ_A, JQ_P, JQ_CC, JQ_WC, JQ_PARTS, JQ_COLS, JQ_VCOLS,
        JQ_N };
 
-static jdd_t jdd_at(double *X, double *D, int i, int q, int row0) {
+JDD_INLINE jdd_t jdd_at(double *X, double *D, int i, int q, int row0) {
     const int *o = jdd_off + 2 * (JQ_N * i + q);
     int ny = jdd_ny[i], nv = jdd_nv[i];
     int val = jdd_val[JQ_N * i + q];
     jdd_t t = {X + val + row0, {D + o[0] + row0 * ny, D + o[1] + row0 * nv}, {ny, nv}};
     if (o[0] < 0) { t.d[0] = D; t.n[0] = 0; }
     if (o[1] < 0) { t.d[1] = D; t.n[1] = 0; }
+    if (q == JQ_PARTS || q == JQ_COLS) {  /* a local expression without derivatives: none */
+        int live = jdd_live[jdd_live_start[i] + (q == JQ_COLS ? JDD_BODY_ROWS : 0) + row0];
+        if (!(live & 1)) t.n[0] = 0;
+        if (!(live & 2)) t.n[1] = 0;
+    }
     return t;
 }
 
 /* a temporary of one body: tangents in scratch */
-static jdd_t jdd_tmp(double *x, double *scratch, int i, int rows, int with_rates) {
+JDD_INLINE jdd_t jdd_tmp(double *x, double *scratch, int i, int rows, int with_rates) {
     int ny = jdd_ny[i], nv = with_rates ? jdd_nv[i] : 0;
     jdd_t t = {x, {scratch, scratch + rows * ny}, {ny, nv}};
     return t;
@@ -149,7 +195,7 @@ static int jdd_inverse(const double *y, const double *yd, const double *ydd, dou
                        double *tau_yd, double *tau_u, double *X, double *D) {
     double *L = X + JDD_NVAL;  /* the local expressions, then their derivatives */
     jdd_parts(y, yd, t, p, u, L);
-    for (long a = 0; a < JDD_NTAN; ++a) D[a] = 0.0;
+    for (int g = 0; g < JDD_NZERO; ++g) memset(D + jdd_zero_off[g], 0, sizeof(double) * jdd_zero_len[g]);
     for (long m = 0; m < JDD_NPD; ++m) D[jdd_pd_dst[m]] = L[JDD_NL + m];
     double scratch[JDD_SCRATCH];
     for (int i = 0; i < JDD_P; ++i) {

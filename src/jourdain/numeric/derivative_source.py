@@ -55,6 +55,20 @@ class DerivativeLayout:
     source: str
 
 
+#: the groups of a body's local expressions (first row, rows): A, d, ω̄, v̄, ᾱ, ā, m, com, I,
+#: f, l; a column's J_R and J_T
+PART_GROUPS = ((0, 9), (9, 3), (12, 3), (15, 3), (18, 3), (21, 3), (24, 1), (25, 3), (28, 6),
+               (34, 3), (37, 3))
+
+
+def _group(q: str, r: int) -> tuple[int, int]:
+    """The group (first row, rows) of row r of a body's local expressions (q "PARTS") or of
+    its columns ("COLS")."""
+    if q == "COLS":
+        return r - r % 3, 3
+    return next(g for g in PART_GROUPS if g[0] <= r < g[0] + g[1])
+
+
 def _table(name: str, values: list[int]) -> str:
     body = ", ".join(str(v) for v in values) if values else "0"
     return f"static const int {name}[{max(len(values), 1)}] = {{{body}}};\n"
@@ -159,6 +173,33 @@ def derivative_layout(system: System) -> DerivativeLayout:
             else:
                 dst.append(o1 + r * nv + index_v[b][x - f])
             partials.append(grad[x])
+    # the groups of local expressions with a nonzero derivative in a block ("live"): the
+    # engine reads the others as constants (no tangent) and zeroes only these before the
+    # derivatives are put in place
+    live: set[tuple[int, str, int, int]] = set()
+    for e, grad in enumerate(j.gradients):
+        b, q, r = where(e)
+        row0, _ = _group(q, r)
+        for x in grad:
+            live.add((b, q, row0, 0 if x < f else 1))
+    live_flags: list[int] = []
+    zero_off: list[int] = []
+    zero_len: list[int] = []
+    for b in range(p):
+        for q, rows in (("PARTS", BODY_BLOCK), ("COLS", COLUMN_BLOCK * len(lay.columns[b]))):
+            o0, o1, ny, nv = pos[(b, q)]
+            for r in range(rows):
+                row0, n_rows = _group(q, r)
+                flags = sum(1 << blk for blk in (0, 1) if (b, q, row0, blk) in live)
+                live_flags.append(flags)
+                if r == row0:
+                    for blk, (o, n) in enumerate(((o0, ny), (o1, nv))):
+                        if flags >> blk & 1:
+                            zero_off.append(o + row0 * n)
+                            zero_len.append(n_rows * n)
+    live_start = [0]
+    for b in range(p):
+        live_start.append(live_start[-1] + BODY_BLOCK + COLUMN_BLOCK * len(lay.columns[b]))
     col_rate = [index_v[col_body[c]][coord] for c, coord in
                 enumerate(k for cs in lay.columns for k in cs)]
     flat_y = [x for vy in vars_y for x in vy]
@@ -187,6 +228,9 @@ def derivative_layout(system: System) -> DerivativeLayout:
             + _table("jdd_vars_y", flat_y) + _table("jdd_vars_y_start", starts_y)
             + _table("jdd_vars_v", flat_v) + _table("jdd_vars_v_start", starts_v)
             + _table("jdd_val", val_off) + _table("jdd_off", tan_off)
-            + _ltable("jdd_pd_dst", dst))
+            + _ltable("jdd_pd_dst", dst)
+            + f"#define JDD_NZERO {len(zero_off)}\n"
+            + _ltable("jdd_zero_off", zero_off) + _table("jdd_zero_len", zero_len)
+            + _table("jdd_live", live_flags) + _table("jdd_live_start", live_start))
     source = HEADER + parts + head + ENGINE
     return DerivativeLayout(tuple(vars_y), tuple(vars_v), source)
