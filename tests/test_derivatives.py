@@ -1,0 +1,139 @@
+"""The compiled derivatives of the dynamics (jourdain.numeric.derivatives, issue 37) against
+the symbolic linearization in its general form (an independent path: the symbolic stages and
+the forward mode over their expression graph, :func:`jourdain.linearization_general`), whose
+``M̃, P, Q, B, h`` at a state ``(y, ẏ, ÿ, u)`` are exactly ``∂τ/∂ÿ, ∂τ/∂ẏ, ∂τ/∂y, −∂τ/∂u``
+and ``−τ`` of ``τ = M·ÿ + k − q``; the forward dynamics against ``M⁻¹`` of the same numbers;
+a batch against the states one by one (bit for bit); the errors.
+
+Tolerances: both sides evaluate sums of products of the same magnitudes (no solve), so
+:func:`tests.tolerance.eval_tol` with the number of bodies' terms and the largest entry; the
+forward derivatives come out of a solve with M: :func:`tests.tolerance.solve_tol`. Pinocchio
+and central differences are the other references (tests/reference/test_derivatives_pinocchio.py).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import jourdain as jd
+from jourdain.errors import ClosedSystemError, EvaluationError
+from jourdain.io.modelfile.loader import load_model
+from jourdain.models import four_bar, heavy_top, n_link_pendulum_on_cart, spatial_chain
+from tests.tolerance import eval_tol, solve_tol
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _models():
+    return {
+        "cart3": n_link_pendulum_on_cart(3),               # absolute angles, an input
+        "top": heavy_top(),                                 # spatial, gyroscopic
+        "chain4": spatial_chain(4),                         # universal and spherical joints
+        "quarter_car": load_model(ROOT / "examples" / "quarter_car.toml").system,
+        "bushings": load_model(ROOT / "examples" / "vehicle_on_bushings.toml").system,
+    }
+
+
+MODELS = _models()
+
+
+def _state(system, rng):
+    f, nu = system.f, len(system.inputs)
+    return (rng.uniform(-0.5, 0.5, f), rng.uniform(-1, 1, f), rng.uniform(-2, 2, f),
+            rng.uniform(-1, 1, nu) if nu else None)
+
+
+@pytest.mark.parametrize("name", sorted(MODELS))
+def test_inverse_derivatives_equal_the_symbolic_linearization(name):
+    system = MODELS[name]
+    glin = jd.linearization_general(system.equations_of_motion())
+    d = jd.derivatives(system)
+    rng = np.random.default_rng(3)
+    n_terms = 6 * len(system.bodies) + 6
+    for _ in range(3):
+        y, yd, ydd, u = _state(system, rng)
+        inputs = None if u is None else dict(zip(system.input_names, u, strict=True))
+        ref = glin.evaluate(y, yd, ydd, inputs=inputs)
+        inv = d.inverse(y, yd, ydd, u)
+        pairs = (("tau", inv.tau, -ref["h"].reshape(-1)), ("tau_y", inv.tau_y, ref["Q"]),
+                 ("tau_yd", inv.tau_yd, ref["P"]), ("tau_ydd", inv.tau_ydd, ref["M_tilde"]))
+        for what, ours, theirs in pairs:
+            scale = max(np.abs(theirs).max(), np.abs(ref["M_tilde"] @ ydd).max(), 1.0)
+            tol = eval_tol(n_terms, scale)
+            assert np.abs(ours - theirs).max() <= tol, (name, what)
+        if u is not None:
+            B = ref["B"]
+            assert np.abs(inv.tau_u + B).max() <= eval_tol(n_terms, max(np.abs(B).max(), 1.0))
+
+
+@pytest.mark.parametrize("name", ["cart3", "top", "quarter_car"])
+def test_forward_derivatives_are_minus_m_inverse_times_the_inverse_ones(name):
+    system = MODELS[name]
+    d = jd.derivatives(system)
+    rng = np.random.default_rng(5)
+    y, yd, _, u = _state(system, rng)
+    fw = d.forward(y, yd, u)
+    out = system.evaluate(y, yd, inputs=None if u is None else list(u))
+    M = out["M"]
+    ydd = np.linalg.solve(M, out["q"] - out["k"])
+    assert np.abs(fw.ydd - ydd).max() <= solve_tol(M, max(np.abs(ydd).max(), 1.0))
+    inv = d.inverse(y, yd, fw.ydd, u)
+    for ours, tau_x in ((fw.ydd_y, inv.tau_y), (fw.ydd_yd, inv.tau_yd), (fw.ydd_u, inv.tau_u)):
+        if tau_x.size == 0:
+            continue
+        ref = -np.linalg.solve(M, tau_x)
+        assert np.abs(ours - ref).max() <= solve_tol(M, max(np.abs(ref).max(), 1e-300))
+
+
+def test_a_batch_equals_the_states_one_by_one():
+    system = MODELS["cart3"]
+    d = system.derivatives()
+    rng = np.random.default_rng(9)
+    n = 5
+    Y = rng.uniform(-1, 1, (n, system.f))
+    YD = rng.uniform(-1, 1, (n, system.f))
+    YDD = rng.uniform(-1, 1, (n, system.f))
+    U = rng.uniform(-1, 1, (n, 1))
+    inv = d.inverse(Y, YD, YDD, U)
+    fw = d.forward(Y, YD, U)
+    assert inv.tau_y.shape == (n, system.f, system.f) and fw.ydd_u.shape == (n, system.f, 1)
+    for i in range(n):
+        one = d.inverse(Y[i], YD[i], YDD[i], U[i])
+        assert np.array_equal(one.tau_y, inv.tau_y[i]) and np.array_equal(one.tau, inv.tau[i])
+        f1 = d.forward(Y[i], YD[i], U[i])
+        assert np.array_equal(f1.ydd_y, fw.ydd_y[i]) and np.array_equal(f1.ydd, fw.ydd[i])
+    shared = d.forward(Y, YD, U[0])  # one input vector for all states
+    assert np.array_equal(shared.ydd[0], fw.ydd[0])
+
+
+def test_parameters_change_the_numbers_without_a_new_library():
+    system = MODELS["cart3"]
+    d = jd.derivatives(system)
+    y, yd, ydd, u = _state(system, np.random.default_rng(1))
+    base = d.inverse(y, yd, ydd, u)
+    heavier = d.inverse(y, yd, ydd, u, parameters={"m0": 2 * system.parameter_values["m0"]})
+    assert jd.derivatives(system) is d
+    assert not np.array_equal(base.tau_ydd, heavier.tau_ydd)
+    glin = jd.linearization_general(system.equations_of_motion())
+    ref = glin.evaluate(y, yd, ydd, parameters={"m0": 2 * system.parameter_values["m0"]},
+                        inputs=dict(zip(system.input_names, u, strict=True)))
+    assert np.abs(heavier.tau_y - ref["Q"]).max() <= eval_tol(30, max(np.abs(ref["Q"]).max(), 1))
+
+
+def test_bad_input_is_named():
+    system = MODELS["cart3"]
+    d = jd.derivatives(system)
+    f = system.f
+    with pytest.raises(EvaluationError, match="y contains NaN"):
+        d.forward(np.full(f, np.nan), np.zeros(f), [0.0])
+    with pytest.raises(EvaluationError, match="shape"):
+        d.inverse(np.zeros(f + 1), np.zeros(f), np.zeros(f), [0.0])
+    with pytest.raises(EvaluationError, match="inputs"):
+        d.forward(np.zeros(f), np.zeros(f))
+    with pytest.raises(EvaluationError, match="unknown parameter"):
+        d.forward(np.zeros(f), np.zeros(f), [0.0], parameters={"nope": 1.0})
+    with pytest.raises(ClosedSystemError, match="derivatives"):
+        jd.derivatives(four_bar())
