@@ -76,6 +76,7 @@ bench: $(BIN)/.installed
 	$(BIN)/python benchmarks/crosscheck.py --n 3 --tree 3 --states 1
 	$(BIN)/python benchmarks/scaling.py --quick
 	$(BIN)/python benchmarks/per_state.py --quick
+	$(BIN)/python benchmarks/derivatives.py --quick
 	$(BIN)/python benchmarks/study.py --quick
 	$(BIN)/python benchmarks/loops.py --units --T 1
 	$(BIN)/python benchmarks/hostile_files.py --repeat 1
