@@ -137,3 +137,49 @@ def test_bad_input_is_named():
         d.forward(np.zeros(f), np.zeros(f), [0.0], parameters={"nope": 1.0})
     with pytest.raises(ClosedSystemError, match="derivatives"):
         jd.derivatives(four_bar())
+
+
+def test_exported_c_sources_compile_alone_and_give_the_same_numbers(tmp_path):
+    import shutil
+    import subprocess
+
+    from jourdain.numeric.toolchain import CompilerError, compiler
+
+    try:
+        cc = compiler()
+    except CompilerError:
+        pytest.skip("no C compiler")
+    system = MODELS["cart3"]
+    d = jd.derivatives(system)
+    paths = d.export_c(tmp_path / "src")
+    header = (tmp_path / "src" / "jourdain_derivatives.h").read_text()
+    assert "jd_forward_derivatives" in header and "q0" in header and "F" in header
+    y, yd, _, u = _state(system, np.random.default_rng(11))
+    p = np.array(list(system.parameter_values.values()))
+    def fmt(values) -> str:
+        return ", ".join(repr(float(v)) for v in values)
+
+    main = f"""#include <stdio.h>
+#include "jourdain_derivatives.h"
+int main(void) {{
+    double y[] = {{{fmt(y)}}}, yd[] = {{{fmt(yd)}}};
+    double p[] = {{{fmt(p)}}}, u[] = {{{fmt(u)}}};
+    double out[JOURDAIN_F + 2 * JOURDAIN_F * JOURDAIN_F + JOURDAIN_F * JOURDAIN_NU];
+    if (jd_forward_derivatives(y, yd, 0.0, p, u, out)) return 1;
+    for (int i = 0; i < (int)(sizeof out / sizeof *out); ++i) printf("%.17g\\n", out[i]);
+    return 0;
+}}
+"""
+    (tmp_path / "src" / "main.c").write_text(main)
+    exe = tmp_path / "run"
+    sources = [str(x) for x in paths[1:]] + [str(tmp_path / "src" / "main.c")]
+    subprocess.run([cc, "-O2", "-std=c99", "-o", str(exe), *sources, "-lm"], check=True,
+                   capture_output=True)
+    printed = subprocess.run([str(exe)], check=True, capture_output=True, text=True).stdout
+    numbers = np.array([float(x) for x in printed.split()])
+    fw = d.forward(y, yd, u)
+    ours = np.concatenate([fw.ydd, fw.ydd_y.ravel(), fw.ydd_yd.ravel(), fw.ydd_u.ravel()])
+    # another compilation of the same source (flags may differ: -march): rounding only
+    M = system.evaluate(y, yd, inputs=list(u))["M"]
+    assert np.abs(numbers - ours).max() <= solve_tol(M, max(np.abs(ours).max(), 1.0))
+    shutil.rmtree(tmp_path / "src")

@@ -12,8 +12,8 @@ forward mode with prefix tangents (:mod:`.derivative_source`, ``derivative_engin
 generated for the model and compiled once (cached on disk like every library of jourdain).
 ``M`` comes from the recursion's own library, linked into the same one. Many states go in one
 call (the loop runs in C). The C entry points (``jd_inverse_derivatives``,
-``jd_forward_derivatives`` and their ``_batch``) are documented in
-:func:`jourdain.io.export.export_c` 's header when exported.
+``jd_forward_derivatives`` and their ``_batch``) are written with a documented header by
+:meth:`Derivatives.export_c`, for use outside Python.
 
 Trees only: a closed system (closing joints, contacts, generalized velocities of its own) is
 refused by name (:class:`jourdain.errors.ClosedSystemError`); its dynamics in independent
@@ -26,6 +26,7 @@ import ctypes
 from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import lru_cache
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -122,6 +123,25 @@ class Derivatives:
             ydd_u=out[:, f + 2 * FF:].reshape(n, f, nu))
         return _first(res) if one else res
 
+    def export_c(self, folder: str | Path) -> list[Path]:
+        """Write the C sources of these derivatives for use outside Python into ``folder``:
+        ``jourdain_derivatives.h`` (the documented interface: sizes, the order of the
+        coordinates, parameters with their default values and inputs, the layout of the
+        outputs) and the translation units ``jd_local.c``, ``jd_engine.c``,
+        ``jd_derivatives.c`` (compile and link the three, e.g. ``cc -O2 -c jd_*.c``; only the
+        C standard library and libm are needed). Returns the paths written."""
+        out = Path(folder)
+        out.mkdir(parents=True, exist_ok=True)
+        names = ("jd_local.c", "jd_engine.c", "jd_derivatives.c")
+        paths = []
+        for name, text in zip(names, derivative_units(self.system), strict=True):
+            path = out / name
+            path.write_text('#include "jourdain_derivatives.h"\n' + text, encoding="utf-8")
+            paths.append(path)
+        header = out / "jourdain_derivatives.h"
+        header.write_text(c_header(self.system), encoding="utf-8")
+        return [header, *paths]
+
     def _states(self, y: Any, yd: Any, u: Any, t: Any,
                 parameters: Mapping[str, float] | None) -> tuple:
         f, nu = self.f, self.n_u
@@ -159,6 +179,56 @@ class Derivatives:
         if status == 3:
             raise MemoryError("no memory for the derivatives' work arrays")
         raise EvaluationError(f"the dynamics or their derivatives are not finite at {where}")
+
+
+def c_header(system: System) -> str:
+    """The documented interface of :meth:`Derivatives.export_c`'s sources."""
+    f, nu = system.f, len(system.inputs)
+    values = system.parameter_values
+    lines = [f"  y[{i}] = {n}" for i, n in enumerate(system.coordinate_names)]
+    plines = [f"  p[{i}] = {n} (default {values[n]!r})" for i, n in enumerate(values)]
+    ulines = [f"  u[{i}] = {n}" for i, n in enumerate(system.input_names)] or ["  (none)"]
+    return f"""/* jourdain: the first derivatives of the dynamics of {system.name or 'a model'}
+   (generated; see jourdain.numeric.derivatives). M·ÿ + k = q with f = {f} coordinates.
+
+   Coordinates (y, rates yd = ẏ, accelerations ydd = ÿ in the same order):
+{chr(10).join(lines)}
+   Parameters (p, by value; change them freely, nothing is recompiled):
+{chr(10).join(plines) or "  (none)"}
+   Inputs (u):
+{chr(10).join(ulines)}
+
+   Matrices are row-major: X_y[i*F + j] = ∂X_i/∂y_j. Return values: 0 ok, 1 M not positive
+   definite, 2 a number not finite, 3 no memory. The functions are reentrant (work on the
+   heap per call or per batch). */
+#ifndef JOURDAIN_DERIVATIVES_H
+#define JOURDAIN_DERIVATIVES_H
+#define JOURDAIN_F {f}
+#define JOURDAIN_NU {nu}
+#define JOURDAIN_NP {len(values)}
+
+/* inverse dynamics: out = [tau (F), tau_y (F*F), tau_yd (F*F), tau_u (F*NU), M (F*F)] with
+   tau = M·ÿ + k − q, the generalized force that, added to q, makes ÿ happen */
+int jd_inverse_derivatives(const double *y, const double *yd, const double *ydd, double t,
+                           const double *p, const double *u, double *out);
+/* forward dynamics: out = [ydd (F), ydd_y (F*F), ydd_yd (F*F), ydd_u (F*NU)],
+   ÿ = M⁻¹(q − k), ∂ÿ/∂x = −M⁻¹·∂tau/∂x at that ÿ */
+int jd_forward_derivatives(const double *y, const double *yd, double t, const double *p,
+                           const double *u, double *out);
+/* n states one after the other (y, yd, ydd: n*F; t: n; out: n times the size above); p and u
+   advance by ps and us per state (0: one vector for all); returns -1, or the first state
+   that failed with its code in *status */
+long jd_inverse_derivatives_batch(long n, const double *y, const double *yd, const double *ydd,
+                                  const double *t, const double *p, long ps, const double *u,
+                                  long us, double *out, int *status);
+long jd_forward_derivatives_batch(long n, const double *y, const double *yd, const double *t,
+                                  const double *p, long ps, const double *u, long us,
+                                  double *out, int *status);
+/* M (F*F), k (F), q (F) at a state, one after the other in out */
+void jd_fn(const double *y, const double *yd, double t, const double *p, const double *u,
+           double *out);
+#endif
+"""
 
 
 def _array(x: Any, n: int, m: int, what: str) -> np.ndarray:
