@@ -43,7 +43,7 @@ reference test tests/reference/test_derivatives_pinocchio.py holds the tolerance
 difference relative to the largest entry of Pinocchio's, per quantity.
 
 Measured on the 2-core development machine (µs per state, 1000 states, best of 7; jourdain's
-derivatives as of commit 8741e25, Pinocchio 4.1.0 net of its per-call floor of 1.2-1.4 µs):
+derivatives as of commit 6cac064, Pinocchio 4.1.0 net of its per-call floor of 1.2-1.4 µs):
 
     robot    f   forward: C batch / py 1 call / pin net   inverse: C batch / py 1 call / pin net
     panda    7            20.8 / 56.4 / 4.9                        20.2 / 60.4 / 3.6
