@@ -210,7 +210,11 @@ def test_the_rolling_disc_example_finds_the_critical_spin(tmp_path) -> None:
     html = (tmp_path / "r" / "report.html").read_text(encoding="utf-8")
     bounds = [float(x) for x in html.split("(boundaries ")[1].split(" by")[0].split(", ")]
     ref = np.sqrt(9.81 / (3 * 0.5))
-    assert len(bounds) == 1 and abs(bounds[0] - ref) <= 1e-9 * ref
+    # the stable side is only marginally stable (purely imaginary eigenvalues), so the boundary
+    # is where the verdict changes, read off eigenvalues that split from a multiple root there:
+    # rounding of the matrices (ε ≈ 2e-16) moves them by about √ε, and the boundary by as much
+    # relative (measured 3e-8 with the complex step of jourdain.graph.complex_step)
+    assert len(bounds) == 1 and abs(bounds[0] - ref) <= 10 * np.sqrt(np.finfo(float).eps) * ref
 
 
 def test_a_top_in_body_fixed_angular_velocities() -> None:

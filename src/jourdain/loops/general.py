@@ -31,6 +31,7 @@ import scipy.linalg as sla
 import symengine as se
 
 from ..errors import EvaluationError, SingularConfiguration
+from ..graph.complex_step import ComplexTape
 from ..model import System
 from ..model.forces import rate
 from ..numeric import lambdify, mkq_function, parameter_vector
@@ -68,7 +69,9 @@ POS, VEL, TREE = "pos", "vel", "tree"
 class Functions:
     """At a state, by group: the holonomic rows' ``Phi, Phi_y, Phi_t`` (``"pos"``), every
     row's ``A, a, c`` and the speeds' ``Y, b, cY`` (``"vel"``), the tree's ``M, k, q``
-    (``"tree"``); compiled (real) or by SymEngine's complex evaluation. Newton evaluates the
+    (``"tree"``); compiled (real) or in complex arithmetic for the complex step
+    (:class:`jourdain.graph.complex_step.ComplexTape`, exact for integer powers of negative
+    numbers, where SymEngine's complex evaluation is not). Newton evaluates the
     positions' group alone, the velocity map the velocities', so that no call computes what
     its caller throws away."""
 
@@ -93,7 +96,7 @@ class Functions:
             names = list(group)
             exprs = [e for n in names for e in group[n].entries()]
             self.fns[key] = (names, [group[n].shape for n in names],
-                             se.Lambdify(args, exprs, real=False, cse=True))
+                             ComplexTape(args, exprs))
 
     def __call__(self, y: np.ndarray, yd: np.ndarray, t: float, p: np.ndarray,
                  u: np.ndarray, groups: tuple[str, ...] = (POS, VEL, TREE)
