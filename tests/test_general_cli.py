@@ -177,6 +177,7 @@ def test_every_public_function_handles_or_refuses_a_general_system() -> None:
         "find_equilibrium": lambda: jd.find_equilibrium(s, y0),
         "find_equilibria": lambda: jd.find_equilibria(s, [y0]),
         "state_feedback": lambda: jd.state_feedback(s, np.zeros((0, 2)), {"zc": -0.3}),
+        "to_casadi": lambda: jd.to_casadi(s),
     }
     handled = {"sweep", "stability_boundary"}
     assert set(refused) | handled == {k for k, v in OUTCOME.items() if v == "refused"}

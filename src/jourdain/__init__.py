@@ -105,7 +105,7 @@ from .model import (
 )
 from .model.closing import ClosingJoint
 from .model.contacts import KnifeEdge, RollingDisc, VelocityConstraint
-from .numeric.derivatives import Derivatives, derivatives
+from .numeric.derivatives import Derivatives
 from .numeric.linearization import (  # the stage's results with their numbers (issue 16)
     CompiledLinearization,
     GeneralLinearization,
@@ -114,6 +114,7 @@ from .numeric.linearization import (  # the stage's results with their numbers (
     linearization_general,
 )
 from .pipeline import System
+from .pipeline.system import derivatives
 from .simulation.results import Results
 from .simulation.simulate import Event, IntegrationError, simulate
 from .stages.constraints import ConstraintRow, Constraints, constraints

@@ -22,7 +22,8 @@ from ..analysis.reactions import evaluate_keys
 from ..errors import ModelError, refuse_closed
 from ..model.system import System as Model
 from ..numeric import evaluate as evaluate_eom
-from ..numeric.derivatives import Derivatives, derivatives
+from ..numeric.derivatives import Derivatives
+from ..numeric.derivatives import derivatives as compiled_derivatives
 from ..numeric.linearization import Linearization, linearization  # with its numbers
 from ..simulation.results import Results
 from ..simulation.simulate import DEFAULT_ATOL, DEFAULT_METHOD, DEFAULT_RTOL, simulate
@@ -33,10 +34,27 @@ from ..stages.projection import EquationsOfMotion, projection
 from ..stages.reactions import Reactions, reactions
 
 if TYPE_CHECKING:  # a closed system's linearizations (jourdain.loops loads SciPy: not here)
+    from ..loops.derivatives import ClosedDerivatives
     from ..loops.linearization import LoopLinearization
     from ..loops.periodic import ClosedLinearization
 
 _T = TypeVar("_T")
+
+
+def derivatives(system: Model) -> Derivatives | ClosedDerivatives:
+    """The first derivatives of ``system``'s dynamics per state.
+
+    A tree: compiled (:func:`jourdain.numeric.derivatives.derivatives`): ``.forward(y, yd, u)``
+    gives ÿ, ∂ÿ/∂y, ∂ÿ/∂ẏ, ∂ÿ/∂u; ``.inverse(y, yd, ydd, u)`` gives τ = M·ÿ + k − q and its
+    derivatives; one state or a batch in one call; ``.export_c(folder)`` the C sources. A
+    closed system (closing joints, contacts, speeds of its own): in its state ``x = (y_i, z)``
+    by the complex step (:mod:`jourdain.loops.derivatives`), ``.forward(y, yd, u)`` gives ẋ,
+    ∂ẋ/∂x, ∂ẋ/∂u and ``.inverse(y, yd, zd, u)`` τ = M·ż + k − q and its derivatives."""
+    if system.is_closed:
+        from ..loops.derivatives import closed_derivatives
+
+        return closed_derivatives(system)
+    return compiled_derivatives(system)
 _LOCKS = threading.Lock()  # guards the creation of the per-system locks
 
 
@@ -176,11 +194,9 @@ class System(Model):
         out.update(evaluate_keys(self, y, yd, t, parameters, inputs, eom=eom))
         return out
 
-    def derivatives(self) -> Derivatives:
-        """The compiled first derivatives of the forward and inverse dynamics per state
-        (:func:`jourdain.numeric.derivatives.derivatives`: ``.forward(y, yd, u)`` gives ÿ,
-        ∂ÿ/∂y, ∂ÿ/∂ẏ, ∂ÿ/∂u; ``.inverse(y, yd, ydd, u)`` gives τ = M·ÿ + k − q and its
-        derivatives; one state or a batch). Trees only."""
+    def derivatives(self) -> Derivatives | ClosedDerivatives:
+        """The first derivatives of the forward and inverse dynamics per state
+        (:func:`derivatives`)."""
         return derivatives(self)
 
     def simulate(self, t_span: tuple[float, float], y0: Any, yd0: Any,
