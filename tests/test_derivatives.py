@@ -135,8 +135,12 @@ def test_bad_input_is_named():
         d.forward(np.zeros(f), np.zeros(f))
     with pytest.raises(EvaluationError, match="unknown parameter"):
         d.forward(np.zeros(f), np.zeros(f), [0.0], parameters={"nope": 1.0})
+    # the compiled derivatives are a tree's (jd.derivatives takes a closed system to its own:
+    # tests/test_derivatives_closed.py)
+    from jourdain.numeric.derivatives import derivatives as compiled
+
     with pytest.raises(ClosedSystemError, match="derivatives"):
-        jd.derivatives(four_bar())
+        compiled(four_bar())
 
 
 def test_exported_c_sources_compile_alone_and_give_the_same_numbers(tmp_path):

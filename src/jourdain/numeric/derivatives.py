@@ -23,10 +23,12 @@ coordinates are :meth:`jourdain.System.linearize`'s (complex step) for now.
 from __future__ import annotations
 
 import ctypes
+import threading
 from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
+from types import SimpleNamespace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -81,10 +83,69 @@ class Derivatives:
     def n_u(self) -> int:
         return len(self.system.inputs)
 
+    def _buffers(self) -> Any:
+        """This thread's arrays for one state and their addresses (a call per state then
+        converts no argument: microseconds, where a batch's checks take tens)."""
+        local = self.__dict__.setdefault("_local", threading.local())
+        b = getattr(local, "b", None)
+        if b is None:
+            f, nu = self.f, self.n_u
+            p = parameter_vector(self.system, None)
+            b = SimpleNamespace(y=np.zeros(f), yd=np.zeros(f), ydd=np.zeros(f),
+                                u=np.zeros(max(nu, 1)), p=p if p.size else np.zeros(1),
+                                inv=np.empty(f + 3 * f * f + f * nu),
+                                fwd=np.empty(f + 2 * f * f + f * nu))
+            for k in ("y", "yd", "ydd", "u", "p", "inv", "fwd"):
+                setattr(b, k + "_at", getattr(b, k).ctypes.data)
+            local.b = b
+        return b
+
+    def _one(self, inverse: bool, y: Any, yd: Any, ydd: Any, u: Any, t: Any) -> Any:
+        """One state with the default parameters, or None where an argument does not fit
+        (the general path then says what is wrong)."""
+        b = self._buffers()
+        try:
+            b.y[:] = y
+            b.yd[:] = yd
+            if inverse:
+                b.ydd[:] = ydd
+            if self.n_u:
+                if u is None:
+                    return None
+                b.u[:] = u
+            elif u is not None:
+                return None
+            tv = float(t)
+        except (ValueError, TypeError):
+            return None
+        f, nu = self.f, self.n_u
+        FF = f * f
+        if inverse:
+            status = self.lib.jd_inverse_derivatives(b.y_at, b.yd_at, b.ydd_at, tv, b.p_at,
+                                                     b.u_at, b.inv_at)
+            if status:
+                return None
+            o = b.inv.copy()
+            return InverseDerivatives(tau=o[:f], tau_y=o[f:f + FF].reshape(f, f),
+                                      tau_yd=o[f + FF:f + 2 * FF].reshape(f, f),
+                                      tau_u=o[f + 2 * FF:f + 2 * FF + f * nu].reshape(f, nu),
+                                      tau_ydd=o[f + 2 * FF + f * nu:].reshape(f, f))
+        status = self.lib.jd_forward_derivatives(b.y_at, b.yd_at, tv, b.p_at, b.u_at, b.fwd_at)
+        if status:
+            return None
+        o = b.fwd.copy()
+        return ForwardDerivatives(ydd=o[:f], ydd_y=o[f:f + FF].reshape(f, f),
+                                  ydd_yd=o[f + FF:f + 2 * FF].reshape(f, f),
+                                  ydd_u=o[f + 2 * FF:].reshape(f, nu))
+
     def inverse(self, y: Any, yd: Any, ydd: Any, u: Any = None, t: Any = 0.0,
                 parameters: Mapping[str, float] | None = None) -> InverseDerivatives:
         """τ and its derivatives at one state (``y``, ``yd``, ``ydd`` of shape (f,)) or at
         ``n`` states (shape (n, f); ``u`` (n_u,) shared or (n, n_u); ``t`` a number or (n,))."""
+        if parameters is None and np.ndim(y) == 1:
+            res = self._one(True, y, yd, ydd, u, t)
+            if res is not None:
+                return res
         f, nu = self.f, self.n_u
         n, one, Y, YD, T, P, U, us = self._states(y, yd, u, t, parameters)
         YDD = _array(ydd, n, f, "ydd")
@@ -107,6 +168,10 @@ class Derivatives:
                 parameters: Mapping[str, float] | None = None) -> ForwardDerivatives:
         """ÿ and its derivatives at one state or at ``n`` states (as :meth:`inverse`);
         :class:`SingularMassMatrix` names the first state where M is not positive definite."""
+        if parameters is None and np.ndim(y) == 1:
+            res = self._one(False, y, yd, None, u, t)
+            if res is not None:
+                return res
         f, nu = self.f, self.n_u
         n, one, Y, YD, T, P, U, us = self._states(y, yd, u, t, parameters)
         size = f + 2 * f * f + f * nu
@@ -199,8 +264,8 @@ def c_header(system: System) -> str:
 {chr(10).join(ulines)}
 
    Matrices are row-major: X_y[i*F + j] = ∂X_i/∂y_j. Return values: 0 ok, 1 M not positive
-   definite, 2 a number not finite, 3 no memory. The functions are reentrant (work on the
-   heap per call or per batch). */
+   definite, 2 a number not finite, 3 no memory. The functions are thread-safe: each thread
+   allocates its work array on its first call and keeps it. */
 #ifndef JOURDAIN_DERIVATIVES_H
 #define JOURDAIN_DERIVATIVES_H
 #define JOURDAIN_F {f}
@@ -271,6 +336,11 @@ def _compiled(system: System) -> Derivatives:
     lib.jd_inverse_derivatives_batch.argtypes = [lg, vp, vp, vp, vp, vp, lg, vp, lg, vp, vp]
     lib.jd_forward_derivatives_batch.restype = lg
     lib.jd_forward_derivatives_batch.argtypes = [lg, vp, vp, vp, vp, lg, vp, lg, vp, vp]
+    dbl = ctypes.c_double
+    lib.jd_inverse_derivatives.restype = ctypes.c_int
+    lib.jd_inverse_derivatives.argtypes = [vp, vp, vp, dbl, vp, vp, vp]
+    lib.jd_forward_derivatives.restype = ctypes.c_int
+    lib.jd_forward_derivatives.argtypes = [vp, vp, dbl, vp, vp, vp]
     return Derivatives(system, lib, key)
 
 
