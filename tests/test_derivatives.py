@@ -187,3 +187,28 @@ int main(void) {{
     M = system.evaluate(y, yd, inputs=list(u))["M"]
     assert np.abs(numbers - ours).max() <= solve_tol(M, max(np.abs(ours).max(), 1.0))
     shutil.rmtree(tmp_path / "src")
+
+
+@pytest.mark.parametrize("name", ["top", "chain4"])
+def test_the_recursions_of_screw_joints_equal_the_forward_mode(name):
+    """Two implementations of the same derivatives: the recursions on the columns of screw
+    joints (derivative_screw.h, what jd.derivatives takes for these models) and the forward
+    mode of every intermediate quantity (derivative_engine.h)."""
+    from jourdain.numeric.derivative_screw import screw_columns
+    from jourdain.numeric.derivatives import compiled_derivatives
+
+    system = MODELS[name]
+    assert screw_columns(system) is not None
+    screw, fwd = compiled_derivatives(system), compiled_derivatives(system, forward_mode=True)
+    rng = np.random.default_rng(17)
+    n_terms = 6 * len(system.bodies) + 6
+    for _ in range(3):
+        y, yd, ydd, u = _state(system, rng)
+        a, b = screw.inverse(y, yd, ydd, u), fwd.inverse(y, yd, ydd, u)
+        for x, z in ((a.tau, b.tau), (a.tau_y, b.tau_y), (a.tau_yd, b.tau_yd),
+                     (a.tau_ydd, b.tau_ydd)):
+            scale = max(np.abs(z).max(), np.abs(b.tau_ydd @ ydd).max(), 1.0)
+            assert np.abs(x - z).max() <= eval_tol(n_terms, scale)
+        fa, fb = screw.forward(y, yd, u), fwd.forward(y, yd, u)
+        assert np.abs(fa.ydd_y - fb.ydd_y).max() <= solve_tol(
+            b.tau_ydd, max(np.abs(fb.ydd_y).max(), 1.0))

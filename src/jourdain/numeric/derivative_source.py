@@ -43,6 +43,8 @@ MASS_ROWS = range(24, 34)
 
 ENGINE = resources.files(__package__ or "jourdain.numeric").joinpath(
     "derivative_engine.h").read_text(encoding="utf-8")
+ENTRY = resources.files(__package__ or "jourdain.numeric").joinpath(
+    "derivative_entry.h").read_text(encoding="utf-8")
 
 
 @dataclass(frozen=True)
@@ -232,5 +234,5 @@ def derivative_layout(system: System) -> DerivativeLayout:
             + f"#define JDD_NZERO {len(zero_off)}\n"
             + _ltable("jdd_zero_off", zero_off) + _table("jdd_zero_len", zero_len)
             + _table("jdd_live", live_flags) + _table("jdd_live_start", live_start))
-    source = HEADER + parts + head + ENGINE
+    source = HEADER + parts + head + ENGINE + ENTRY
     return DerivativeLayout(tuple(vars_y), tuple(vars_v), source)

@@ -33,8 +33,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import EvaluationError, SingularMassMatrix, refuse_closed
+from ..errors import EvaluationError, ModelError, SingularMassMatrix, refuse_closed
 from .compiled import _GENERATOR_VERSION
+from .derivative_screw import screw_columns, screw_source
 from .derivative_source import derivative_layout
 from .recursive import recursive_units
 from .state import parameter_vector
@@ -74,6 +75,8 @@ class Derivatives:
     system: Any
     lib: Any
     key: str
+    #: the forward mode of every intermediate quantity, not the recursions of screw joints
+    forward_mode: bool = False
 
     @property
     def f(self) -> int:
@@ -199,13 +202,17 @@ class Derivatives:
         out.mkdir(parents=True, exist_ok=True)
         names = ("jd_local.c", "jd_engine.c", "jd_derivatives.c")
         paths = []
-        for name, text in zip(names, derivative_units(self.system), strict=True):
+        for name, text in zip(names, self.units(), strict=True):
             path = out / name
             path.write_text('#include "jourdain_derivatives.h"\n' + text, encoding="utf-8")
             paths.append(path)
         header = out / "jourdain_derivatives.h"
         header.write_text(c_header(self.system), encoding="utf-8")
         return [header, *paths]
+
+    def units(self) -> tuple[str, ...]:
+        """The C translation units of this library."""
+        return derivative_units(self.system, self.forward_mode)
 
     def _states(self, y: Any, yd: Any, u: Any, t: Any,
                 parameters: Mapping[str, float] | None) -> tuple:
@@ -311,11 +318,16 @@ def _first(res: Any) -> Any:
     return type(res)(**{k: v[0] for k, v in vars(res).items()})
 
 
-def derivative_units(system: System) -> tuple[str, ...]:
-    """The translation units of the derivatives' library: the recursion (``jd_fn``: M, k, q)
-    and the derivative unit."""
+def derivative_units(system: System, forward_mode: bool = False) -> tuple[str, ...]:
+    """The translation units of the derivatives' library: the recursion (``jd_local``, the
+    joints' local expressions, and ``jd_fn``: M, k, q) and the derivative unit, by the
+    recursions of screw joints where the model qualifies (:mod:`.derivative_screw`), else (or
+    with ``forward_mode``) by the forward mode (:mod:`.derivative_source`)."""
     local, engine = recursive_units(system)
-    return local, engine, derivative_layout(system).source
+    cols = None if forward_mode else screw_columns(system)
+    unit = (screw_source(system, cols) if cols is not None
+            else derivative_layout(system).source)
+    return local, engine, unit
 
 
 def derivatives(system: System) -> Derivatives:
@@ -323,12 +335,18 @@ def derivatives(system: System) -> Derivatives:
     per system; the library is cached on disk). Trees only (:class:`ClosedSystemError`)."""
     refuse_closed(system, "the derivatives of the dynamics cover trees",
                   "linearize the closed system with system.linearize (complex step)")
-    return _compiled(system)
+    if system.frictions:
+        raise ModelError(f"{system.name}: the derivatives do not cover joint friction (its "
+                         f"forces are set-valued at rest: {', '.join(fr.name for fr in system.frictions)})")
+    return compiled_derivatives(system)
 
 
 @lru_cache(maxsize=16)
-def _compiled(system: System) -> Derivatives:
-    units = derivative_units(system)
+def compiled_derivatives(system: System, forward_mode: bool = False) -> Derivatives:
+    """The library of :func:`derivatives` (memoized); ``forward_mode``: the forward mode of
+    ``derivative_engine.h`` even where the recursions of screw joints apply (the tests compare
+    the two)."""
+    units = derivative_units(system, forward_mode)
     key = content_key(_GENERATOR_VERSION, "derivatives", *units)
     lib = build(key, units)
     vp, lg = ctypes.c_void_p, ctypes.c_long
@@ -341,7 +359,7 @@ def _compiled(system: System) -> Derivatives:
     lib.jd_inverse_derivatives.argtypes = [vp, vp, vp, dbl, vp, vp, vp]
     lib.jd_forward_derivatives.restype = ctypes.c_int
     lib.jd_forward_derivatives.argtypes = [vp, vp, dbl, vp, vp, vp]
-    return Derivatives(system, lib, key)
+    return Derivatives(system, lib, key, forward_mode)
 
 
 __all__ = ["Derivatives", "ForwardDerivatives", "InverseDerivatives", "derivatives",

@@ -1,0 +1,317 @@
+/* The first derivatives of tau = M*ydd + k - q for trees of screw joints (derivatives.py):
+   every coordinate drives one elementary rotation or translation along a constant axis, in the
+   order of its joint's steps ("columns" j, each with the column before it on its path,
+   jda_pred), gravity and generalized forces of the inputs alone.
+
+   Spatial vectors about the inertial origin in inertial components: motion (w, u), force
+   (moment, force); S_j the twist of column j, v_j and a_j the velocity and acceleration after
+   it (a_0 = (0, -g): gravity as an acceleration of the base), so that
+       v_j = v_p + S_j ẏ_j,   a_j = a_p + S_j ÿ_j + v_j × S_j ẏ_j      (p = jda_pred[j]).
+   Each body: I_i its spatial inertia, f_i = I_i a_i + v_i ×* I_i v_i, and the operator
+   B_i x = −I_i (v_i × x) + x ×* (I_i v_i) + v_i ×* (I_i x); I^C, B^C, F the sums over the
+   sub-tree. With ψ̇_k = v_k × S_k and ψ̈_k = a_k × S_k + v_k × ψ̇_k (the first and second time
+   derivatives of S_k), the derivatives of the sub-tree's force are
+       ∂F_b/∂y_k = S_k ×* F_b + I^C_b ψ̈_k + B^C_b ψ̇_k,  ∂F_b/∂ẏ_k = 2 I^C_b ψ̇_k + B^C_b S_k
+   for k on the path of body b, and τ_j = S_jᵀF_b (∂S_j/∂y_k = S_k × S_j cancels S_k ×* F_b):
+       k before or at j:  ∂τ_j/∂y_k = (I^C S_j)·ψ̈_k + (B^Cᵀ S_j)·ψ̇_k,
+                          ∂τ_j/∂ẏ_k = 2 (I^C S_j)·ψ̇_k + (B^Cᵀ S_j)·S_k,
+       k after j:         ∂τ_j/∂y_k = S_j·(S_k ×* F + I^C ψ̈_k + B^C ψ̇_k)   (at k's body),
+                          ∂τ_j/∂ẏ_k = S_j·(2 I^C ψ̇_k + B^C S_k),
+   and M_jk = S_k·(I^C S_j) for k before j (Carpentier & Mansard 2018 derive the same
+   relations). O(Σ depth) dot products of 6-vectors per state. */
+
+void jd_local(const double *y, const double *yd, double t, const double *p, const double *u,
+              double *out);
+
+static inline void jda_cross3(const double *a, const double *b, double *r) {
+    double r0 = a[1] * b[2] - a[2] * b[1], r1 = a[2] * b[0] - a[0] * b[2];
+    double r2 = a[0] * b[1] - a[1] * b[0];
+    r[0] = r0; r[1] = r1; r[2] = r2;
+}
+/* motion × motion */
+static inline void jda_crm(const double *v, const double *x, double *r) {
+    double a[3], b[3], c[3];
+    jda_cross3(v, x, a);
+    jda_cross3(v, x + 3, b);
+    jda_cross3(v + 3, x, c);
+    for (int k = 0; k < 3; ++k) { r[k] = a[k]; r[3 + k] = b[k] + c[k]; }
+}
+/* motion ×* force */
+static inline void jda_crf(const double *v, const double *F, double *r) {
+    double a[3], b[3], c[3];
+    jda_cross3(v, F, a);
+    jda_cross3(v + 3, F + 3, b);
+    jda_cross3(v, F + 3, c);
+    for (int k = 0; k < 3; ++k) { r[k] = a[k] + b[k]; r[3 + k] = c[k]; }
+}
+static inline double jda_dot6(const double *a, const double *b) {
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] + a[4] * b[4] + a[5] * b[5];
+}
+static inline void jda_mv6(const double *A, const double *x, double *r) {
+    for (int k = 0; k < 6; ++k) r[k] = jda_dot6(A + 6 * k, x);
+}
+static inline void jda_mtv6(const double *A, const double *x, double *r) {
+    for (int k = 0; k < 6; ++k) {
+        double s = 0.0;
+        for (int m = 0; m < 6; ++m) s += A[6 * m + k] * x[m];
+        r[k] = s;
+    }
+}
+
+typedef struct {
+    double R[9 * JDA_P], o[3 * JDA_P];
+    double S[6 * JDA_NC], v[6 * JDA_NC], a[6 * JDA_NC], pd[6 * JDA_NC], pdd[6 * JDA_NC];
+    double IC[36 * JDA_P], BC[36 * JDA_P], F[6 * JDA_P];
+    double A[6 * JDA_NC], Bt[6 * JDA_NC], G[6 * JDA_NC], H[6 * JDA_NC];
+    double L[JDA_NL > 0 ? JDA_NL : 1], K[JDA_NK > 0 ? JDA_NK : 1];
+} jda_work;
+
+/* frames, twists, velocities, accelerations; the bodies' inertias, forces and B; the sums;
+   with derivs: A, Bt, G, H per column; tau always */
+static void jda_pass(const double *y, const double *yd, const double *ydd, double t,
+                     const double *p, const double *u, jda_work *W, int derivs, double *tau) {
+    static const double I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, Z3[3] = {0, 0, 0};
+    jd_local(y, yd, t, p, u, W->L);
+    jda_consts(y, yd, t, p, u, W->K);
+    const double *L = W->L, *g = W->K;
+    const double a0[6] = {0, 0, 0, -g[0], -g[1], -g[2]}, z6[6] = {0, 0, 0, 0, 0, 0};
+    for (int i = 0; i < JDA_P; ++i) {  /* frames */
+        const double *b = L + 40 * i, *A = b, *d = b + 9;
+        int lam = jda_parent[i];
+        const double *Rl = lam < 0 ? I3 : W->R + 9 * lam, *ol = lam < 0 ? Z3 : W->o + 3 * lam;
+        double *R = W->R + 9 * i, *o = W->o + 3 * i;
+        for (int r = 0; r < 3; ++r)
+            for (int s = 0; s < 3; ++s)
+                R[3 * r + s] = Rl[3 * r] * A[s] + Rl[3 * r + 1] * A[3 + s] + Rl[3 * r + 2] * A[6 + s];
+        for (int r = 0; r < 3; ++r)
+            o[r] = ol[r] + Rl[3 * r] * d[0] + Rl[3 * r + 1] * d[1] + Rl[3 * r + 2] * d[2];
+    }
+    for (int j = 0; j < JDA_NC; ++j) {  /* columns in the order of their paths */
+        int i = jda_body[j], lam = jda_parent[i], pj = jda_pred[j], c = jda_coord[j];
+        const double *Rl = lam < 0 ? I3 : W->R + 9 * lam, *R = W->R + 9 * i, *o = W->o + 3 * i;
+        const double *JR = L + 40 * JDA_P + 6 * jda_lcol[j], *JT = JR + 3;
+        double *S = W->S + 6 * j, w[3], ut[3];
+        for (int r = 0; r < 3; ++r) {
+            w[r] = R[3 * r] * JR[0] + R[3 * r + 1] * JR[1] + R[3 * r + 2] * JR[2];
+            ut[r] = Rl[3 * r] * JT[0] + Rl[3 * r + 1] * JT[1] + Rl[3 * r + 2] * JT[2];
+        }
+        jda_cross3(o, w, S + 3);
+        for (int r = 0; r < 3; ++r) { S[r] = w[r]; S[3 + r] += ut[r]; }
+        const double *vp = pj < 0 ? z6 : W->v + 6 * pj, *ap = pj < 0 ? a0 : W->a + 6 * pj;
+        double *v = W->v + 6 * j, *a = W->a + 6 * j, *pd = W->pd + 6 * j, *pdd = W->pdd + 6 * j;
+        double qd = yd[c], vxs[6];
+        for (int r = 0; r < 6; ++r) v[r] = vp[r] + S[r] * qd;
+        jda_crm(v, S, pd);                       /* ψ̇ = v × S */
+        for (int r = 0; r < 6; ++r) a[r] = ap[r] + S[r] * ydd[c] + pd[r] * qd;
+        if (derivs) {
+            jda_crm(a, S, pdd);
+            jda_crm(v, pd, vxs);
+            for (int r = 0; r < 6; ++r) pdd[r] += vxs[r];   /* ψ̈ = a × S + v × ψ̇ */
+        }
+    }
+    for (int i = 0; i < JDA_P; ++i) {  /* each body: I, f, B about the origin */
+        const double *b = L + 40 * i, m = b[24], *com = b + 25, *In = b + 28;
+        const double *R = W->R + 9 * i, *o = W->o + 3 * i;
+        int vc = jda_vcol[i];  /* the last column on the body's path (-1: the base) */
+        const double *v = vc < 0 ? z6 : W->v + 6 * vc, *a = vc < 0 ? a0 : W->a + 6 * vc;
+        double *IC = W->IC + 36 * i, *BC = W->BC + 36 * i, *F = W->F + 6 * i;
+        double c[3], SI[9], Ib[9];
+        for (int r = 0; r < 3; ++r) c[r] = o[r] + R[3 * r] * com[0] + R[3 * r + 1] * com[1] + R[3 * r + 2] * com[2];
+        const double Is[9] = {In[0], In[1], In[2], In[1], In[3], In[4], In[2], In[4], In[5]};
+        for (int r = 0; r < 3; ++r)
+            for (int s = 0; s < 3; ++s)
+                SI[3 * r + s] = R[3 * r] * Is[s] + R[3 * r + 1] * Is[3 + s] + R[3 * r + 2] * Is[6 + s];
+        double c2 = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
+        for (int r = 0; r < 3; ++r)
+            for (int s = 0; s < 3; ++s)
+                Ib[3 * r + s] = SI[3 * r] * R[3 * s] + SI[3 * r + 1] * R[3 * s + 1]
+                                + SI[3 * r + 2] * R[3 * s + 2] + m * ((r == s ? c2 : 0.0) - c[r] * c[s]);
+        double h[3] = {m * c[0], m * c[1], m * c[2]};
+        double Hx[9] = {0, -h[2], h[1], h[2], 0, -h[0], -h[1], h[0], 0};
+        for (int r = 0; r < 3; ++r)
+            for (int s = 0; s < 3; ++s) {
+                IC[6 * r + s] = Ib[3 * r + s];
+                IC[6 * r + 3 + s] = Hx[3 * r + s];
+                IC[6 * (3 + r) + s] = -Hx[3 * r + s];
+                IC[6 * (3 + r) + 3 + s] = r == s ? m : 0.0;
+            }
+        double Iv[6], Ia[6], vf[6];
+        jda_mv6(IC, v, Iv);
+        jda_mv6(IC, a, Ia);
+        jda_crf(v, Iv, vf);
+        for (int r = 0; r < 6; ++r) F[r] = Ia[r] + vf[r];
+        if (derivs) {  /* B x = −I (v × x) + x ×* (I v) + v ×* (I x), column by column */
+            for (int e = 0; e < 6; ++e) {
+                double x[6] = {0, 0, 0, 0, 0, 0}, vx[6], Ivx[6], xIv[6], Ix[6], vIx[6];
+                x[e] = 1.0;
+                jda_crm(v, x, vx);
+                jda_mv6(IC, vx, Ivx);
+                jda_crf(x, Iv, xIv);
+                for (int r = 0; r < 6; ++r) Ix[r] = IC[6 * r + e];
+                jda_crf(v, Ix, vIx);
+                for (int r = 0; r < 6; ++r) BC[6 * r + e] = -Ivx[r] + xIv[r] + vIx[r];
+            }
+        }
+    }
+    for (int i = JDA_P - 1; i >= 0; --i) {  /* sums over the sub-trees */
+        int lam = jda_parent[i];
+        if (lam < 0) continue;
+        for (int r = 0; r < 36; ++r) W->IC[36 * lam + r] += W->IC[36 * i + r];
+        if (derivs) for (int r = 0; r < 36; ++r) W->BC[36 * lam + r] += W->BC[36 * i + r];
+        for (int r = 0; r < 6; ++r) W->F[6 * lam + r] += W->F[6 * i + r];
+    }
+    for (int r = 0; r < JDA_F; ++r) tau[r] = -W->K[3 + r];  /* − the generalized forces */
+    for (int j = 0; j < JDA_NC; ++j) {
+        int i = jda_body[j];
+        const double *S = W->S + 6 * j, *IC = W->IC + 36 * i, *F = W->F + 6 * i;
+        tau[jda_coord[j]] += jda_dot6(S, F);
+        if (!derivs) continue;
+        const double *BC = W->BC + 36 * i, *pd = W->pd + 6 * j, *pdd = W->pdd + 6 * j;
+        double *A = W->A + 6 * j, *Bt = W->Bt + 6 * j, *G = W->G + 6 * j, *H = W->H + 6 * j;
+        double t1[6], t2[6], t3[6];
+        jda_mv6(IC, S, A);
+        jda_mtv6(BC, S, Bt);
+        jda_crf(S, F, t1);
+        jda_mv6(IC, pdd, t2);
+        jda_mv6(BC, pd, t3);
+        for (int r = 0; r < 6; ++r) G[r] = t1[r] + t2[r] + t3[r];
+        jda_mv6(IC, pd, t1);
+        jda_mv6(BC, S, t2);
+        for (int r = 0; r < 6; ++r) H[r] = 2.0 * t1[r] + t2[r];
+    }
+}
+
+/* M from the composite inertias: M_jk = S_k·(I^C S_j) for k before j on j's path */
+static void jda_mass(const jda_work *W, double *M) {
+    for (long r = 0; r < (long)JDA_F * JDA_F; ++r) M[r] = 0.0;
+    for (int j = 0; j < JDA_NC; ++j) {
+        double A[6];
+        jda_mv6(W->IC + 36 * jda_body[j], W->S + 6 * j, A);
+        int cj = jda_coord[j];
+        for (int k = j; k >= 0; k = jda_pred[k]) {
+            double m = jda_dot6(W->S + 6 * k, A);
+            int ck = jda_coord[k];
+            M[(long)cj * JDA_F + ck] = m;
+            M[(long)ck * JDA_F + cj] = m;
+        }
+    }
+}
+
+/* tau (f), tau_y, tau_yd (f×f), tau_u (f×nu) at ÿ; W holds the pass with derivs */
+static int jda_inverse(const double *y, const double *yd, const double *ydd, double t,
+                       const double *p, const double *u, double *tau, double *tau_y,
+                       double *tau_yd, double *tau_u, jda_work *W) {
+    jda_pass(y, yd, ydd, t, p, u, W, 1, tau);
+    for (long r = 0; r < (long)JDA_F * JDA_F; ++r) { tau_y[r] = 0.0; tau_yd[r] = 0.0; }
+    for (int k = 0; k < JDA_NC; ++k) {
+        int ck = jda_coord[k];
+        const double *Ak = W->A + 6 * k, *Btk = W->Bt + 6 * k;
+        const double *Gk = W->G + 6 * k, *Hk = W->H + 6 * k;
+        /* j at or before k on k's path: ∂τ_k/∂y_j and ∂τ_j/∂y_k */
+        for (int j = k; j >= 0; j = jda_pred[j]) {
+            int cj = jda_coord[j];
+            const double *Sj = W->S + 6 * j, *pdj = W->pd + 6 * j, *pddj = W->pdd + 6 * j;
+            tau_y[(long)ck * JDA_F + cj] = jda_dot6(Ak, pddj) + jda_dot6(Btk, pdj);
+            tau_yd[(long)ck * JDA_F + cj] = 2.0 * jda_dot6(Ak, pdj) + jda_dot6(Btk, Sj);
+            if (j != k) {
+                tau_y[(long)cj * JDA_F + ck] = jda_dot6(Sj, Gk);
+                tau_yd[(long)cj * JDA_F + ck] = jda_dot6(Sj, Hk);
+            }
+        }
+    }
+    /* the generalized forces of the inputs: τ_u = −∂q/∂u */
+    for (long r = 0; r < (long)JDA_F * JDA_NU; ++r) tau_u[r] = -W->K[3 + JDA_F + r];
+    for (int r = 0; r < JDA_F; ++r) if (!isfinite(tau[r])) return 2;
+    return 0;
+}
+
+/* ---- the driver (the same entry points as derivative_engine.h's) ---- */
+#define JDD_F JDA_F
+#define JDD_NU JDA_NU
+
+static int jdd_cholesky(double *M, int n) {
+    double dmax = 0.0;
+    for (int i = 0; i < n; ++i) dmax = fmax(dmax, fabs(M[i * n + i]));
+    for (int j = 0; j < n; ++j) {
+        double d = M[j * n + j];
+        for (int m = 0; m < j; ++m) d -= M[j * n + m] * M[j * n + m];
+        if (!(d > 1e-13 * dmax)) return isfinite(d) ? 1 : 2;
+        double inv = 1.0 / sqrt(d);
+        M[j * n + j] = inv;
+        for (int i = j + 1; i < n; ++i) {
+            double s = M[j * n + i];
+            for (int m = 0; m < j; ++m) s -= M[i * n + m] * M[j * n + m];
+            M[i * n + j] = s * inv;
+        }
+    }
+    return 0;
+}
+
+static void jdd_solve(const double *Lc, double *b, int n, int cols) {
+    for (int i = 0; i < n; ++i) {
+        double *bi = b + (long)i * cols, li = Lc[i * n + i];
+        for (int m = 0; m < i; ++m) {
+            double l = Lc[i * n + m];
+            const double *bm = b + (long)m * cols;
+            for (int c = 0; c < cols; ++c) bi[c] -= l * bm[c];
+        }
+        for (int c = 0; c < cols; ++c) bi[c] *= li;
+    }
+    for (int i = n - 1; i >= 0; --i) {
+        double *bi = b + (long)i * cols, li = Lc[i * n + i];
+        for (int m = i + 1; m < n; ++m) {
+            double l = Lc[m * n + i];
+            const double *bm = b + (long)m * cols;
+            for (int c = 0; c < cols; ++c) bi[c] -= l * bm[c];
+        }
+        for (int c = 0; c < cols; ++c) bi[c] *= li;
+    }
+}
+
+#define JDD_WORK ((long)(sizeof(jda_work) / sizeof(double)) + 1 + 2L * JDA_F * JDA_F \
+                  + (long)JDA_F * (2 * JDA_F + JDA_NU) + JDA_F)
+
+static int jdd_inverse_with(const double *y, const double *yd, const double *ydd, double t,
+                            const double *p, const double *u, double *out, double *work) {
+    const long F = JDA_F, FF = (long)JDA_F * JDA_F;
+    jda_work *W = (jda_work *)work;
+    int status = jda_inverse(y, yd, ydd, t, p, u, out, out + F, out + F + FF,
+                             out + F + 2 * FF, W);
+    jda_mass(W, out + F + 2 * FF + F * JDA_NU);
+    return status;
+}
+
+static int jdd_forward_with(const double *y, const double *yd, double t, const double *p,
+                            const double *u, double *out, double *work) {
+    const long F = JDA_F, FF = (long)JDA_F * JDA_F, NC = 2 * JDA_F + JDA_NU;
+    jda_work *W = (jda_work *)work;
+    double *M = work + sizeof(jda_work) / sizeof(double) + 1, *G = M + FF, *tau = G + F * NC;
+    double *ydd = out;
+    for (long i = 0; i < F; ++i) ydd[i] = 0.0;
+    jda_pass(y, yd, ydd, t, p, u, W, 0, tau);          /* k − q at ÿ = 0 */
+    jda_mass(W, M);
+    int status = jdd_cholesky(M, JDA_F);
+    if (status) return status;
+    for (long i = 0; i < F; ++i) ydd[i] = -tau[i];
+    jdd_solve(M, ydd, JDA_F, 1);
+    double *ty = out + F, *tyd = out + F + FF, *tu = out + F + 2 * FF;
+    status = jda_inverse(y, yd, ydd, t, p, u, tau, ty, tyd, tu, W);
+    if (status) return status;
+    for (long i = 0; i < F; ++i) {
+        for (long j = 0; j < F; ++j) {
+            G[i * NC + j] = -ty[i * F + j];
+            G[i * NC + F + j] = -tyd[i * F + j];
+        }
+        for (long j = 0; j < JDA_NU; ++j) G[i * NC + 2 * F + j] = -tu[i * JDA_NU + j];
+    }
+    jdd_solve(M, G, JDA_F, (int)NC);
+    for (long i = 0; i < F; ++i) {
+        for (long j = 0; j < F; ++j) {
+            ty[i * F + j] = G[i * NC + j];
+            tyd[i * F + j] = G[i * NC + F + j];
+        }
+        for (long j = 0; j < JDA_NU; ++j) tu[i * JDA_NU + j] = G[i * NC + 2 * F + j];
+    }
+    for (long a = 0; a < F + 2 * FF + F * JDA_NU; ++a) if (!isfinite(out[a])) return 2;
+    return 0;
+}
