@@ -20,8 +20,6 @@
    and M_jk = S_k·(I^C S_j) for k before j (Carpentier & Mansard 2018 derive the same
    relations). O(Σ depth) dot products of 6-vectors per state. */
 
-void jd_local(const double *y, const double *yd, double t, const double *p, const double *u,
-              double *out);
 
 static inline void jda_cross3(const double *a, const double *b, double *r) {
     double r0 = a[1] * b[2] - a[2] * b[1], r1 = a[2] * b[0] - a[0] * b[2];
@@ -47,34 +45,53 @@ static inline void jda_crf(const double *v, const double *F, double *r) {
 static inline double jda_dot6(const double *a, const double *b) {
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] + a[4] * b[4] + a[5] * b[5];
 }
-static inline void jda_mv6(const double *A, const double *x, double *r) {
-    for (int k = 0; k < 6; ++k) r[k] = jda_dot6(A + 6 * k, x);
+/* a spatial inertia about the origin as (Ī 9, h = m·c 3, m): I x = (Ī xw + h × xu, m xu − h × xw) */
+static inline void jda_inertia(const double *I, const double *x, double *r) {
+    double a[3], b[3];
+    jda_cross3(I + 9, x + 3, a);
+    jda_cross3(I + 9, x, b);
+    for (int k = 0; k < 3; ++k) {
+        r[k] = I[3 * k] * x[0] + I[3 * k + 1] * x[1] + I[3 * k + 2] * x[2] + a[k];
+        r[3 + k] = I[12] * x[3 + k] - b[k];
+    }
 }
-static inline void jda_mtv6(const double *A, const double *x, double *r) {
-    for (int k = 0; k < 6; ++k) {
-        double s = 0.0;
-        for (int m = 0; m < 6; ++m) s += A[6 * m + k] * x[m];
-        r[k] = s;
+/* B = [[B11, 0], [−2[h_f]×, 0]] as (B11 9, h_f 3): B x and Bᵀ x */
+static inline void jda_bx(const double *B, const double *x, double *r) {
+    double c[3];
+    jda_cross3(B + 9, x, c);
+    for (int k = 0; k < 3; ++k) {
+        r[k] = B[3 * k] * x[0] + B[3 * k + 1] * x[1] + B[3 * k + 2] * x[2];
+        r[3 + k] = -2.0 * c[k];
+    }
+}
+static inline void jda_btx(const double *B, const double *x, double *r) {
+    double c[3];
+    jda_cross3(B + 9, x + 3, c);
+    for (int k = 0; k < 3; ++k) {
+        r[k] = B[k] * x[0] + B[3 + k] * x[1] + B[6 + k] * x[2] + 2.0 * c[k];
+        r[3 + k] = 0.0;
     }
 }
 
 typedef struct {
     double R[9 * JDA_P], o[3 * JDA_P];
     double S[6 * JDA_NC], v[6 * JDA_NC], a[6 * JDA_NC], pd[6 * JDA_NC], pdd[6 * JDA_NC];
-    double IC[36 * JDA_P], BC[36 * JDA_P], F[6 * JDA_P];
+    double Ib[13 * JDA_P], Iv[6 * JDA_P], IC[13 * JDA_P], BC[12 * JDA_P], F[6 * JDA_P];
     double A[6 * JDA_NC], Bt[6 * JDA_NC], G[6 * JDA_NC], H[6 * JDA_NC];
     double L[JDA_NL > 0 ? JDA_NL : 1], K[JDA_NK > 0 ? JDA_NK : 1];
 } jda_work;
 
 /* frames, twists, velocities, accelerations; the bodies' inertias, forces and B; the sums;
    with derivs: A, Bt, G, H per column; tau always */
-static void jda_pass(const double *y, const double *yd, const double *ydd, double t,
-                     const double *p, const double *u, jda_work *W, int derivs, double *tau) {
+/* frames, twists, velocities, ψ̇; each body's inertia I, I·v and B about the origin; the
+   sums I^C, B^C over the sub-trees (nothing here depends on ÿ) */
+static void jda_geometry(const double *y, const double *yd, double t, const double *p,
+                         const double *u, jda_work *W) {
     static const double I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, Z3[3] = {0, 0, 0};
-    jd_local(y, yd, t, p, u, W->L);
+    static const double z6[6] = {0, 0, 0, 0, 0, 0};
+    jda_local(y, yd, t, p, u, W->L);
     jda_consts(y, yd, t, p, u, W->K);
-    const double *L = W->L, *g = W->K;
-    const double a0[6] = {0, 0, 0, -g[0], -g[1], -g[2]}, z6[6] = {0, 0, 0, 0, 0, 0};
+    const double *L = W->L;
     for (int i = 0; i < JDA_P; ++i) {  /* frames */
         const double *b = L + 40 * i, *A = b, *d = b + 9;
         int lam = jda_parent[i];
@@ -97,25 +114,18 @@ static void jda_pass(const double *y, const double *yd, const double *ydd, doubl
         }
         jda_cross3(o, w, S + 3);
         for (int r = 0; r < 3; ++r) { S[r] = w[r]; S[3 + r] += ut[r]; }
-        const double *vp = pj < 0 ? z6 : W->v + 6 * pj, *ap = pj < 0 ? a0 : W->a + 6 * pj;
-        double *v = W->v + 6 * j, *a = W->a + 6 * j, *pd = W->pd + 6 * j, *pdd = W->pdd + 6 * j;
-        double qd = yd[c], vxs[6];
+        const double *vp = pj < 0 ? z6 : W->v + 6 * pj;
+        double *v = W->v + 6 * j, qd = yd[c];
         for (int r = 0; r < 6; ++r) v[r] = vp[r] + S[r] * qd;
-        jda_crm(v, S, pd);                       /* ψ̇ = v × S */
-        for (int r = 0; r < 6; ++r) a[r] = ap[r] + S[r] * ydd[c] + pd[r] * qd;
-        if (derivs) {
-            jda_crm(a, S, pdd);
-            jda_crm(v, pd, vxs);
-            for (int r = 0; r < 6; ++r) pdd[r] += vxs[r];   /* ψ̈ = a × S + v × ψ̇ */
-        }
+        jda_crm(v, S, W->pd + 6 * j);                       /* ψ̇ = v × S */
     }
-    for (int i = 0; i < JDA_P; ++i) {  /* each body: I, f, B about the origin */
+    for (int i = 0; i < JDA_P; ++i) {  /* each body: I, I v, B about the origin */
         const double *b = L + 40 * i, m = b[24], *com = b + 25, *In = b + 28;
         const double *R = W->R + 9 * i, *o = W->o + 3 * i;
         int vc = jda_vcol[i];  /* the last column on the body's path (-1: the base) */
-        const double *v = vc < 0 ? z6 : W->v + 6 * vc, *a = vc < 0 ? a0 : W->a + 6 * vc;
-        double *IC = W->IC + 36 * i, *BC = W->BC + 36 * i, *F = W->F + 6 * i;
-        double c[3], SI[9], Ib[9];
+        const double *v = vc < 0 ? z6 : W->v + 6 * vc;
+        double *Ib = W->Ib + 13 * i, *BC = W->BC + 12 * i, *Iv = W->Iv + 6 * i;
+        double c[3], SI[9];
         for (int r = 0; r < 3; ++r) c[r] = o[r] + R[3 * r] * com[0] + R[3 * r + 1] * com[1] + R[3 * r + 2] * com[2];
         const double Is[9] = {In[0], In[1], In[2], In[1], In[3], In[4], In[2], In[4], In[5]};
         for (int r = 0; r < 3; ++r)
@@ -126,57 +136,87 @@ static void jda_pass(const double *y, const double *yd, const double *ydd, doubl
             for (int s = 0; s < 3; ++s)
                 Ib[3 * r + s] = SI[3 * r] * R[3 * s] + SI[3 * r + 1] * R[3 * s + 1]
                                 + SI[3 * r + 2] * R[3 * s + 2] + m * ((r == s ? c2 : 0.0) - c[r] * c[s]);
-        double h[3] = {m * c[0], m * c[1], m * c[2]};
-        double Hx[9] = {0, -h[2], h[1], h[2], 0, -h[0], -h[1], h[0], 0};
+        for (int r = 0; r < 3; ++r) Ib[9 + r] = m * c[r];
+        Ib[12] = m;
+        jda_inertia(Ib, v, Iv);
+        /* B x = −I (v × x) + x ×* (I v) + v ×* (I x) = [[B11, 0], [−2[h_f]×, 0]] x with
+           (I v) = (h_m, h_f), W = [ω]×, H = [h]×, U = [u]×:
+           B11 = W Ī − Ī W − (H U + U H) − [h_m]× */
+        const double *w = v, *uu = v + 3, *h = Ib + 9;
+        double Wm[9] = {0, -w[2], w[1], w[2], 0, -w[0], -w[1], w[0], 0};
+        double Hm[9] = {0, -h[2], h[1], h[2], 0, -h[0], -h[1], h[0], 0};
+        double Um[9] = {0, -uu[2], uu[1], uu[2], 0, -uu[0], -uu[1], uu[0], 0};
         for (int r = 0; r < 3; ++r)
             for (int s = 0; s < 3; ++s) {
-                IC[6 * r + s] = Ib[3 * r + s];
-                IC[6 * r + 3 + s] = Hx[3 * r + s];
-                IC[6 * (3 + r) + s] = -Hx[3 * r + s];
-                IC[6 * (3 + r) + 3 + s] = r == s ? m : 0.0;
+                double t2 = 0.0;
+                for (int k = 0; k < 3; ++k)
+                    t2 += Wm[3 * r + k] * Ib[3 * k + s] - Ib[3 * r + k] * Wm[3 * k + s]
+                          - Hm[3 * r + k] * Um[3 * k + s] - Um[3 * r + k] * Hm[3 * k + s];
+                BC[3 * r + s] = t2;
             }
-        double Iv[6], Ia[6], vf[6];
-        jda_mv6(IC, v, Iv);
-        jda_mv6(IC, a, Ia);
-        jda_crf(v, Iv, vf);
-        for (int r = 0; r < 6; ++r) F[r] = Ia[r] + vf[r];
-        if (derivs) {  /* B x = −I (v × x) + x ×* (I v) + v ×* (I x), column by column */
-            for (int e = 0; e < 6; ++e) {
-                double x[6] = {0, 0, 0, 0, 0, 0}, vx[6], Ivx[6], xIv[6], Ix[6], vIx[6];
-                x[e] = 1.0;
-                jda_crm(v, x, vx);
-                jda_mv6(IC, vx, Ivx);
-                jda_crf(x, Iv, xIv);
-                for (int r = 0; r < 6; ++r) Ix[r] = IC[6 * r + e];
-                jda_crf(v, Ix, vIx);
-                for (int r = 0; r < 6; ++r) BC[6 * r + e] = -Ivx[r] + xIv[r] + vIx[r];
-            }
-        }
+        BC[1] += Iv[2]; BC[2] -= Iv[1]; BC[3] -= Iv[2];
+        BC[5] += Iv[0]; BC[6] += Iv[1]; BC[7] -= Iv[0];    /* − [h_m]× */
+        for (int r = 0; r < 3; ++r) BC[9 + r] = Iv[3 + r];
+        for (int r = 0; r < 13; ++r) W->IC[13 * i + r] = Ib[r];
     }
     for (int i = JDA_P - 1; i >= 0; --i) {  /* sums over the sub-trees */
         int lam = jda_parent[i];
         if (lam < 0) continue;
-        for (int r = 0; r < 36; ++r) W->IC[36 * lam + r] += W->IC[36 * i + r];
-        if (derivs) for (int r = 0; r < 36; ++r) W->BC[36 * lam + r] += W->BC[36 * i + r];
-        for (int r = 0; r < 6; ++r) W->F[6 * lam + r] += W->F[6 * i + r];
+        for (int r = 0; r < 13; ++r) W->IC[13 * lam + r] += W->IC[13 * i + r];
+        for (int r = 0; r < 12; ++r) W->BC[12 * lam + r] += W->BC[12 * i + r];
     }
+}
+
+/* for ÿ: accelerations, the bodies' forces f = I a + v ×* I v and their sums F, tau; with
+   derivs also ψ̈ and per column A = I^C S, Bt = B^Cᵀ S, G, H */
+static void jda_dynamics(const double *yd, const double *ydd, jda_work *W, int derivs,
+                         double *tau) {
+    static const double z6[6] = {0, 0, 0, 0, 0, 0};
+    const double *g = W->K;
+    const double a0[6] = {0, 0, 0, -g[0], -g[1], -g[2]};
+    for (int j = 0; j < JDA_NC; ++j) {
+        int pj = jda_pred[j], c = jda_coord[j];
+        const double *S = W->S + 6 * j, *v = W->v + 6 * j, *pd = W->pd + 6 * j;
+        const double *ap = pj < 0 ? a0 : W->a + 6 * pj;
+        double *a = W->a + 6 * j, qd = yd[c];
+        for (int r = 0; r < 6; ++r) a[r] = ap[r] + S[r] * ydd[c] + pd[r] * qd;
+        if (derivs) {
+            double *pdd = W->pdd + 6 * j, vxs[6];
+            jda_crm(a, S, pdd);
+            jda_crm(v, pd, vxs);
+            for (int r = 0; r < 6; ++r) pdd[r] += vxs[r];   /* ψ̈ = a × S + v × ψ̇ */
+        }
+    }
+    for (int i = 0; i < JDA_P; ++i) {
+        int vc = jda_vcol[i];
+        const double *v = vc < 0 ? z6 : W->v + 6 * vc, *a = vc < 0 ? a0 : W->a + 6 * vc;
+        double Ia[6], vf[6], *F = W->F + 6 * i;
+        jda_inertia(W->Ib + 13 * i, a, Ia);
+        jda_crf(v, W->Iv + 6 * i, vf);
+        for (int r = 0; r < 6; ++r) F[r] = Ia[r] + vf[r];
+    }
+    for (int i = JDA_P - 1; i >= 0; --i) {
+        int lam = jda_parent[i];
+        if (lam >= 0) for (int r = 0; r < 6; ++r) W->F[6 * lam + r] += W->F[6 * i + r];
+    }
+    (void)z6;
     for (int r = 0; r < JDA_F; ++r) tau[r] = -W->K[3 + r];  /* − the generalized forces */
     for (int j = 0; j < JDA_NC; ++j) {
         int i = jda_body[j];
-        const double *S = W->S + 6 * j, *IC = W->IC + 36 * i, *F = W->F + 6 * i;
+        const double *S = W->S + 6 * j, *IC = W->IC + 13 * i, *F = W->F + 6 * i;
         tau[jda_coord[j]] += jda_dot6(S, F);
         if (!derivs) continue;
-        const double *BC = W->BC + 36 * i, *pd = W->pd + 6 * j, *pdd = W->pdd + 6 * j;
+        const double *BC = W->BC + 12 * i, *pd = W->pd + 6 * j, *pdd = W->pdd + 6 * j;
         double *A = W->A + 6 * j, *Bt = W->Bt + 6 * j, *G = W->G + 6 * j, *H = W->H + 6 * j;
         double t1[6], t2[6], t3[6];
-        jda_mv6(IC, S, A);
-        jda_mtv6(BC, S, Bt);
+        jda_inertia(IC, S, A);
+        jda_btx(BC, S, Bt);
         jda_crf(S, F, t1);
-        jda_mv6(IC, pdd, t2);
-        jda_mv6(BC, pd, t3);
+        jda_inertia(IC, pdd, t2);
+        jda_bx(BC, pd, t3);
         for (int r = 0; r < 6; ++r) G[r] = t1[r] + t2[r] + t3[r];
-        jda_mv6(IC, pd, t1);
-        jda_mv6(BC, S, t2);
+        jda_inertia(IC, pd, t1);
+        jda_bx(BC, S, t2);
         for (int r = 0; r < 6; ++r) H[r] = 2.0 * t1[r] + t2[r];
     }
 }
@@ -186,7 +226,7 @@ static void jda_mass(const jda_work *W, double *M) {
     for (long r = 0; r < (long)JDA_F * JDA_F; ++r) M[r] = 0.0;
     for (int j = 0; j < JDA_NC; ++j) {
         double A[6];
-        jda_mv6(W->IC + 36 * jda_body[j], W->S + 6 * j, A);
+        jda_inertia(W->IC + 13 * jda_body[j], W->S + 6 * j, A);
         int cj = jda_coord[j];
         for (int k = j; k >= 0; k = jda_pred[k]) {
             double m = jda_dot6(W->S + 6 * k, A);
@@ -198,10 +238,9 @@ static void jda_mass(const jda_work *W, double *M) {
 }
 
 /* tau (f), tau_y, tau_yd (f×f), tau_u (f×nu) at ÿ; W holds the pass with derivs */
-static int jda_inverse(const double *y, const double *yd, const double *ydd, double t,
-                       const double *p, const double *u, double *tau, double *tau_y,
+static int jda_inverse(const double *yd, const double *ydd, double *tau, double *tau_y,
                        double *tau_yd, double *tau_u, jda_work *W) {
-    jda_pass(y, yd, ydd, t, p, u, W, 1, tau);
+    jda_dynamics(yd, ydd, W, 1, tau);
     for (long r = 0; r < (long)JDA_F * JDA_F; ++r) { tau_y[r] = 0.0; tau_yd[r] = 0.0; }
     for (int k = 0; k < JDA_NC; ++k) {
         int ck = jda_coord[k];
@@ -275,8 +314,8 @@ static int jdd_inverse_with(const double *y, const double *yd, const double *ydd
                             const double *p, const double *u, double *out, double *work) {
     const long F = JDA_F, FF = (long)JDA_F * JDA_F;
     jda_work *W = (jda_work *)work;
-    int status = jda_inverse(y, yd, ydd, t, p, u, out, out + F, out + F + FF,
-                             out + F + 2 * FF, W);
+    jda_geometry(y, yd, t, p, u, W);
+    int status = jda_inverse(yd, ydd, out, out + F, out + F + FF, out + F + 2 * FF, W);
     jda_mass(W, out + F + 2 * FF + F * JDA_NU);
     return status;
 }
@@ -288,14 +327,15 @@ static int jdd_forward_with(const double *y, const double *yd, double t, const d
     double *M = work + sizeof(jda_work) / sizeof(double) + 1, *G = M + FF, *tau = G + F * NC;
     double *ydd = out;
     for (long i = 0; i < F; ++i) ydd[i] = 0.0;
-    jda_pass(y, yd, ydd, t, p, u, W, 0, tau);          /* k − q at ÿ = 0 */
+    jda_geometry(y, yd, t, p, u, W);
+    jda_dynamics(yd, ydd, W, 0, tau);                   /* k − q at ÿ = 0 */
     jda_mass(W, M);
     int status = jdd_cholesky(M, JDA_F);
     if (status) return status;
     for (long i = 0; i < F; ++i) ydd[i] = -tau[i];
     jdd_solve(M, ydd, JDA_F, 1);
     double *ty = out + F, *tyd = out + F + FF, *tu = out + F + 2 * FF;
-    status = jda_inverse(y, yd, ydd, t, p, u, tau, ty, tyd, tu, W);
+    status = jda_inverse(yd, ydd, tau, ty, tyd, tu, W);
     if (status) return status;
     for (long i = 0; i < F; ++i) {
         for (long j = 0; j < F; ++j) {

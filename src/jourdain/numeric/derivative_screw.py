@@ -121,6 +121,12 @@ def screw_source(system: System, cols: list[tuple[int, int]]) -> str:
     names = argument_names(system.y, system.yd, system.t, system.parameter_symbols,
                            system.inputs)
     consts = function_source("jda_consts", [*g, *q, *q_u], names)
+    # the joints' motion, columns and mass data (no rates, accelerations or applied forces:
+    # the recursions form those)
+    zero = se.Integer(0)
+    local = [zero if (e < 40 * p and (12 <= e % 40 < 24 or e % 40 >= 34)) else x
+             for e, x in enumerate(lay.exprs)]
+    consts += function_source("jda_local", local, names)
 
     def table(name: str, values: list[int]) -> str:
         body = ", ".join(map(str, values)) if values else "0"
