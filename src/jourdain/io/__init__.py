@@ -7,7 +7,15 @@
 - :func:`matrix_latex`, :func:`matrix_mathml`, :func:`matrix_text`, :func:`matrices_json`:
   exports of symbolic matrices (large ones summarized by size and operation count).
 - :func:`write_report`: the self-contained HTML report of ``jourdain run``.
+
+The report (:mod:`.report`, which sits above the workflow it shares with the command line) is
+imported on first use of its names (module ``__getattr__``): ``import jourdain.io`` then never
+imports the workflow, whatever imports it first (``jourdain`` itself imports its names lazily:
+issue 35).
 """
+
+from importlib import import_module
+from typing import TYPE_CHECKING, Any
 
 from .export import matrices_json, matrix_latex, matrix_mathml, matrix_text
 from .expressions import FUNCTIONS, ExpressionError, parse_expression, parse_number
@@ -19,7 +27,9 @@ from .modelfile import (
     load_model,
     loads_model,
 )
-from .report import ReportInfo, write_report
+
+if TYPE_CHECKING:
+    from .report import ReportInfo, write_report
 
 __all__ = [
     "FUNCTIONS", "ExpressionError", "parse_expression", "parse_number", "ModelFile",
@@ -28,3 +38,12 @@ __all__ = [
     "write_report",
 ]
 
+
+
+def __getattr__(name: str) -> Any:
+    """The report's names, imported from :mod:`.report` on first use."""
+    if name in ("ReportInfo", "write_report"):
+        value = getattr(import_module(f"{__name__}.report"), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -17,14 +17,9 @@ from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 
-from ..analysis.friction import evaluate_friction
-from ..analysis.reactions import evaluate_keys
 from ..errors import ModelError, refuse_closed
 from ..model.system import System as Model
 from ..numeric import evaluate as evaluate_eom
-from ..numeric.derivatives import Derivatives
-from ..numeric.derivatives import derivatives as compiled_derivatives
-from ..numeric.linearization import Linearization, linearization  # with its numbers
 from ..simulation.results import Results
 from ..simulation.simulate import DEFAULT_ATOL, DEFAULT_METHOD, DEFAULT_RTOL, simulate
 from ..stages.constraints import Constraints, constraints
@@ -33,10 +28,16 @@ from ..stages.newton_euler import NewtonEuler, newton_euler
 from ..stages.projection import EquationsOfMotion, projection
 from ..stages.reactions import Reactions, reactions
 
-if TYPE_CHECKING:  # a closed system's linearizations (jourdain.loops loads SciPy: not here)
+if TYPE_CHECKING:
+    # imported where used: a closed system's linearizations (jourdain.loops loads SciPy), and
+    # the analysis, the linearization and the derivatives, which building a system and
+    # simulating it do not need (a script that does only that waits for every module it
+    # imports: issue 35)
     from ..loops.derivatives import ClosedDerivatives
     from ..loops.linearization import LoopLinearization
     from ..loops.periodic import ClosedLinearization
+    from ..numeric.derivatives import Derivatives
+    from ..numeric.linearization import Linearization
 
 _T = TypeVar("_T")
 
@@ -54,6 +55,8 @@ def derivatives(system: Model) -> Derivatives | ClosedDerivatives:
         from ..loops.derivatives import closed_derivatives
 
         return closed_derivatives(system)
+    from ..numeric.derivatives import derivatives as compiled_derivatives
+
     return compiled_derivatives(system)
 _LOCKS = threading.Lock()  # guards the creation of the per-system locks
 
@@ -161,6 +164,8 @@ class System(Model):
             from ..loops.nominal import linearize_closed
 
             return linearize_closed(self, nominal, inputs)
+        from ..numeric.linearization import linearization  # with its numbers
+
         return linearization(self.equations_of_motion(), nominal, inputs)
 
     def evaluate(self, y: Any, yd: Any, t: float = 0.0,
@@ -179,6 +184,8 @@ class System(Model):
         :func:`jourdain.analysis.friction.evaluate_friction`).
         """
         if self.frictions:
+            from ..analysis.friction import evaluate_friction
+
             return evaluate_friction(self, y, yd, t, parameters, inputs)
         if self.is_general:  # velocity constraints (METHOD §7): jourdain.loops.general
             from ..loops.general_eval import evaluate_general
@@ -191,6 +198,8 @@ class System(Model):
         out: dict[str, Any] = dict(evaluate_eom(self, y, yd, t=t, parameters=parameters,
                                                 inputs=inputs))
         eom: dict[str, np.ndarray] = dict(out)
+        from ..analysis.reactions import evaluate_keys
+
         out.update(evaluate_keys(self, y, yd, t, parameters, inputs, eom=eom))
         return out
 
@@ -240,6 +249,8 @@ def tree_linearization(lin: Linearization | LoopLinearization | ClosedLinearizat
                        ) -> Linearization:
     """``lin`` as the symbolic linearization of a tree (what :meth:`System.linearize` gives a
     system without closing joints), for code on the tree's path after its closed branch."""
+    from ..numeric.linearization import Linearization
+
     if not isinstance(lin, Linearization):
         raise TypeError(f"expected a tree's Linearization, got {type(lin).__name__}")
     return lin

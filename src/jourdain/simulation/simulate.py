@@ -43,7 +43,6 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..analysis.friction import friction_inputs
 from ..errors import EvaluationError
 from ..numeric import CompiledFunction, _vector, mkq_function, parameter_vector
 from .options import (  # noqa: F401 - the import paths of the options stay those of this module
@@ -171,6 +170,8 @@ def simulate(system: System, t_span: tuple[float, float], y0: Any, yd0: Any,
                                raise_on_interrupt=raise_on_interrupt, **closed_options)
     _tree_takes_no(system, closed_options)
     if getattr(system, "frictions", ()):  # friction forces fed back from the reactions
+        from ..analysis.friction import friction_inputs  # with the analysis (issue 35)
+
         system, inputs = friction_inputs(system, inputs, parameters)
     f = system.f
     t0, t1 = check_t_span(t_span)
