@@ -212,3 +212,13 @@ def test_the_recursions_of_screw_joints_equal_the_forward_mode(name):
         fa, fb = screw.forward(y, yd, u), fwd.forward(y, yd, u)
         assert np.abs(fa.ydd_y - fb.ydd_y).max() <= solve_tol(
             b.tau_ydd, max(np.abs(fb.ydd_y).max(), 1.0))
+
+
+def test_joint_friction_is_refused_by_name():
+    """Joint friction is set-valued at rest: no derivatives (never silently without it)."""
+    from tests.test_friction import incline
+
+    system = incline(0.5, 0.3)
+    assert system.frictions
+    with pytest.raises(jd.ModelError, match="joint friction"):
+        jd.derivatives(system)
