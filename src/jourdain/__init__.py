@@ -24,6 +24,7 @@ files' readers, the report, URDF or the analysis it does not call (issue 35: 0.2
 """
 
 from importlib import import_module
+from importlib.util import find_spec
 from typing import TYPE_CHECKING, Any
 
 from symengine import atan2, cos, exp, log, pi, sin, sqrt, tan
@@ -185,10 +186,14 @@ _MODULE_OF = {name: module for module, names in _WHERE.items() for name in names
 
 
 def __getattr__(name: str) -> Any:
-    """A public name imported from its submodule on first use (PEP 562), then kept here."""
+    """A public name imported from its submodule on first use (PEP 562), then kept here; a
+    subpackage or module by its name (``jourdain.models`` after ``import jourdain``, as when
+    this module imported them all)."""
     module = _MODULE_OF.get(name)
     if module is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+        if name.startswith("_") or find_spec(f"{__name__}.{name}") is None:
+            raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+        return import_module(f"{__name__}.{name}")  # the import system sets it here
     value = getattr(import_module(f"{__name__}.{module}"), name)
     globals()[name] = value
     return value

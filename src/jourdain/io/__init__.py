@@ -15,6 +15,7 @@ issue 35).
 """
 
 from importlib import import_module
+from importlib.util import find_spec
 from typing import TYPE_CHECKING, Any
 
 from .export import matrices_json, matrix_latex, matrix_mathml, matrix_text
@@ -41,9 +42,12 @@ __all__ = [
 
 
 def __getattr__(name: str) -> Any:
-    """The report's names, imported from :mod:`.report` on first use."""
+    """The report's names, imported from :mod:`.report` on first use; a subpackage or module
+    by its name (``jourdain.io.viewer``, which the report used to import with this package)."""
     if name in ("ReportInfo", "write_report"):
         value = getattr(import_module(f"{__name__}.report"), name)
         globals()[name] = value
         return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    if name.startswith("_") or find_spec(f"{__name__}.{name}") is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    return import_module(f"{__name__}.{name}")
