@@ -82,6 +82,7 @@ bench: $(BIN)/.installed
 	$(BIN)/python benchmarks/hostile_files.py --repeat 1
 	$(BIN)/python benchmarks/rolling.py --quick
 	$(BIN)/python benchmarks/per_call.py --repeat 50
+	$(BIN)/python benchmarks/setup.py --quick
 
 # the 3-D view's three.js bundle (src/jourdain/io/viewer/three_bundle.js, committed): rebuilt from
 # the npm versions pinned in tools/viewer/package-lock.json; needs node and npm, nothing else does

@@ -1,0 +1,290 @@
+"""Setup time and per-call overhead of a simulation (issue 35, item 3: "setup in milliseconds").
+
+Each measurement of a start runs in a fresh Python process (:func:`benchmarks.crosscheck.spawn`),
+``--trials`` times (default 5), and every column is the smallest over the trials: on a shared
+machine other work only ever adds to a time. Models: ``n_link_pendulum_on_cart(n)`` (f = n + 1)
+and ``spatial_chain(n)`` (revolute, universal and spherical joints in turn) for f = 2 … 32.
+Columns:
+
+* ``import s``: ``import jourdain, jourdain.models`` in the child (the interpreter's own
+  start-up not included; ``python -c pass`` is printed above the table);
+* ``cold s``: import → the model built → the first simulated step returned
+  (``system.simulate((0, 1e-3), y0, ẏ0)``) with an empty ``JOURDAIN_CACHE``: derivation, code
+  generation, C compilation and loading included; the integrator library is the one compiled
+  at install time (``prebuilt/``), as on a user's machine;
+* ``warm s``: the same with the cache filled by an earlier process (nothing compiled);
+* ``mujoco s``: with ``--mujoco`` (``pip install jourdain[bench]``), MuJoCo's ``import
+  mujoco`` → ``MjModel.from_xml_string`` of an MJCF of the same chain (generated here) → the
+  first ``mj_step``, in a fresh process, as the reference of the issue.
+
+Below the table, in this process (the model compiled and memoized, as in a user's loop):
+
+* ``simulate() overhead``: the median time of ``system.simulate((0, 1e-9), y0, ẏ0)`` (one
+  step, a dozen right-hand sides) of the 4-link pendulum on a cart: what a call costs outside
+  the C step loop (the target: 20 µs);
+* ``step loop``: a 10 s run of the same model (DOP853, the default tolerances): its C time per
+  right-hand side evaluation against the compiled M, k, q per state (``fn.batch`` on 10 000
+  states, best of 5): the loop's share beyond M, k, q (it includes the LDLᵀ solve of each
+  right-hand side and the step's vector arithmetic; the target: 30 % of a right-hand side).
+
+    .venv/bin/python benchmarks/setup.py                   # f = 2 … 32, 5 trials (minutes)
+    .venv/bin/python benchmarks/setup.py --quick           # f = 2 and 5, 2 trials
+    .venv/bin/python benchmarks/setup.py --mujoco --json setup.json
+
+A child runs ``python -m benchmarks.setup '{"kind": "cart", "n": 4}'`` and prints one JSON
+line (:func:`case`).
+
+Measured (2-core AMD EPYC, load average 1.7-2.4 from other sessions' test runs; Python 3.11,
+NumPy 2, best of 3, PYTHONDONTWRITEBYTECODE unset so that the byte code is cached as on an
+installed package): before issue 35's changes, ``import jourdain`` 0.24 s; cold 0.30 s (cart,
+f = 2) … 0.39 s (f = 5) and 1.2-1.4 s (chains f = 7 … 31, gcc's -O2 of the recursion's engine:
+0.4 s); warm 0.25-0.47 s; simulate() 80 µs per call at n = 4. After: ``import jourdain``
+0.10 s, ``import jourdain, jourdain.models`` 0.19 s (figures of the full run in the issue's
+closing note).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+CASES = (("cart", 1), ("cart", 4), ("cart", 8), ("cart", 16), ("cart", 31),
+         ("chain", 2), ("chain", 4), ("chain", 8), ("chain", 16))
+QUICK_CASES = (("cart", 1), ("cart", 4))
+#: the issue's targets (seconds; the overhead in µs, the loop's share in %)
+TARGET_COLD, TARGET_WARM, TARGET_OVERHEAD_US, TARGET_LOOP_SHARE = 0.100, 0.030, 20.0, 30.0
+HEADER = ("| model | f | import s | cold s | warm s | build+step cold s | build+step warm s "
+          "| mujoco s |")
+
+
+def _name(kind: str, n: int) -> str:
+    return f"n_link_pendulum_on_cart({n})" if kind == "cart" else f"spatial_chain({n})"
+
+
+def case(kind: str, n: int) -> dict:
+    """One start, measured in this process (which should be fresh): import, build, first
+    simulated step."""
+    t0 = time.perf_counter()
+    import numpy as np
+
+    import jourdain  # noqa: F401 - the import is what is timed
+    import jourdain.models as models
+
+    t1 = time.perf_counter()
+    system = models.n_link_pendulum_on_cart(n) if kind == "cart" else models.spatial_chain(n)
+    f = system.f
+    inputs = {u: 0.0 for u in system.input_names}
+    res = system.simulate((0.0, 1e-3), np.full(f, 0.1), np.zeros(f), inputs=inputs)
+    t2 = time.perf_counter()
+    return {"kind": kind, "n": n, "f": f, "import_s": t1 - t0, "first_s": t2 - t0,
+            "after_import_s": t2 - t1, "y_end": res.y[-1].tolist()}
+
+
+def mujoco_xml(kind: str, n: int) -> str:
+    """An MJCF of the same chain: the cart (a slide along x) with n links turning about z
+    (point masses at their ends, gravity along -y), or the spatial chain's bodies, inertias
+    and joints (a universal joint as two hinges, a spherical one as a ball)."""
+    if kind == "cart":
+        inner = ""
+        for i in range(n, 0, -1):
+            inner = (f'<body name="l{i}" pos="{0 if i == 1 else 1} 0 0"><joint type="hinge" '
+                     f'axis="0 0 1"/><inertial pos="1 0 0" mass="0.01" '
+                     f'diaginertia="1e-6 1e-6 1e-6"/>{inner}</body>')
+        body = ('<body name="cart"><joint type="slide" axis="1 0 0"/><inertial pos="0 0 0" '
+                f'mass="0.01" diaginertia="1e-6 1e-6 1e-6"/>{inner}</body>')
+        gravity = "0 -9.81 0"
+    else:
+        from jourdain.models import spatial_chain_data
+
+        body = ""
+        data = spatial_chain_data(n)
+        for i, d in reversed(list(enumerate(data))):
+            prev = data[i - 1]["offset"] if i else (0.0, 0.0, 0.0)
+            if d["joint"] == "spherical":
+                joints = '<joint type="ball"/>'
+            else:
+                joints = "".join(f'<joint type="hinge" axis="{_axis(a)}"/>' for a in d["axes"])
+            inertia = d["inertia"]
+            full = " ".join(str(float(v)) for v in (inertia[0][0], inertia[1][1], inertia[2][2],
+                                                    inertia[0][1], inertia[0][2], inertia[1][2]))
+            com = " ".join(str(float(c)) for c in d["com"])
+            pos = " ".join(str(float(c)) for c in prev)
+            body = (f'<body name="b{i}" pos="{pos}">{joints}<inertial pos="{com}" '
+                    f'mass="{float(d["mass"])}" fullinertia="{full}"/>{body}</body>')
+        gravity = "0 0 -9.81"
+    return (f'<mujoco><option gravity="{gravity}" timestep="1e-3"/><worldbody>{body}'
+            "</worldbody></mujoco>")
+
+
+def _axis(name: str) -> str:
+    return " ".join("1" if name == c else "0" for c in "xyz")
+
+
+def mujoco_case(kind: str, n: int) -> dict:
+    """MuJoCo's start in this (fresh) process: import, model from the MJCF, first mj_step."""
+    xml = mujoco_xml(kind, n)  # the text is ready before the clock runs
+    t0 = time.perf_counter()
+    import mujoco
+
+    t1 = time.perf_counter()
+    model = mujoco.MjModel.from_xml_string(xml)
+    data = mujoco.MjData(model)
+    mujoco.mj_step(model, data)
+    t2 = time.perf_counter()
+    return {"import_s": t1 - t0, "first_s": t2 - t0, "nv": int(model.nv)}
+
+
+def _spawn(spec: dict, cache: str | None) -> dict:
+    from benchmarks.crosscheck import spawn
+
+    return spawn(spec, 0, cache=cache, module="benchmarks.setup")
+
+
+def starts(kind: str, n: int, trials: int, mujoco: bool) -> dict:
+    """Best of ``trials`` fresh processes: cold (a new empty cache each), warm (one cache
+    filled by the first cold run), and MuJoCo's."""
+    spec = {"kind": kind, "n": n}
+    cold = [_spawn(spec, None) for _ in range(trials)]
+    with tempfile.TemporaryDirectory(prefix="jourdain-setup-") as cache:
+        fill = _spawn(spec, cache)
+        warm = [_spawn(spec, cache) for _ in range(trials)]
+    # the same motion from a filled cache as from an empty one, to the bit
+    same = all(r["y_end"] == fill["y_end"] for r in (*cold, *warm))
+    row = {"kind": kind, "n": n, "f": cold[0]["f"], "bit_identical": same,
+           "import_s": min(r["import_s"] for r in (*cold, *warm)),
+           "cold_s": min(r["first_s"] for r in cold),
+           "warm_s": min(r["first_s"] for r in warm),
+           "cold_after_import_s": min(r["after_import_s"] for r in cold),
+           "warm_after_import_s": min(r["after_import_s"] for r in warm)}
+    if mujoco:
+        mj = [_spawn({**spec, "mujoco": True}, None) for _ in range(trials)]
+        row["mujoco_s"] = min(r["first_s"] for r in mj)
+        row["mujoco_import_s"] = min(r["import_s"] for r in mj)
+    return row
+
+
+def overhead(repeat: int = 300) -> dict:
+    """simulate()'s cost outside the C loop, and the step loop's share beyond M, k, q, for the
+    4-link pendulum on a cart (this process; compiled once, memoized)."""
+    import numpy as np
+
+    from jourdain.models import n_link_pendulum_on_cart
+    from jourdain.numeric import mkq_function
+
+    system = n_link_pendulum_on_cart(4)
+    f = system.f
+    y0, yd0 = np.full(f, 0.1), np.zeros(f)
+    u = {"F": 0.0}
+    system.simulate((0.0, 1e-9), y0, yd0, inputs=u)
+    times, nfev = [], 0
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        r = system.simulate((0.0, 1e-9), y0, yd0, inputs=u)
+        times.append(time.perf_counter() - t0)
+        nfev = r.nfev
+    long = min((system.simulate((0.0, 10.0), y0, yd0, inputs=u) for _ in range(3)),
+               key=lambda r: r.wall_time)
+    fn = mkq_function(system)
+    rng = np.random.default_rng(0)
+    m = 10000
+    Y, YD = rng.uniform(-1, 1, (m, f)), rng.uniform(-1, 1, (m, f))
+    best = np.inf
+    for _ in range(5):
+        t0 = time.perf_counter()
+        fn.batch(Y, YD, 0.0, None, np.zeros((m, 1)))
+        best = min(best, time.perf_counter() - t0)
+    mkq_s = best / m
+    per_eval = long.wall_time / long.nfev
+    return {"simulate_us": 1e6 * statistics.median(times), "short_nfev": nfev,
+            "run_s": long.wall_time, "run_nfev": long.nfev, "per_eval_us": 1e6 * per_eval,
+            "mkq_us": 1e6 * mkq_s, "loop_share_pct": 100.0 * (per_eval - mkq_s) / mkq_s}
+
+
+def _mark(value: float, target: float) -> str:
+    return "met" if value <= target else "not met"
+
+
+def table(rows: list[dict], over: dict | None) -> str:
+    out = [HEADER, "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"]
+    for r in rows:
+        mj = f"{r['mujoco_s']:.3f}" if "mujoco_s" in r else "—"
+        out.append(f"| {_name(r['kind'], r['n'])} | {r['f']} | {r['import_s']:.3f} | "
+                   f"{r['cold_s']:.3f} | {r['warm_s']:.3f} | {r['cold_after_import_s']:.3f} | "
+                   f"{r['warm_after_import_s']:.3f} | {mj} |")
+    worst_cold = max(r["cold_s"] for r in rows)
+    worst_warm = max(r["warm_s"] for r in rows)
+    out.append("")
+    out.append(f"import → first step, empty cache: at most {worst_cold:.3f} s (target "
+               f"{TARGET_COLD:.3f} s: {_mark(worst_cold, TARGET_COLD)}); warm cache: at most "
+               f"{worst_warm:.3f} s (target {TARGET_WARM:.3f} s: "
+               f"{_mark(worst_warm, TARGET_WARM)})")
+    if not all(r["bit_identical"] for r in rows):
+        out.append("WARNING: a warm start's motion differs from a cold start's")
+    if over is not None:
+        out.append(f"simulate() per call (one step, {over['short_nfev']} right-hand sides): "
+                   f"{over['simulate_us']:.1f} µs (target {TARGET_OVERHEAD_US:.0f} µs: "
+                   f"{_mark(over['simulate_us'], TARGET_OVERHEAD_US)})")
+        out.append(f"step loop, n = 4, 10 s: {over['run_nfev']} right-hand sides in "
+                   f"{1e3 * over['run_s']:.2f} ms, {over['per_eval_us']:.3f} µs each against "
+                   f"M, k, q {over['mkq_us']:.3f} µs: the loop and the solve "
+                   f"{over['loop_share_pct']:.0f} % of M, k, q (target "
+                   f"{TARGET_LOOP_SHARE:.0f} %: "
+                   f"{_mark(over['loop_share_pct'], TARGET_LOOP_SHARE)})")
+    return "\n".join(out)
+
+
+def _startup() -> float:
+    import subprocess
+
+    best = float("inf")
+    for _ in range(3):
+        t0 = time.perf_counter()
+        subprocess.run([sys.executable, "-c", "pass"], check=True)
+        best = min(best, time.perf_counter() - t0)
+    return best
+
+
+def main(argv: list[str] | None = None) -> list[dict]:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--quick", action="store_true", help="f = 2 and 5, 2 trials")
+    ap.add_argument("--trials", type=int, default=None, help="fresh processes per column")
+    ap.add_argument("--mujoco", action="store_true", help="MuJoCo's start as a reference")
+    ap.add_argument("--no-overhead", action="store_true", help="skip the in-process part")
+    ap.add_argument("--json", help="write the rows to this file")
+    args = ap.parse_args(argv)
+    # the children's byte code cached as an installed package's is (not in the source tree)
+    os.environ.pop("PYTHONDONTWRITEBYTECODE", None)
+    os.environ.setdefault("PYTHONPYCACHEPREFIX",
+                          str(Path(tempfile.gettempdir()) / "jourdain-setup-pycache"))
+    cases = QUICK_CASES if args.quick else CASES
+    trials = args.trials or (2 if args.quick else 5)
+    import subprocess
+
+    # one untimed import first, so that the children find their byte code cached
+    subprocess.run([sys.executable, "-c", "import jourdain.models, jourdain.simulation.simulate"],
+                   check=True, cwd=ROOT)
+    print(f"python -c pass: {_startup():.3f} s (not in the columns)")
+    rows = [starts(k, n, trials, args.mujoco) for k, n in cases]
+    over = None if args.no_overhead else overhead(50 if args.quick else 300)
+    print(table(rows, over))
+    if args.json:
+        Path(args.json).write_text(json.dumps({"rows": rows, "overhead": over}, indent=1))
+    return rows
+
+
+if __name__ == "__main__":
+    if len(sys.argv) == 2 and sys.argv[1].startswith("{"):
+        spec = json.loads(sys.argv[1])
+        print(json.dumps(mujoco_case(spec["kind"], spec["n"]) if spec.get("mujoco")
+                         else case(spec["kind"], spec["n"])))
+    else:
+        main()
