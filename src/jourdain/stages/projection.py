@@ -7,7 +7,8 @@ Produces M, k, q (:class:`EquationsOfMotion`).
 The products are formed body by body from the sparse columns of J_T and J_R, never as dense
 6p×6p products; terms that share the same Jacobian columns are collected first (so M_jk of a chain
 reads ``(m_i + m_{i+1} + …)·(J_T,j · J_T,k)``), and only the upper triangle of M is built, so M is
-exactly symmetric.
+exactly symmetric. Large systems (shared kinematics) get the same sums regrouped by composite
+bodies, which grow like f² instead of f³ (:mod:`jourdain.stages.composite`).
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ import symengine as se
 from ..identity import IdentityMap
 from ..model.joints import Mat3
 from ..symbolic import SymMatrix
+from .composite import composite_projection
 from .kinematics import ROOT, FrameTag, _add, _cross, _dot, _mv, _scale, relative_rotation
 from .newton_euler import NewtonEuler
 
@@ -59,6 +61,9 @@ class EquationsOfMotion:
 
 def projection(ne: NewtonEuler) -> EquationsOfMotion:
     """Project the Newton–Euler equations with J̄ᵀ: M = J̄ᵀM̄J̄, k = J̄ᵀq̄^c, q = J̄ᵀq̄^e."""
+    shared = composite_projection(ne)
+    if shared is not None:
+        return EquationsOfMotion(ne, *shared)
     kin = ne.kinematics
     system = kin.system
     f = len(kin.y)

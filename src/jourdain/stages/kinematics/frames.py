@@ -79,3 +79,30 @@ def _chain(ms: list[Mat3]) -> Mat3 | None:
     for m in ms:
         out = m if out is None else _mm(out, m)
     return out
+
+
+class Node:
+    """One elementary step of the recursion in a shared kinematics (``kinematics(...,
+    shared=True)``): the tree of these steps is what the composite-body projection
+    (:mod:`jourdain.stages.composite`) walks, up for the composite bodies and down for the
+    Jacobian columns.
+
+    ``A``: the step's rotation (v_parent = A·v_this), or ``d``: its translation (parent-frame
+    components; the orientation is the parent's); ``tag``: the orientation after the step;
+    ``JR``, ``JT``: every Jacobian column of the frame's origin after the step in its own
+    components (the twist of each coordinate there: angular velocity and velocity of the
+    origin per unit rate); ``anchors``: ``(j, δω, δv)`` for each coordinate j this step depends
+    on directly (its angle or vector is a function of y_j), with the twist it adds here (the
+    axis times ∂angle/∂y_j, or ∂vector/∂y_j): below the step, the columns of y_j are rigid
+    transports of these twists. ``index`` is the step's place in the order of creation
+    (parents first).
+    """
+
+    __slots__ = ("parent", "A", "d", "tag", "JR", "JT", "anchors", "index")
+
+    def __init__(self, parent: Node | None, A: Mat3 | None, d: Vec3 | None, tag: FrameTag,
+                 JR: dict[int, Vec3], JT: dict[int, Vec3],
+                 anchors: tuple[tuple[int, Vec3, Vec3], ...],
+                 index: int) -> None:
+        self.parent, self.A, self.d, self.tag = parent, A, d, tag
+        self.JR, self.JT, self.anchors, self.index = JR, JT, anchors, index

@@ -2,10 +2,16 @@
 time along the tree (rotations merged about fixed axes, translations), carrying the position,
 the rotation, the Jacobians J_T, J_R and the local accelerations; the shared expression graph
 this builds grows linearly with the depth of the tree.
+
+A *shared* recursion (``_Context.shared``, for large systems: :func:`.result.kinematics`)
+carries the Jacobian columns of the frame's origin in the frame's own components (``JT_loc``,
+each step a short expression of the previous one) instead of inertial sums that grow with the
+depth, and records each step as a :class:`~.frames.Node` for the composite-body projection.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -16,7 +22,7 @@ from ...model.joints import IDENTITY, Joint, Mat3, Rot, Trans, Vec3, rotation_ma
 
 if TYPE_CHECKING:
     pass
-from .frames import ROOT, FrameTag
+from .frames import ROOT, FrameTag, Node
 from .vectors import Z3, ZERO, _add, _cross, _is_zero, _mm, _mtv, _mv, _scale
 
 
@@ -36,6 +42,13 @@ class _Frame:
     a_pieces: tuple = ()
     # the orientation: S, and the single axis when all rotations so far are about one
     tag: FrameTag = ROOT
+    # shared recursion: the columns of J_T of the origin in this frame's components, and the
+    # last step taken
+    JT_loc: dict[int, Vec3] = field(default_factory=dict)
+    node: Node | None = None
+    # shared recursion: the inertial columns of J_T of coordinates without an angular part
+    # (translations), the same vector for every frame below the step that formed them
+    JT_fixed: dict[int, Vec3] = field(default_factory=dict)
 
     @property
     def S(self) -> Mat3:
@@ -47,7 +60,8 @@ class _Frame:
 
     def copy(self) -> _Frame:
         return _Frame(self.r, dict(self.JT), self.v_bar, self.a_bar, dict(self.JR), self.omega,
-                      self.omega_bar, self.alpha_bar, self.a_pieces, self.tag)
+                      self.omega_bar, self.alpha_bar, self.a_pieces, self.tag,
+                      dict(self.JT_loc), self.node, dict(self.JT_fixed))
 
 
 class _Rates:
@@ -91,6 +105,16 @@ class _Context:
     t: se.Symbol
     # columns of J_T as sums of rotated local vectors S_k·v_k: col -> ((tag, v), ...)
     pieces: IdentityMap[tuple] = field(default_factory=IdentityMap)
+    # the shared recursion (module docstring): its steps, the inertial frame's first
+    shared: bool = False
+    nodes: list[Node] = field(default_factory=list)
+
+    def step(self, F: _Frame, A: Mat3 | None, d: Vec3 | None,
+             anchors: tuple[tuple[int, Vec3, Vec3], ...]) -> None:
+        """Record the step just applied to F (shared recursion only)."""
+        if self.shared:
+            F.node = Node(F.node, A, d, F.tag, F.JR, F.JT_loc, anchors, len(self.nodes))
+            self.nodes.append(F.node)
 
 
 def _rotate(F: _Frame, u: Vec3, angle: se.Basic, ctx: _Context) -> None:
@@ -119,9 +143,12 @@ def _rotate(F: _Frame, u: Vec3, angle: se.Basic, ctx: _Context) -> None:
     w_rel = _scale(u, rt.d1)
     F.alpha_bar = _mtv(A, _add(_add(F.alpha_bar, _scale(u, rt.d2_local)), _cross(F.omega, w_rel)))
     F.omega = _mtv(A, _add(F.omega, w_rel))
+    if ctx.shared:
+        F.JT_loc = {j: _mtv(A, c) for j, c in F.JT_loc.items()}
+        ctx.step(F, A, None, tuple((j, _scale(u, rt.dy[j]), Z3) for j in sorted(rt.dy)))
 
 
-def _reorient(F: _Frame, R0: Mat3) -> None:
+def _reorient(F: _Frame, R0: Mat3, ctx: _Context) -> None:
     """Apply a constant change of axes R0 (new axes in current-frame components)."""
     if R0 == IDENTITY:
         return
@@ -129,6 +156,9 @@ def _reorient(F: _Frame, R0: Mat3) -> None:
     F.JR = {j: _mtv(R0, c) for j, c in F.JR.items()}
     F.omega, F.omega_bar, F.alpha_bar = (_mtv(R0, F.omega), _mtv(R0, F.omega_bar),
                                          _mtv(R0, F.alpha_bar))
+    if ctx.shared:
+        F.JT_loc = {j: _mtv(R0, c) for j, c in F.JT_loc.items()}
+        ctx.step(F, R0, None, ())
 
 
 def _append(pieces: tuple, tag: FrameTag, v: Vec3) -> tuple:
@@ -146,6 +176,25 @@ def _translate(F: _Frame, d: Vec3, ctx: _Context) -> None:
     S = F.S
     toI = (lambda v: v) if F.identity else (lambda v: _mv(S, v))
     F.r = _add(F.r, toI(d))
+    if ctx.shared:
+        _translate_columns(F, d, rates, toI, ctx)
+    else:
+        _translate_inertial(F, d, rates, toI, ctx)
+    d_t: Vec3 = tuple(rt.dt for rt in rates)
+    d_1: Vec3 = tuple(rt.d1 for rt in rates)
+    d_2: Vec3 = tuple(rt.d2_local for rt in rates)
+    F.v_bar = _add(F.v_bar, toI(_add(_cross(F.omega_bar, d), d_t)))
+    acc = _add(_cross(F.alpha_bar, d), _cross(F.omega, _cross(F.omega, d)))
+    if not _is_zero(d_1):
+        acc = _add(acc, _add(_scale(_cross(F.omega, d_1), se.Integer(2)), d_2))
+    F.a_bar = _add(F.a_bar, toI(acc))
+    if not _is_zero(acc):
+        F.a_pieces = _append(F.a_pieces, F.tag, acc)
+
+
+def _translate_inertial(F: _Frame, d: Vec3, rates: list[_Rates], toI: Callable[[Vec3], Vec3],
+                        ctx: _Context) -> None:
+    """The columns of J_T (inertial) after the translation by d, with their pieces."""
     keys = set(F.JT) | set(F.JR) | {j for rt in rates for j in rt.dy}
     newJT = {}
     for j in keys:
@@ -172,22 +221,34 @@ def _translate(F: _Frame, d: Vec3, ctx: _Context) -> None:
         if pieces is not None:
             ctx.pieces[col] = pieces
     F.JT = newJT
-    d_t: Vec3 = tuple(rt.dt for rt in rates)
-    d_1: Vec3 = tuple(rt.d1 for rt in rates)
-    d_2: Vec3 = tuple(rt.d2_local for rt in rates)
-    F.v_bar = _add(F.v_bar, toI(_add(_cross(F.omega_bar, d), d_t)))
-    acc = _add(_cross(F.alpha_bar, d), _cross(F.omega, _cross(F.omega, d)))
-    if not _is_zero(d_1):
-        acc = _add(acc, _add(_scale(_cross(F.omega, d_1), se.Integer(2)), d_2))
-    F.a_bar = _add(F.a_bar, toI(acc))
-    if not _is_zero(acc):
-        F.a_pieces = _append(F.a_pieces, F.tag, acc)
+
+
+def _translate_columns(F: _Frame, d: Vec3, rates: list[_Rates], toI: Callable[[Vec3], Vec3],
+                       ctx: _Context) -> None:
+    """The columns of J_T in the frame's components after the translation by d (shared
+    recursion): v_j + ω_j × d + ∂d/∂y_j, each a short expression of the one before."""
+    keys = set(F.JT_loc) | set(F.JR) | {j for rt in rates for j in rt.dy}
+    new = {}
+    anchors = []
+    for j in sorted(keys):
+        col = F.JT_loc.get(j, Z3)
+        if j in F.JR:
+            col = _add(col, _cross(F.JR[j], d))
+        dj = tuple(rt.dy.get(j, ZERO) for rt in rates)
+        if not _is_zero(dj):
+            col = _add(col, dj)
+            anchors.append((j, Z3, dj))
+            if j not in F.JR:  # S·(Sᵀ·v) of later frames would only repeat this vector
+                F.JT_fixed[j] = toI(col)
+        new[j] = col
+    F.JT_loc = new
+    ctx.step(F, None, d, tuple(anchors))
 
 
 def _joint_steps(F: _Frame, joint: Joint, ctx: _Context) -> None:
     """Apply a joint's constant orientation and its elementary steps to the frame at the joint
     point."""
-    _reorient(F, joint.orientation)
+    _reorient(F, joint.orientation, ctx)
     for step in joint.steps:
         if isinstance(step, Rot):
             _rotate(F, step.axis, step.angle, ctx)

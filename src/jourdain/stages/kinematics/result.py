@@ -19,6 +19,7 @@ from ...symbolic import SymMatrix
 
 if TYPE_CHECKING:
     from ...model.system import System
+from .frames import Node
 from .recursion import _Context, _Frame, _joint_steps, _translate
 from .vectors import Z3, _add, _cross, _dense, _mat, _mv, _vec
 
@@ -54,6 +55,9 @@ class BodyKinematics:
     cols_T_O: MappingProxyType = field(repr=False, compare=False)
     #: a_bar as pieces S_k·v_k, ((FrameTag, v_k), ...)
     a_bar_pieces: tuple = field(default=(), repr=False, compare=False)
+    #: shared kinematics: the step at the centre of mass (its frame is the body frame moved
+    #: to the centre of mass), in :attr:`Kinematics.nodes`
+    node: Node | None = field(default=None, repr=False, compare=False)
 
     def point(self, p: Vec3) -> tuple[Vec3, dict[int, Vec3], Vec3, Vec3]:
         """Position, J_T columns, v̄ and ā (inertial) of the point ``p`` (body-frame, from the
@@ -83,6 +87,9 @@ class Kinematics:
     #: columns of J_T as sums of rotated local vectors: col -> ((FrameTag, v), ...), by identity
     column_pieces: IdentityMap[tuple] = field(default_factory=IdentityMap, repr=False,
                                               compare=False)
+    #: shared kinematics (:func:`kinematics`): the elementary steps of the recursion, parents
+    #: first, the inertial frame's first; None otherwise
+    nodes: tuple[Node, ...] | None = field(default=None, repr=False, compare=False)
 
     def __getitem__(self, name: str) -> BodyKinematics:
         for b in self.bodies:
@@ -92,8 +99,22 @@ class Kinematics:
         raise KeyError(name)
 
 
-def kinematics(system: System) -> Kinematics:
+#: systems with at least this many coordinates get the shared kinematics by default: below,
+#: the body-by-body sums read like a textbook's (a double pendulum's M), are the shortest
+#: code for planar chains, and are what the integrator compiles up to
+#: ``jourdain.numeric.compiled.SYMBOLIC_MAX_F`` = 24 coordinates
+SHARED_FROM_F = 25
+
+
+def kinematics(system: System, shared: bool | None = None) -> Kinematics:
     """Kinematics of every body of ``system`` (METHOD.md §1), built recursively along the tree.
+
+    ``shared`` (default: ``f >= SHARED_FROM_F``): carry the Jacobian columns in each frame's
+    own components and record the steps (:attr:`Kinematics.nodes`), so that the projection can
+    form M, k, q from composite bodies (:mod:`jourdain.stages.composite`) in time and memory
+    that grow like f² instead of f³; J_T of each body is then ``S·(local column)``, a short
+    expression of shared ones, rather than the sum of the pieces ``S_k·v_k`` of every step
+    above, which reads better but grows with the depth of the tree.
 
     A closed system (with closing joints) is refused with :class:`ClosedSystemError`: every
     stage after this one would treat it as the open tree. Its kinematics are its tree's,
@@ -104,9 +125,13 @@ def kinematics(system: System) -> Kinematics:
                   "use the system's own methods or functions (evaluate, simulate, linearize, "
                   "reactions), or system.tree for the open tree")
     y = system.coordinates
-    ctx = _Context({c: i for i, c in enumerate(y)}, tuple(rate(c) for c in y), system.t)
     f = len(y)
-    frames: dict[str, _Frame] = {"world": _Frame()}
+    ctx = _Context({c: i for i, c in enumerate(y)}, tuple(rate(c) for c in y), system.t,
+                   shared=f >= SHARED_FROM_F if shared is None else shared)
+    world = _Frame()
+    if ctx.shared:
+        ctx.step(world, None, None, ())
+    frames: dict[str, _Frame] = {"world": world}
     coms: dict[str, tuple[Vec3, _Frame]] = {}
     out = []
     for body in system.bodies:
@@ -126,6 +151,8 @@ def kinematics(system: System) -> Kinematics:
         C = F.copy()
         _translate(C, body.com, ctx)
         coms[body.name] = (body.com, C)
+        if ctx.shared:
+            F.JT, C.JT = _inertial(F), _inertial(C)
         col = SymMatrix.column
         out.append(BodyKinematics(
             name=body.name, r=col(C.r), S=SymMatrix.from_rows(F.S), omega=col(F.omega),
@@ -133,10 +160,20 @@ def kinematics(system: System) -> Kinematics:
             omega_bar=col(F.omega_bar), a_bar=col(C.a_bar), alpha_bar=col(F.alpha_bar),
             r_O=col(F.r), J_T_O=_dense(F.JT, f), v_bar_O=col(F.v_bar), a_bar_O=col(F.a_bar),
             cols_T=MappingProxyType(C.JT), cols_R=MappingProxyType(F.JR),
-            cols_T_O=MappingProxyType(F.JT), a_bar_pieces=C.a_pieces,
+            cols_T_O=MappingProxyType(F.JT), a_bar_pieces=C.a_pieces, node=C.node,
         ))
     return Kinematics(system, tuple(out), y, ctx.yd, tuple(acceleration(c) for c in y), system.t,
-                      ctx.pieces)
+                      ctx.pieces, tuple(ctx.nodes) if ctx.shared else None)
+
+
+def _inertial(F: _Frame) -> dict[int, Vec3]:
+    """The columns of J_T of F's origin in inertial components: S·(local column), or the
+    vector formed at the step of a coordinate without an angular part."""
+    if F.identity:
+        return dict(F.JT_loc)
+    S, JR, fixed = F.S, F.JR, F.JT_fixed
+    return {j: fixed[j] if j in fixed and j not in JR else _mv(S, c)
+            for j, c in F.JT_loc.items()}
 
 
 @dataclass(frozen=True)
