@@ -34,13 +34,36 @@ Below the table, in this process (the model compiled and memoized, as in a user'
 A child runs ``python -m benchmarks.setup '{"kind": "cart", "n": 4}'`` and prints one JSON
 line (:func:`case`).
 
-Measured (2-core AMD EPYC, load average 1.7-2.4 from other sessions' test runs; Python 3.11,
-NumPy 2, best of 3, PYTHONDONTWRITEBYTECODE unset so that the byte code is cached as on an
-installed package): before issue 35's changes, ``import jourdain`` 0.24 s; cold 0.30 s (cart,
-f = 2) … 0.39 s (f = 5) and 1.2-1.4 s (chains f = 7 … 31, gcc's -O2 of the recursion's engine:
-0.4 s); warm 0.25-0.47 s; simulate() 80 µs per call at n = 4. After: ``import jourdain``
-0.10 s, ``import jourdain, jourdain.models`` 0.19 s (figures of the full run in the issue's
-closing note).
+Measured 2026-11-26 on a 2-core AMD EPYC shared with other sessions' test runs (load average
+3.8-4.5 during both runs, so every figure carries that noise), best of 3, byte code cached,
+without (before, commit 2608593) and with issue 35's lazy imports (``import s`` here is
+``import jourdain, jourdain.models``; ``import jourdain`` alone went 0.24 → 0.10 s at load 1-2):
+
+| model | f | import s | cold s | warm s | build+step cold | build+step warm | MuJoCo s |
+| --- | ---: | --- | --- | --- | --- | --- | ---: |
+| cart(1) | 2 | 0.239 → 0.167 | 0.371 → 0.314 | 0.248 → 0.175 | 0.109 → 0.093 | 0.008 | 0.178 |
+| cart(4) | 5 | 0.251 → 0.170 | 0.440 → 0.337 | 0.277 → 0.184 | 0.170 → 0.130 | 0.014 | 0.166 |
+| cart(8) | 9 | 0.233 → 0.227 | 0.501 → 0.612 | 0.254 → 0.264 | 0.221 → 0.300 | 0.021 → 0.032 | 0.326 |
+| cart(16) | 17 | 0.240 → 0.262 | 0.682 → 0.944 | 0.312 → 0.393 | 0.442 → 0.646 | 0.054 → 0.051 | 0.286 |
+| cart(31) | 32 | 0.232 → 0.246 | 1.049 → 1.548 | 0.272 → 0.303 | 0.747 → 1.195 | 0.039 → 0.056 | 0.315 |
+| chain(2) | 3 | 0.339 → 0.238 | 0.621 → 0.448 | 0.367 → 0.286 | 0.267 → 0.198 | 0.022 → 0.025 | 0.122 |
+| chain(4) | 7 | 0.273 → 0.233 | 0.894 → 1.064 | 0.388 → 0.272 | 0.617 → 0.812 | 0.045 → 0.039 | 0.125 |
+| chain(8) | 15 | 0.320 → 0.245 | 1.253 → 1.195 | 0.414 → 0.340 | 0.864 → 0.929 | 0.094 → 0.092 | 0.097 |
+| chain(16) | 31 | 0.326 → 0.229 | 1.548 → 1.323 | 0.404 → 0.290 | 1.176 → 1.090 | 0.051 → 0.027 | 0.098 |
+
+(the columns after the import did not change in code: their spread is the load's). simulate()
+per call 76 → 74 µs; the step loop at n = 4: 0.14 µs per right-hand side against 0.054 µs of
+M, k, q (155-165 %). The targets stand unmet, and why: the interpreter's start-up and the
+imports of NumPy and SymEngine alone take 0.09-0.13 s here (``import numpy`` 0.09 s), over the
+cold target before any model code runs; cold starts wait for gcc (0.09 s for the smallest
+model's one unit, 0.4 s at -O2 for the recursion's engine of chains: -O0 halves it, but a
+first library at -O0 with the -O2 one built meanwhile needs both in one process and an exit
+that does not cut the build off); warm starts derive the symbolic projection before they can
+name the library to load (chain(8): 45 ms, of which the projection and its node count take
+30 ms; a derivation cache keyed by the model's content needs an exact serialization of its
+expressions: SymEngine's ``str`` prints 15 digits, so two models can print alike); and the
+per-call cost is Python around the C call (argument checks, the packing of the problem, the
+copies into Results, ~15-25 µs each).
 """
 
 from __future__ import annotations
