@@ -268,46 +268,7 @@ static int jda_inverse(const double *yd, const double *ydd, double *tau, double 
 #define JDD_F JDA_F
 #define JDD_NU JDA_NU
 
-static int jdd_cholesky(double *M, int n) {
-    double dmax = 0.0;
-    for (int i = 0; i < n; ++i) dmax = fmax(dmax, fabs(M[i * n + i]));
-    for (int j = 0; j < n; ++j) {
-        double d = M[j * n + j];
-        for (int m = 0; m < j; ++m) d -= M[j * n + m] * M[j * n + m];
-        if (!(d > 1e-13 * dmax)) return isfinite(d) ? 1 : 2;
-        double inv = 1.0 / sqrt(d);
-        M[j * n + j] = inv;
-        for (int i = j + 1; i < n; ++i) {
-            double s = M[j * n + i];
-            for (int m = 0; m < j; ++m) s -= M[i * n + m] * M[j * n + m];
-            M[i * n + j] = s * inv;
-        }
-    }
-    return 0;
-}
-
-static void jdd_solve(const double *Lc, double *b, int n, int cols) {
-    for (int i = 0; i < n; ++i) {
-        double *bi = b + (long)i * cols, li = Lc[i * n + i];
-        for (int m = 0; m < i; ++m) {
-            double l = Lc[i * n + m];
-            const double *bm = b + (long)m * cols;
-            for (int c = 0; c < cols; ++c) bi[c] -= l * bm[c];
-        }
-        for (int c = 0; c < cols; ++c) bi[c] *= li;
-    }
-    for (int i = n - 1; i >= 0; --i) {
-        double *bi = b + (long)i * cols, li = Lc[i * n + i];
-        for (int m = i + 1; m < n; ++m) {
-            double l = Lc[m * n + i];
-            const double *bm = b + (long)m * cols;
-            for (int c = 0; c < cols; ++c) bi[c] -= l * bm[c];
-        }
-        for (int c = 0; c < cols; ++c) bi[c] *= li;
-    }
-}
-
-#define JDD_WORK ((long)(sizeof(jda_work) / sizeof(double)) + 1 + 2L * JDA_F * JDA_F \
+#define JDD_WORK ((long)(sizeof(jda_work) / sizeof(double)) + 1 + 3L * JDA_F * JDA_F \
                   + (long)JDA_F * (2 * JDA_F + JDA_NU) + JDA_F)
 
 static int jdd_inverse_with(const double *y, const double *yd, const double *ydd, double t,
@@ -320,37 +281,82 @@ static int jdd_inverse_with(const double *y, const double *yd, const double *ydd
     return status;
 }
 
+/* M = LᵀL with the sparsity of the tree (Featherstone's LTL: no fill-in where the columns'
+   parents come first): row j of H holds L_jk for k at or above j on j's path, in the order of
+   the columns; 0, or 1 where M is not positive definite, 2 where not finite */
+static int jda_ltl(const double *M, double *H) {
+    double dmax = 0.0;
+    for (int j = 0; j < JDA_NC; ++j) {
+        int cj = jda_coord[j];
+        dmax = fmax(dmax, fabs(M[(long)cj * JDA_F + cj]));
+        for (int k = j; k >= 0; k = jda_pred[k]) H[(long)j * JDA_NC + k] = M[(long)cj * JDA_F + jda_coord[k]];
+    }
+    for (int k = JDA_NC - 1; k >= 0; --k) {
+        double d = H[(long)k * JDA_NC + k];
+        if (!(d > 1e-13 * dmax)) return isfinite(d) ? 1 : 2;
+        d = sqrt(d);
+        H[(long)k * JDA_NC + k] = d;
+        for (int i = jda_pred[k]; i >= 0; i = jda_pred[i]) H[(long)k * JDA_NC + i] /= d;
+        for (int i = jda_pred[k]; i >= 0; i = jda_pred[i])
+            for (int j = i; j >= 0; j = jda_pred[j])
+                H[(long)i * JDA_NC + j] -= H[(long)k * JDA_NC + i] * H[(long)k * JDA_NC + j];
+    }
+    return 0;
+}
+
+/* X = M⁻¹ X for `cols` right-hand sides (rows in the order of the columns): Lᵀ z = x, L x = z */
+static void jda_ltl_solve(const double *H, double *X, int cols) {
+    for (int i = JDA_NC - 1; i >= 0; --i) {
+        double *xi = X + (long)i * cols, li = 1.0 / H[(long)i * JDA_NC + i];
+        for (int c = 0; c < cols; ++c) xi[c] *= li;
+        for (int j = jda_pred[i]; j >= 0; j = jda_pred[j]) {
+            double l = H[(long)i * JDA_NC + j];
+            double *xj = X + (long)j * cols;
+            for (int c = 0; c < cols; ++c) xj[c] -= l * xi[c];
+        }
+    }
+    for (int i = 0; i < JDA_NC; ++i) {
+        double *xi = X + (long)i * cols;
+        for (int j = jda_pred[i]; j >= 0; j = jda_pred[j]) {
+            double l = H[(long)i * JDA_NC + j];
+            const double *xj = X + (long)j * cols;
+            for (int c = 0; c < cols; ++c) xi[c] -= l * xj[c];
+        }
+        double li = 1.0 / H[(long)i * JDA_NC + i];
+        for (int c = 0; c < cols; ++c) xi[c] *= li;
+    }
+}
+
 static int jdd_forward_with(const double *y, const double *yd, double t, const double *p,
                             const double *u, double *out, double *work) {
     const long F = JDA_F, FF = (long)JDA_F * JDA_F, NC = 2 * JDA_F + JDA_NU;
     jda_work *W = (jda_work *)work;
-    double *M = work + sizeof(jda_work) / sizeof(double) + 1, *G = M + FF, *tau = G + F * NC;
-    double *ydd = out;
+    double *M = work + sizeof(jda_work) / sizeof(double) + 1, *H = M + FF, *G = H + FF;
+    double *tau = G + F * NC, *ydd = out;
     for (long i = 0; i < F; ++i) ydd[i] = 0.0;
     jda_geometry(y, yd, t, p, u, W);
     jda_dynamics(yd, ydd, W, 0, tau);                   /* k − q at ÿ = 0 */
     jda_mass(W, M);
-    int status = jdd_cholesky(M, JDA_F);
+    int status = jda_ltl(M, H);
     if (status) return status;
-    for (long i = 0; i < F; ++i) ydd[i] = -tau[i];
-    jdd_solve(M, ydd, JDA_F, 1);
+    for (int j = 0; j < JDA_NC; ++j) G[j] = -tau[jda_coord[j]];
+    jda_ltl_solve(H, G, 1);
+    for (int j = 0; j < JDA_NC; ++j) ydd[jda_coord[j]] = G[j];
     double *ty = out + F, *tyd = out + F + FF, *tu = out + F + 2 * FF;
     status = jda_inverse(yd, ydd, tau, ty, tyd, tu, W);
     if (status) return status;
-    for (long i = 0; i < F; ++i) {
-        for (long j = 0; j < F; ++j) {
-            G[i * NC + j] = -ty[i * F + j];
-            G[i * NC + F + j] = -tyd[i * F + j];
-        }
-        for (long j = 0; j < JDA_NU; ++j) G[i * NC + 2 * F + j] = -tu[i * JDA_NU + j];
+    for (int j = 0; j < JDA_NC; ++j) {  /* −[τ_y τ_ẏ τ_u], rows in the order of the columns */
+        long i = jda_coord[j];
+        double *g = G + (long)j * NC;
+        for (long k = 0; k < F; ++k) { g[k] = -ty[i * F + k]; g[F + k] = -tyd[i * F + k]; }
+        for (long k = 0; k < JDA_NU; ++k) g[2 * F + k] = -tu[i * JDA_NU + k];
     }
-    jdd_solve(M, G, JDA_F, (int)NC);
-    for (long i = 0; i < F; ++i) {
-        for (long j = 0; j < F; ++j) {
-            ty[i * F + j] = G[i * NC + j];
-            tyd[i * F + j] = G[i * NC + F + j];
-        }
-        for (long j = 0; j < JDA_NU; ++j) tu[i * JDA_NU + j] = G[i * NC + 2 * F + j];
+    jda_ltl_solve(H, G, (int)NC);
+    for (int j = 0; j < JDA_NC; ++j) {
+        long i = jda_coord[j];
+        const double *g = G + (long)j * NC;
+        for (long k = 0; k < F; ++k) { ty[i * F + k] = g[k]; tyd[i * F + k] = g[F + k]; }
+        for (long k = 0; k < JDA_NU; ++k) tu[i * JDA_NU + k] = g[2 * F + k];
     }
     for (long a = 0; a < F + 2 * FF + F * JDA_NU; ++a) if (!isfinite(out[a])) return 2;
     return 0;
