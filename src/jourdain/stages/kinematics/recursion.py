@@ -23,7 +23,7 @@ from ...model.joints import IDENTITY, Joint, Mat3, Rot, Trans, Vec3, rotation_ma
 if TYPE_CHECKING:
     pass
 from .frames import ROOT, FrameTag, Node
-from .vectors import Z3, ZERO, _add, _cross, _is_zero, _mm, _mtv, _mv, _scale
+from .vectors import Z3, ZERO, _add, _cross, _is_zero, _mm, _scale, _times, _times_t
 
 
 @dataclass
@@ -135,16 +135,17 @@ def _rotate(F: _Frame, u: Vec3, angle: se.Basic, ctx: _Context) -> None:
     F.tag = FrameTag(F.tag, A, S, axis)
     # angular velocity and acceleration in the new frame: ω' = Aᵀ(ω + u·θ̇)
     keys = set(F.JR) | set(rt.dy)
+    At = _times_t(A)
     F.JR = {
-        j: _mtv(A, _add(F.JR.get(j, Z3), _scale(u, rt.dy[j])) if j in rt.dy else F.JR[j])
+        j: At(_add(F.JR.get(j, Z3), _scale(u, rt.dy[j])) if j in rt.dy else F.JR[j])
         for j in keys
     }
-    F.omega_bar = _mtv(A, _add(F.omega_bar, _scale(u, rt.dt)))
+    F.omega_bar = At(_add(F.omega_bar, _scale(u, rt.dt)))
     w_rel = _scale(u, rt.d1)
-    F.alpha_bar = _mtv(A, _add(_add(F.alpha_bar, _scale(u, rt.d2_local)), _cross(F.omega, w_rel)))
-    F.omega = _mtv(A, _add(F.omega, w_rel))
+    F.alpha_bar = At(_add(_add(F.alpha_bar, _scale(u, rt.d2_local)), _cross(F.omega, w_rel)))
+    F.omega = At(_add(F.omega, w_rel))
     if ctx.shared:
-        F.JT_loc = {j: _mtv(A, c) for j, c in F.JT_loc.items()}
+        F.JT_loc = {j: At(c) for j, c in F.JT_loc.items()}
         ctx.step(F, A, None, tuple((j, _scale(u, rt.dy[j]), Z3) for j in sorted(rt.dy)))
 
 
@@ -153,11 +154,12 @@ def _reorient(F: _Frame, R0: Mat3, ctx: _Context) -> None:
     if R0 == IDENTITY:
         return
     F.tag = FrameTag(F.tag, R0, R0 if F.identity else _mm(F.S, R0), None)
-    F.JR = {j: _mtv(R0, c) for j, c in F.JR.items()}
-    F.omega, F.omega_bar, F.alpha_bar = (_mtv(R0, F.omega), _mtv(R0, F.omega_bar),
-                                         _mtv(R0, F.alpha_bar))
+    Rt = _times_t(R0)
+    F.JR = {j: Rt(c) for j, c in F.JR.items()}
+    F.omega, F.omega_bar, F.alpha_bar = (Rt(F.omega), Rt(F.omega_bar),
+                                         Rt(F.alpha_bar))
     if ctx.shared:
-        F.JT_loc = {j: _mtv(R0, c) for j, c in F.JT_loc.items()}
+        F.JT_loc = {j: Rt(c) for j, c in F.JT_loc.items()}
         ctx.step(F, R0, None, ())
 
 
@@ -173,8 +175,7 @@ def _translate(F: _Frame, d: Vec3, ctx: _Context) -> None:
     if _is_zero(d):
         return
     rates = [_Rates(c, ctx) for c in d]
-    S = F.S
-    toI = (lambda v: v) if F.identity else (lambda v: _mv(S, v))
+    toI = (lambda v: v) if F.identity else _times(F.S)
     F.r = _add(F.r, toI(d))
     if ctx.shared:
         _translate_columns(F, d, rates, toI, ctx)

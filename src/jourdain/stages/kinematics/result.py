@@ -21,7 +21,7 @@ if TYPE_CHECKING:
     from ...model.system import System
 from .frames import Node
 from .recursion import _Context, _Frame, _joint_steps, _translate
-from .vectors import Z3, _add, _cross, _dense, _mat, _mv, _vec
+from .vectors import Z3, _add, _cross, _dense, _mat, _mv, _times, _vec
 
 
 @dataclass(frozen=True)
@@ -171,8 +171,8 @@ def _inertial(F: _Frame) -> dict[int, Vec3]:
     vector formed at the step of a coordinate without an angular part."""
     if F.identity:
         return dict(F.JT_loc)
-    S, JR, fixed = F.S, F.JR, F.JT_fixed
-    return {j: fixed[j] if j in fixed and j not in JR else _mv(S, c)
+    S, JR, fixed = _times(F.S), F.JR, F.JT_fixed
+    return {j: fixed[j] if j in fixed and j not in JR else S(c)
             for j, c in F.JT_loc.items()}
 
 

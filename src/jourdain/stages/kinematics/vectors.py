@@ -5,6 +5,7 @@ compute with (sums, products, cross and dot products), and their conversions to 
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 import symengine as se
@@ -62,8 +63,50 @@ def _mm(A: Mat3, B: Mat3) -> Mat3:
     )  # type: ignore[return-value]
 
 
+_ZERO_TYPE = type(ZERO)
+
+
+def _zero(c: object) -> bool:
+    """c == 0, structurally (SymEngine's only zero is its Zero; other numbers by value)."""
+    return type(c) is _ZERO_TYPE or (type(c) in (int, float) and c == 0)
+
+
 def _is_zero(v: Vec3) -> bool:
-    return v[0] == 0 and v[1] == 0 and v[2] == 0
+    return _zero(v[0]) and _zero(v[1]) and _zero(v[2])
+
+
+def _product(rows: tuple[tuple[object, object, object], ...]) -> Callable[[Vec3], Vec3]:
+    """v ↦ R·v for the rows of R, with R's structural zeros and ones skipped: the same
+    expressions as :func:`_mv`, for many vectors at a fraction of the operations (an
+    elementary rotation has five zeros and ones)."""
+    plan = []
+    for r in rows:
+        terms = [(k, a) for k, a in enumerate(r) if not _zero(a)]
+        plan.append(terms)
+
+    def apply(v: Vec3) -> Vec3:
+        out = []
+        for terms in plan:
+            if not terms:
+                out.append(ZERO)
+            elif len(terms) == 1:
+                k, a = terms[0]
+                out.append(a * v[k])
+            else:
+                out.append(se.Add(*[a * v[k] for k, a in terms]))
+        return tuple(out)  # type: ignore[return-value]
+
+    return apply
+
+
+def _times(A: Mat3) -> Callable[[Vec3], Vec3]:
+    """v ↦ A·v (:func:`_product`)."""
+    return _product(A)
+
+
+def _times_t(A: Mat3) -> Callable[[Vec3], Vec3]:
+    """v ↦ Aᵀ·v (:func:`_product`)."""
+    return _product(tuple(zip(*A, strict=True)))  # type: ignore[arg-type]
 
 def _mtm(A: Mat3, B: Mat3) -> Mat3:
     """Aᵀ·B"""
