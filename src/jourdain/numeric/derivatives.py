@@ -32,6 +32,7 @@ from types import SimpleNamespace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy import copyto
 
 from ..errors import EvaluationError, ModelError, SingularMassMatrix, refuse_closed
 from .compiled import _GENERATOR_VERSION
@@ -78,6 +79,8 @@ class Derivatives:
     #: the forward mode of every intermediate quantity, not the recursions of screw joints
     forward_mode: bool = False
 
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "_local", threading.local())  # per thread: _buffers
     @property
     def f(self) -> int:
         return int(self.system.f)
@@ -89,8 +92,7 @@ class Derivatives:
     def _buffers(self) -> Any:
         """This thread's arrays for one state and their addresses (a call per state then
         converts no argument: microseconds, where a batch's checks take tens)."""
-        local = self.__dict__.setdefault("_local", threading.local())
-        b = getattr(local, "b", None)
+        b = getattr(self._local, "b", None)
         if b is None:
             f, nu = self.f, self.n_u
             p = parameter_vector(self.system, None)
@@ -100,7 +102,7 @@ class Derivatives:
                                 fwd=np.empty(f + 2 * f * f + f * nu))
             for k in ("y", "yd", "ydd", "u", "p", "inv", "fwd"):
                 setattr(b, k + "_at", getattr(b, k).ctypes.data)
-            local.b = b
+            self._local.b = b
         return b
 
     def _one(self, inverse: bool, y: Any, yd: Any, ydd: Any, u: Any, t: Any) -> Any:
@@ -108,14 +110,14 @@ class Derivatives:
         (the general path then says what is wrong)."""
         b = self._buffers()
         try:
-            b.y[:] = y
-            b.yd[:] = yd
+            copyto(b.y, y)
+            copyto(b.yd, yd)
             if inverse:
-                b.ydd[:] = ydd
+                copyto(b.ydd, ydd)
             if self.n_u:
                 if u is None:
                     return None
-                b.u[:] = u
+                copyto(b.u, u)
             elif u is not None:
                 return None
             tv = float(t)
@@ -145,7 +147,7 @@ class Derivatives:
                 parameters: Mapping[str, float] | None = None) -> InverseDerivatives:
         """τ and its derivatives at one state (``y``, ``yd``, ``ydd`` of shape (f,)) or at
         ``n`` states (shape (n, f); ``u`` (n_u,) shared or (n, n_u); ``t`` a number or (n,))."""
-        if parameters is None and np.ndim(y) == 1:
+        if parameters is None and getattr(y, "ndim", 1) == 1:
             res = self._one(True, y, yd, ydd, u, t)
             if res is not None:
                 return res
@@ -171,7 +173,7 @@ class Derivatives:
                 parameters: Mapping[str, float] | None = None) -> ForwardDerivatives:
         """ÿ and its derivatives at one state or at ``n`` states (as :meth:`inverse`);
         :class:`SingularMassMatrix` names the first state where M is not positive definite."""
-        if parameters is None and np.ndim(y) == 1:
+        if parameters is None and getattr(y, "ndim", 1) == 1:
             res = self._one(False, y, yd, None, u, t)
             if res is not None:
                 return res
