@@ -25,7 +25,7 @@ from __future__ import annotations
 import ctypes
 import threading
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
 from types import SimpleNamespace
@@ -79,8 +79,8 @@ class Derivatives:
     #: the forward mode of every intermediate quantity, not the recursions of screw joints
     forward_mode: bool = False
 
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "_local", threading.local())  # per thread: _buffers
+    #: this thread's arrays for one state (:meth:`_buffers`)
+    _local: threading.local = field(default_factory=threading.local, repr=False, compare=False)
     @property
     def f(self) -> int:
         return int(self.system.f)
