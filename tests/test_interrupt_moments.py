@@ -74,12 +74,20 @@ def written(folder: Path) -> dict[str, str]:
     return out
 
 
+def _sigint_default() -> None:
+    """Ctrl-C as in a terminal: a suite started in the background (``nohup make test &``, a
+    CI runner without job control) passes SIGINT on as ignored, and an ignored signal stays
+    ignored in every child (Python then installs no handler): no trial could be interrupted."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def interrupt_at(command: list[str], delay: float | None, cwd: Path) -> tuple[int, str]:
     """Run ``command``, SIGINT ``delay`` seconds (None: never) after its console script has
     imported its entry; its status and stderr."""
     ready = cwd / f".ready-{time.monotonic_ns()}"
     proc = subprocess.Popen(command, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, env={**os.environ, "JD_READY": str(ready)})
+                            text=True, env={**os.environ, "JD_READY": str(ready)},
+                            preexec_fn=_sigint_default)
     try:
         if delay is not None:
             t0 = time.monotonic()
