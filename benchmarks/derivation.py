@@ -1,18 +1,28 @@
 """Derivation of the equations of motion: jourdain against sympy.physics.mechanics, in one run.
 
-Family 1: ``n_link_pendulum_on_cart(n)``, jourdain against sympy's ``KanesMethod`` on sympy's own
-model (``sympy.physics.mechanics.models.n_link_pendulum_on_cart``).
-Family 2: ``spatial_chain(n)``, jourdain against sympy's ``System``/joints API on the same data
-(relative joint coordinates; see ``benchmarks/sympy_models.py``).
+Family ``pendulum``: ``n_link_pendulum_on_cart(n)``, jourdain against sympy's ``KanesMethod`` on
+sympy's own model (``sympy.physics.mechanics.models.n_link_pendulum_on_cart``).
+Family ``chain``: ``spatial_chain(n)``, f = 3 … 127, jourdain against sympy's ``System``/joints
+API on the same data (relative joint coordinates, ``form_eoms()`` with its default
+``KanesMethod``; see ``benchmarks/sympy_models.py``), sympy up to ``--sympy-upto`` links.
 
-Reported per case: derivation times (best of ``--repeat`` for jourdain, one run for sympy, each
-sympy case in a subprocess with a time limit), their ratio, and the operation counts of M and of the
-forcing vector q - k after common-subexpression elimination, both counted by the same function
-(``jourdain.symbolic.count_ops``: graph CSE, n-ary + and * count n-1) on SymEngine versions of
-both results. Where sympy finishes, both results are also compared numerically at a random state.
+Every case runs in fresh processes, jourdain's (``python -m benchmarks.derivation '{...}'``) and
+sympy's (with the time limit ``--timeout``), so that each peak resident memory (``ru_maxrss``) is
+its own. Reported per case: the time of the symbolic M, k, q (jourdain: ``equations_of_motion()``,
+the best of ``--repeat`` derivations of new systems in its process; sympy: one), the process's
+peak RSS and what the derivation added to it (Δ: over the RSS after the imports and the model's
+construction), the ratios sympy/jourdain of time and of peak RSS, and the operation counts of M
+and of the forcing vector q - k after common-subexpression elimination, both counted by the same
+function (``jourdain.symbolic.count_ops``: graph CSE, n-ary + and * count n-1) on SymEngine
+versions of both results. Where sympy finishes (up to ``--check-upto`` links), both symbolic
+results are evaluated at a random state and compared.
+
+Below the table: the growth exponents of jourdain's time and Δ memory with f over the chains
+(log-log slope from f = 7 to the largest f, and over the top half), and the targets of issue 35,
+item 4 at the largest chain: f = 127 in ≤ 1.5 s and ≤ 300 MB peak RSS, growth ≤ f².
 
     python benchmarks/derivation.py            # the full run (several minutes: sympy is slow)
-    python benchmarks/derivation.py --quick    # n = 1, 2 only
+    python benchmarks/derivation.py --quick    # n = 1, 2 and a chain of f = 7, sympy at n ≤ 2
 """
 
 from __future__ import annotations
@@ -26,29 +36,56 @@ import time
 from pathlib import Path
 
 import numpy as np
-import symengine as se
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from jourdain.models import n_link_pendulum_on_cart, spatial_chain  # noqa: E402
-from jourdain.symbolic import count_ops  # noqa: E402
+#: issue 35, item 4: the spatial chain of f = 127 in at most this many seconds and MB of peak
+#: RSS, growing at most like f^GROWTH_TARGET
+TARGET_F, TARGET_S, TARGET_MB, GROWTH_TARGET = 127, 1.5, 300.0, 2.0
+CASES = {"pendulum": [1, 2, 4, 8, 16, 32], "chain": [2, 3, 4, 5, 6, 8, 16, 32, 64]}
+QUICK = {"pendulum": [1, 2], "chain": [2, 4]}
 
 
-def _jourdain_case(family: str, n: int, repeat: int) -> dict:
-    make = n_link_pendulum_on_cart if family == "pendulum" else spatial_chain
-    best = math.inf
-    for _ in range(repeat):
+def _make(family: str, n: int):  # noqa: ANN202 - a jourdain System
+    from jourdain.models import n_link_pendulum_on_cart, spatial_chain
+
+    return (n_link_pendulum_on_cart if family == "pendulum" else spatial_chain)(n)
+
+
+def _rss_mb() -> float:
+    import resource
+
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0  # Linux: kB
+
+
+def jourdain_case(family: str, n: int, repeat: int = 3) -> dict:
+    """One model in this process (which should be fresh): time, peak RSS and operation counts
+    of ``equations_of_motion()``."""
+    from jourdain.symbolic import count_ops
+
+    system = _make(family, n)
+    rss0 = _rss_mb()
+    t0 = time.perf_counter()
+    eom = system.equations_of_motion()
+    best = time.perf_counter() - t0
+    rss = _rss_mb()
+    for _ in range(repeat - 1):
+        other = _make(family, n)
         t0 = time.perf_counter()
-        eom = make(n).equations_of_motion()
+        other.equations_of_motion()
         best = min(best, time.perf_counter() - t0)
-    return {"time": best, "ops_M": count_ops(eom.M.entries()),
-            "ops_f": count_ops(eom.forcing.entries()),
-            "eom": eom}
+        del other
+    return {"f": system.f, "time": best, "rss_mb": rss, "delta_mb": rss - rss0,
+            "ops_M": count_ops(eom.M.entries()), "ops_f": count_ops(eom.forcing.entries())}
 
 
 def _sympy_worker(family: str, n: int, check: bool, out: mp.Queue) -> None:
+    import symengine as se
     import sympy as sp
 
+    from jourdain.symbolic import count_ops
+
+    rss0 = _rss_mb()
     t0 = time.perf_counter()
     if family == "pendulum":
         from sympy.physics.mechanics.models import n_link_pendulum_on_cart as sympy_model
@@ -64,29 +101,27 @@ def _sympy_worker(family: str, n: int, check: bool, out: mp.Queue) -> None:
         M, F = system.mass_matrix, system.forcing
         u = list(system.u)
     elapsed = time.perf_counter() - t0
+    rss = _rss_mb()
     # count sympy's results on plain symbols, as jourdain's: q0(t) -> q0, F(t) -> F
     funcs = {x for x in M.atoms(sp.Function) | F.atoms(sp.Function)
              if isinstance(x, sp.core.function.AppliedUndef)} | set(q) | set(u)
     plain = {x: sp.Symbol(x.func.__name__) for x in funcs}
     M, F = M.xreplace(plain), F.xreplace(plain)
     q, u = [plain[x] for x in q], [plain[x] for x in u]
-    res = {"time": elapsed,
+    res = {"time": elapsed, "rss_mb": rss, "delta_mb": rss - rss0,
            "ops_M": count_ops([se.sympify(e) for e in M]),
            "ops_f": count_ops([se.sympify(e) for e in F])}
     if check:
         Fin = sp.Symbol("F")
-        make = n_link_pendulum_on_cart if family == "pendulum" else spatial_chain
-        pv = make(n).parameter_values
+        pv = _make(family, n).parameter_values
         names = sorted(k for k in syms if k in pv)  # t appears only inside q(t), u(t)
         args = [*q, *u, *(syms[k] for k in names), Fin]
-        res["M_f"] = (sp.lambdify(args, M, cse=True), sp.lambdify(args, F, cse=True), names)
         rng = np.random.default_rng(7)
         yv, ydv = rng.uniform(-1, 1, len(q)), rng.uniform(-1, 1, len(q))
         res["state"] = (yv, ydv)
         vals = [*yv, *ydv, *(pv[k] for k in names), 0.0]
-        res["M_val"] = np.array(res["M_f"][0](*vals), float)
-        res["F_val"] = np.array(res["M_f"][1](*vals), float).ravel()
-        del res["M_f"]
+        res["M_val"] = np.array(sp.lambdify(args, M, cse=True)(*vals), float)
+        res["F_val"] = np.array(sp.lambdify(args, F, cse=True)(*vals), float).ravel()
     out.put(res)
 
 
@@ -109,72 +144,152 @@ def _sympy_case(family: str, n: int, timeout: float, check: bool) -> dict | None
     return res
 
 
-def _agreement(family: str, n: int, ours: dict, theirs: dict) -> float | None:
+def _agreement(family: str, n: int, theirs: dict) -> float | None:
+    """Largest relative difference of jourdain's symbolic M and q - k from sympy's at sympy's
+    random state (inputs zero)."""
     if "M_val" not in theirs:
         return None
+    from jourdain.graph import evaluate_float
+
+    system = _make(family, n)
+    eom = system.equations_of_motion()
     yv, ydv = theirs["state"]
-    system = ours["eom"].system
-    inputs = {name: 0.0 for name in system.input_names} or None
-    out = system.evaluate(yv, ydv, inputs=inputs)
-    eM = np.abs(out["M"] - theirs["M_val"]).max() / np.abs(theirs["M_val"]).max()
-    eF = np.abs(out["q"] - out["k"] - theirs["F_val"]).max() / np.abs(theirs["F_val"]).max()
+    values = dict(system.parameter_values)
+    values.update({str(s): float(v) for s, v in zip(system.y, yv, strict=True)})
+    values.update({str(s): float(v) for s, v in zip(system.yd, ydv, strict=True)})
+    values.update({str(s): 0.0 for s in system.inputs})
+    values["t"] = 0.0
+    M = np.array(evaluate_float(eom.M.entries(), values)).reshape(system.f, system.f)
+    F = np.array(evaluate_float(eom.forcing.entries(), values))
+    eM = np.abs(M - theirs["M_val"]).max() / np.abs(theirs["M_val"]).max()
+    eF = np.abs(F - theirs["F_val"]).max() / np.abs(theirs["F_val"]).max()
     return float(max(eM, eF))
 
 
-def run(cases: dict[str, list[int]], timeout: float, repeat: int, check_upto: int) -> list[dict]:
+def _jourdain_fresh(family: str, n: int, repeat: int) -> dict:
+    from benchmarks.crosscheck import spawn
+
+    return spawn({"family": family, "n": n, "repeat": repeat}, "0",
+                 module="benchmarks.derivation")
+
+
+def run(cases: dict[str, list[int]], timeout: float, repeat: int, check_upto: int,
+        sympy_upto: dict[str, int] | None = None) -> list[dict]:
+    """Measure every case (jourdain and, up to ``sympy_upto[family]`` links, sympy), printing
+    one line each under :data:`HEADER`; the rows as dicts."""
+    print(HEADER)
     rows = []
     for family, ns in cases.items():
         for n in ns:
-            ours = _jourdain_case(family, n, repeat)
-            theirs = _sympy_case(family, n, timeout, check=n <= check_upto)
-            row = {"family": family, "n": n, "f": ours["eom"].system.f,
-                   "jourdain_s": ours["time"], "jourdain_ops_M": ours["ops_M"],
+            ours = _jourdain_fresh(family, n, repeat)
+            upto = (sympy_upto or {}).get(family)
+            theirs = (_sympy_case(family, n, timeout, check=n <= check_upto)
+                      if upto is None or n <= upto else None)
+            row = {"family": family, "n": n, "f": ours["f"],
+                   "jourdain_s": ours["time"], "jourdain_rss_mb": ours["rss_mb"],
+                   "jourdain_delta_mb": ours["delta_mb"], "jourdain_ops_M": ours["ops_M"],
                    "jourdain_ops_f": ours["ops_f"],
-                   "sympy_s": theirs["time"] if theirs else None,
-                   "sympy_ops_M": theirs["ops_M"] if theirs else None,
-                   "sympy_ops_f": theirs["ops_f"] if theirs else None,
-                   "max_rel_diff": _agreement(family, n, ours, theirs) if theirs else None}
+                   "sympy_tried": upto is None or n <= upto,
+                   **{f"sympy_{k}": (theirs or {}).get(k)
+                      for k in ("time", "rss_mb", "delta_mb", "ops_M", "ops_f")},
+                   "max_rel_diff": _agreement(family, n, theirs) if theirs else None}
+            row["sympy_s"] = row.pop("sympy_time")
             rows.append(row)
-            _print_row(row, timeout)
+            print(_row(row, timeout), flush=True)
     return rows
 
 
-def _print_row(r: dict, timeout: float) -> None:
-    sym = f"{r['sympy_s']:9.3f}" if r["sympy_s"] is not None else f" >{timeout:6.0f}s"
-    ratio = f"{r['sympy_s'] / r['jourdain_s']:8.0f}x" if r["sympy_s"] is not None else "        -"
-    so = (f"{r['sympy_ops_M']:>9} {r['sympy_ops_f']:>9}" if r["sympy_ops_M"] is not None
-          else f"{'-':>9} {'-':>9}")
+HEADER = (f"{'family':<9}{'n':>3}{'f':>5}{'jourdain s':>12}{'RSS MB':>8}{'Δ MB':>7}"
+          f"{'sympy s':>10}{'RSS MB':>8}{'Δ MB':>7}{'time ×':>9}{'RSS ×':>7}"
+          f"{'ops M(j)':>10}{'ops q-k(j)':>11}{'ops M(s)':>10}{'ops q-k(s)':>11}{'rel diff':>10}")
+
+
+def _row(r: dict, timeout: float) -> str:
+    if r["sympy_s"] is not None:
+        sym = (f"{r['sympy_s']:10.3f}{r['sympy_rss_mb']:8.0f}{r['sympy_delta_mb']:7.0f}"
+               f"{r['sympy_s'] / r['jourdain_s']:8.0f}×{r['sympy_rss_mb'] / r['jourdain_rss_mb']:6.1f}×")
+        ops = f"{r['sympy_ops_M']:>10}{r['sympy_ops_f']:>11}"
+    else:
+        what = f">{timeout:.0f}s" if r["sympy_tried"] else "-"
+        sym = f"{what:>10}{'-':>8}{'-':>7}{'-':>9}{'-':>7}"
+        ops = f"{'-':>10}{'-':>11}"
     diff = f"{r['max_rel_diff']:.1e}" if r["max_rel_diff"] is not None else "-"
-    print(f"{r['family']:9} {r['n']:3d} {r['f']:3d} {r['jourdain_s']:10.4f} {sym} {ratio} "
-          f"{r['jourdain_ops_M']:>9} {r['jourdain_ops_f']:>9} {so} {diff:>8}", flush=True)
+    return (f"{r['family']:<9}{r['n']:>3}{r['f']:>5}{r['jourdain_s']:12.4f}"
+            f"{r['jourdain_rss_mb']:8.0f}{r['jourdain_delta_mb']:7.0f}{sym}"
+            f"{r['jourdain_ops_M']:>10}{r['jourdain_ops_f']:>11}{ops}{diff:>10}")
 
 
-def _growth(rows: list[dict], family: str) -> float | None:
-    pts = [(r["n"], r["jourdain_s"]) for r in rows if r["family"] == family and r["n"] >= 4]
-    if len(pts) < 2:
-        return None
-    x, y = np.log([p[0] for p in pts]), np.log([p[1] for p in pts])
-    return float(np.polyfit(x, y, 1)[0])
+def growth(rows: list[dict], family: str = "chain", f_min: int = 7) -> dict[str, dict]:
+    """Log-log slopes (x ∝ f^a) of jourdain's time and Δ memory between the row of the
+    smallest f ≥ ``f_min`` and the largest (``"all"``), and from the row nearest half the
+    largest f (``"top"``); empty with fewer than two rows."""
+    rs = sorted((r for r in rows if r["family"] == family and r["f"] >= f_min),
+                key=lambda r: r["f"])
+    if len(rs) < 2:
+        return {}
+    hi = rs[-1]
+    spans = {"all": rs[0]}
+    if len(rs) >= 3:
+        spans["top"] = min(rs[:-1], key=lambda r: abs(r["f"] - hi["f"] / 2))
+    out = {}
+    for label, lo in spans.items():
+        span = math.log(hi["f"] / lo["f"])
+        out[label] = {"f_min": lo["f"], "f_max": hi["f"],
+                      **{k: math.log(max(hi[k], 1e-9) / max(lo[k], 1e-9)) / span
+                         for k in ("jourdain_s", "jourdain_delta_mb")}}
+    return out
+
+
+def summary(rows: list[dict]) -> list[str]:
+    """The growth exponents and the targets, as lines of text."""
+    lines = []
+    g = growth(rows)
+    for s in g.values():
+        lines.append(f"jourdain on spatial chains, f = {s['f_min']}…{s['f_max']}: time grows "
+                     f"like f^{s['jourdain_s']:.2f}, memory (Δ) like "
+                     f"f^{s['jourdain_delta_mb']:.2f}")
+    top = [r for r in rows if r["family"] == "chain" and r["f"] == TARGET_F]
+    if top:
+        r = top[0]
+        # the steeper of time and memory, over the whole range and its top half
+        a = max((s[k] for s in g.values() for k in ("jourdain_s", "jourdain_delta_mb")),
+                default=float("nan"))
+        met = ["met" if ok else "NOT met" for ok in (
+            r["jourdain_s"] <= TARGET_S, r["jourdain_rss_mb"] <= TARGET_MB,
+            round(a, 2) <= GROWTH_TARGET)]
+        lines.append(f"targets at f = {TARGET_F}: {r['jourdain_s']:.2f} s (≤ {TARGET_S} s: "
+                     f"{met[0]}), peak RSS {r['jourdain_rss_mb']:.0f} MB (≤ {TARGET_MB:.0f} MB: "
+                     f"{met[1]}), growth f^{a:.2f} (≤ f^{GROWTH_TARGET:.0f}: {met[2]})")
+    for r in rows:
+        if r["sympy_s"] is not None:
+            lines.append(f"{r['family']} n = {r['n']} (f = {r['f']}): sympy takes "
+                         f"{r['sympy_s'] / r['jourdain_s']:.0f}× jourdain's time and "
+                         f"{r['sympy_rss_mb'] / r['jourdain_rss_mb']:.1f}× its peak RSS")
+    return lines
 
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--quick", action="store_true", help="n = 1, 2 only (a smoke test)")
-    ap.add_argument("--timeout", type=float, default=600.0, help="time limit per sympy case [s]")
+    ap.add_argument("child", nargs="?", help=argparse.SUPPRESS)
+    ap.add_argument("--quick", action="store_true",
+                    help="n = 1, 2 and chains of f = 3, 7 (a smoke test)")
+    ap.add_argument("--timeout", type=float, default=300.0, help="time limit per sympy case [s]")
     ap.add_argument("--repeat", type=int, default=3, help="jourdain runs per case (best taken)")
+    ap.add_argument("--sympy-upto", type=int, default=6,
+                    help="largest chain given to sympy (default 6: n = 8 takes it hours)")
+    ap.add_argument("--check-upto", type=int, default=4,
+                    help="largest n whose results are compared numerically (4)")
     ap.add_argument("--json", type=Path, help="also write the rows to this JSON file")
     args = ap.parse_args(argv)
-    if args.quick:
-        cases = {"pendulum": [1, 2], "chain": [2]}
-    else:
-        cases = {"pendulum": [1, 2, 4, 8, 16, 32], "chain": [2, 4, 8, 16]}
-    print("family      n   f  jourdain[s]  sympy[s]    ratio   ops M(j)  ops q-k(j)  "
-          "ops M(s)  ops q-k(s)  max rel diff")
-    rows = run(cases, args.timeout, args.repeat, check_upto=4)
-    for fam in cases:
-        g = _growth(rows, fam)
-        if g is not None:
-            print(f"jourdain derivation time grows like n^{g:.2f} on {fam} (n >= 4)")
+    if args.child is not None:
+        s = json.loads(args.child)
+        print(json.dumps(jourdain_case(s["family"], int(s["n"]), int(s.get("repeat", 3)))))
+        return 0
+    cases = QUICK if args.quick else CASES
+    upto = {"chain": 2 if args.quick else args.sympy_upto}
+    rows = run(cases, args.timeout, args.repeat, args.check_upto, upto)
+    print()
+    print("\n".join(summary(rows)))
     if args.json:
         args.json.write_text(json.dumps(rows, indent=2))
     return 0
