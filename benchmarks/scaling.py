@@ -20,6 +20,9 @@ memory history; :func:`benchmarks.crosscheck.spawn`) and measures, in this order
   (interleaved; the output array preallocated and touched once);
 * ``derive s``: the symbolic ``system.equations_of_motion()`` (not needed for the numbers
   above, which come from the compiled recursion; measured last so that it cannot warm them);
+* ``derive MB``: the resident memory the derivation added and holds (current RSS after it
+  minus before it: the equations M, k, q and their stages; the peak of a process that derives
+  only, and sympy's, are in ``benchmarks/derivation.py``);
 * ``RSS MB``: the child's peak resident memory over everything, derivation included;
 * ``wall s``: the child's wall time, interpreter start-up and imports included.
 
@@ -60,6 +63,18 @@ def _rss_mb() -> float:
     import resource
 
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0  # Linux: kB
+
+
+def _current_rss_mb() -> float:
+    """The resident memory now (not the peak), from /proc/self/statm; 0 where there is none."""
+    import os
+
+    try:
+        with open("/proc/self/statm") as fh:
+            pages = int(fh.read().split()[1])
+    except (OSError, IndexError, ValueError):
+        return 0.0
+    return pages * os.sysconf("SC_PAGE_SIZE") / 2**20
 
 
 def _source_bytes() -> int:
@@ -111,21 +126,25 @@ def case(kind: str, n: int, seed: int = 0, n_states: int = 1000, repeat: int = 3
     best = interleaved({"batch": lambda: fn.batch(Y, YD, 0.0, p, None, out=buf),
                         "dynamics": lambda: fd.dynamics(Y, YD, 0.0, p, None)}, repeat)
     del res
+    rss_before = _current_rss_mb()
     t0 = time.perf_counter()
-    system.equations_of_motion()
+    eom = system.equations_of_motion()
     t_derive = time.perf_counter() - t0
+    derive_mb = _current_rss_mb() - rss_before
+    del eom
     return {"kind": kind, "n": n, "seed": seed, "f": f, "bodies": len(system.bodies),
             "import_s": t_import, "build_s": t_build, "first_s": t_first,
             "source_bytes": src_first, "rss_first_mb": rss_first, "mkq_s": t_mkq,
             "source_all_bytes": src_all, "mkq_path": "rec" if fn.n_bodies else "sym",
             "batch_us": 1e6 * best["batch"] / n_states,
             "dynamics_us": 1e6 * best["dynamics"] / n_states, "states": n_states,
-            "M_vs_evaluate": m_diff, "derive_s": t_derive, "rss_mb": _rss_mb()}
+            "M_vs_evaluate": m_diff, "derive_s": t_derive, "derive_mb": derive_mb,
+            "rss_mb": _rss_mb()}
 
 
 #: measured quantities of which :func:`combine` keeps the smallest over the trials
 TIMES = ("import_s", "build_s", "first_s", "mkq_s", "batch_us", "dynamics_us", "derive_s",
-         "wall_s", "rss_first_mb", "rss_mb")
+         "derive_mb", "wall_s", "rss_first_mb", "rss_mb")
 
 
 def combine(runs: list[dict]) -> dict:
@@ -156,7 +175,8 @@ def matching_tree(f: int, seed: int = 0, limit: int = 200) -> int:
     return best
 
 
-HEADER = (f"| {'model':<22} | {'f':>3} | {'bodies':>6} | {'derive s':>8} | {'first s':>7} "
+HEADER = (f"| {'model':<22} | {'f':>3} | {'bodies':>6} | {'derive s':>8} | {'derive MB':>9} "
+          f"| {'first s':>7} "
           f"| {'source kB':>9} | {'mkq s':>5} | {'path':>4} | {'all kB':>6} | {'M,k,q µs':>8} "
           f"| {'ÿ+W µs':>7} | {'RSS1 MB':>7} | {'RSS MB':>6} | {'wall s':>6} |")
 
@@ -166,6 +186,7 @@ def row(r: dict) -> str:
     name = (f"spatial_chain({r['n']})" if r["kind"] == "chain"
             else f"random_tree({r['n']}, {r['seed']})")
     return (f"| {name:<22} | {r['f']:>3} | {r['bodies']:>6} | {r['derive_s']:>8.2f} "
+            f"| {r['derive_mb']:>9.1f} "
             f"| {r['first_s']:>7.2f} | {r['source_bytes'] / 1e3:>9.1f} | {r['mkq_s']:>5.2f} "
             f"| {r['mkq_path']:>4} | {r['source_all_bytes'] / 1e3:>6.1f} | {r['batch_us']:>8.2f} "
             f"| {r['dynamics_us']:>7.2f} | {r['rss_first_mb']:>7.0f} | {r['rss_mb']:>6.0f} "
@@ -173,7 +194,8 @@ def row(r: dict) -> str:
 
 
 GROWTH = {"first_s": "time to first number", "source_bytes": "generated source",
-          "derive_s": "symbolic derivation", "batch_us": "M, k, q per state",
+          "derive_s": "symbolic derivation", "derive_mb": "memory of the derivation",
+          "batch_us": "M, k, q per state",
           "dynamics_us": "ÿ + wrenches per state", "rss_first_mb": "peak RSS at first number"}
 
 
@@ -194,8 +216,30 @@ def growth(rows: list[dict]) -> dict[str, dict[str, float]]:
         for label, lo in spans.items():
             span = math.log(hi["f"] / lo["f"])
             out[label] = {"f_min": lo["f"], "f_max": hi["f"],
-                          **{k: math.log(hi[k] / lo[k]) / span for k in GROWTH}}
+                          **{k: math.log(max(hi[k], 1e-2) / max(lo[k], 1e-2)) / span
+                             for k in GROWTH}}
     return out
+
+
+#: issue 35, item 4: the symbolic derivation of spatial_chain(64), f = 127, in at most this many
+#: seconds, growing at most like f² (its peak memory and sympy's: benchmarks/derivation.py)
+DERIVE_F, DERIVE_S = 127, 1.5
+
+
+def derivation_targets(rows: list[dict], slopes: dict[str, dict[str, float]]) -> list[str]:
+    """Lines on issue 35's item 4 for the chain of f = DERIVE_F, where it was measured."""
+    top = [r for r in rows if r["kind"] == "chain" and r["f"] == DERIVE_F]
+    if not top:
+        return []
+    r = top[0]
+    a = max((v[k] for key, v in slopes.items() if key.startswith("chain")
+             for k in ("derive_s", "derive_mb")), default=float("nan"))
+    ok = ["met" if c else "NOT met" for c in (r["derive_s"] <= DERIVE_S, round(a, 2) <= 2)]
+    return [f"symbolic M, k, q of spatial_chain({r['n']}), f = {DERIVE_F}: {r['derive_s']:.2f} s "
+            f"(target ≤ {DERIVE_S} s: {ok[0]}), {r['derive_mb']:.0f} MB held; growth of its "
+            f"time and memory at most f^{a:.2f} (target ≤ f²: {ok[1]}); peak RSS of a "
+            "derivation alone and sympy's KanesMethod on the same chains: "
+            "benchmarks/derivation.py"]
 
 
 def _rule(header: str) -> str:
@@ -282,6 +326,8 @@ def main(argv: list[str] | None = None) -> list[dict]:
             print(f"| {label:<26} | "
                   + " | ".join(f"{slopes[k][key]:>{len(c)}.2f}" for k, c in cols.items())
                   + " |")
+        print()
+        print("\n".join(derivation_targets(rows, slopes)))
     if a.json:
         a.json.write_text(json.dumps({"rows": rows, "growth": slopes}, indent=2))
     return rows

@@ -52,3 +52,13 @@ def test_matching_tree():
     n = scaling.matching_tree(48)
     f = sum(TREE_JOINTS[d["joint"]] for d in random_tree_data(n, 0))
     assert abs(f - 48) <= 2
+
+
+def test_derivation_targets():
+    rows = [{"kind": "chain", "n": n, "f": f, **{k: 1e-4 * f**2 for k in scaling.GROWTH}}
+            for n, f in ((4, 7), (32, 63), (64, 127))]
+    (line,) = scaling.derivation_targets(rows, scaling.growth(rows))
+    assert line.startswith("symbolic M, k, q of spatial_chain(64), f = 127: 1.61 s (target ≤ "
+                           "1.5 s: NOT met), 2 MB held; growth of its time and memory at most "
+                           "f^2.00 (target ≤ f²: met)"), line
+    assert scaling.derivation_targets(rows[:2], scaling.growth(rows[:2])) == []
