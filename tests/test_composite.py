@@ -127,8 +127,9 @@ def test_composite_bodies_of_the_example_files(name):
 
 
 def test_small_systems_keep_the_textbook_sums():
-    """Below SHARED_FROM_F coordinates the projection sums body by body: the double
-    pendulum's M reads (m1 + m2)… as before; from there on, the composite bodies."""
+    """Below SHARED_FROM_F coordinates the projection sums body by body (the double
+    pendulum's M as a textbook writes it: tests/test_display_output.py); from there on, the
+    composite bodies."""
     assert composite_projection(models.double_pendulum().newton_euler()) is None
     chain = models.spatial_chain(13)
     assert chain.f >= SHARED_FROM_F

@@ -4,26 +4,26 @@ shared=True)``, the default from :data:`~jourdain.stages.kinematics.result.SHARE
 coordinates on).
 
 The sums over bodies of ``M = J̄ᵀM̄J̄``, ``k = J̄ᵀq̄^c``, ``q = J̄ᵀq̄^e`` are regrouped, exactly,
-at the step of the recursion where each coordinate enters (its *anchor*, ``Node.anchors``):
-below it, every body's Jacobian columns of coordinate j are the rigid transport of one twist
-s_j = (ω_j, v_j) of the anchor's frame (angular velocity, velocity of its origin; the
-recursion's own ``JR``, ``JT`` there), so that
+at the steps of the recursion where each coordinate enters (its angle or vector depends on y_j:
+``Node.anchors``). Below such a step b, the columns of y_j in every body are rigid transports
+of the twist δ_j^b the step adds (an axis times ∂angle/∂y_j, or ∂vector/∂y_j), and the whole
+twist s_j^b of y_j at b (the recursion's ``JR``, ``JT`` there) is the sum of the δ_j of its
+steps at or above b. With the composite body of everything below b (mass m, first moment h,
+inertia about b's origin, in b's frame: I^c_b) and the resultant wrenches w^c_b of the bodies'
+inertia forces m·ā and I·ᾱ + ω × I·ω and w^e_b of the applied forces, about b's origin:
 
-    M_jk = s_jᵀ · I^c_a · s_k      (a = anchor of k, at or below the anchor of j)
-    k_j  = s_jᵀ · w^c_a,   q_j = s_jᵀ · w^e_a      (a = anchor of j)
+    k_j = Σ_b δ_j^b·w^c_b,     q_j = Σ_b δ_j^b·w^e_b      (b: the steps of y_j)
+    M_jk = T_jk + T_kj − D_jk,  T_jk = Σ_b s_j^b·I^c_b·δ_k^b (b: the steps of y_k),
+                                D_jk = Σ_b δ_j^b·I^c_b·δ_k^b (b: the steps of both)
 
-with the composite body of everything below a (mass m, first moment h, inertia about a's
-origin, in a's frame) and the resultant wrenches of the bodies' inertia forces m·ā and
-I·ᾱ + ω × I·ω (w^c) and of the applied forces (w^e) about a's origin. The composite bodies
-and the wrenches are summed from the leaves up, one step at a time, each a short expression of
-the ones below; each entry of M is then a dot product of six components, and nothing is
-expanded: time and memory grow like f² (the f(f+1)/2 entries), where the sums body by body of
-:func:`jourdain.stages.projection.projection` grow like f³. The same numbers, in a different
-arrangement (and a less readable one for small systems, which keep the body-by-body sums).
-
-Requires every coordinate to enter at one step only (one anchor): otherwise (a coordinate in
-the steps of two joints) :func:`composite_projection` returns None and the projection forms
-the sums body by body.
+(each pair of steps (a of y_j, b of y_k) on one path is counted once, at the lower one). Where
+each coordinate enters at one step, as in a chain of joints with relative coordinates, this is
+``M_jk = s_j·I^c_b·s_k`` at the step b of the lower of the two. The composite bodies and the
+wrenches are summed from the leaves up, one step at a time, each a short expression of the ones
+below; each entry of M is then a few dot products of six components, and nothing is expanded:
+time and memory grow like f² (the f(f+1)/2 entries), where the sums body by body of
+:func:`jourdain.stages.projection.projection` grow like f³. The same numbers in a different
+arrangement, and a less readable one for small systems, which keep the body-by-body sums.
 """
 
 from __future__ import annotations
