@@ -3,6 +3,9 @@ M, k, q as the body-by-body sums, on every kind of model, and expressions that g
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -154,3 +157,36 @@ def test_mass_matrix_is_exactly_symmetric_and_shares_its_entries():
     f = M.shape[0]
     assert all(M[i, j] is M[j, i] or M[i, j] == M[j, i] for i in range(f) for j in range(f))
     assert all(isinstance(e, se.Basic) for e in M.entries())
+
+
+CHILD = r"""
+import hashlib, sys
+from jourdain import models
+from jourdain.numeric.ccode import argument_names, function_source
+from jourdain.stages.kinematics import kinematics
+from jourdain.stages.newton_euler import newton_euler
+from jourdain.stages.projection import projection
+junk = [object() for _ in range(int(sys.argv[1]))]  # a different memory history per process
+out = []
+for system in (models.random_tree(9, seed=4), models.n_link_pendulum_on_cart(4)):
+    eom = projection(newton_euler(kinematics(system, shared=True)))
+    exprs = [*eom.M.entries(), *eom.k.entries(), *eom.q.entries()]
+    names = argument_names(system.y, system.yd, system.t, system.parameter_symbols,
+                           system.inputs)
+    out.append(hashlib.sha256(function_source("jd_fn", exprs, names).encode()).hexdigest())
+print(" ".join(out))
+"""
+
+
+def test_composite_bodies_are_the_same_in_every_process():
+    """The composite-body equations, as the C source of their graph, are the same whatever
+    PYTHONHASHSEED and the memory layout (nothing keyed or ordered by id or hash)."""
+    root = Path(__file__).resolve().parent.parent
+    seen = set()
+    for k, seed in enumerate(("0", "12345")):
+        env = {**os.environ, "PYTHONHASHSEED": seed}
+        proc = subprocess.run([sys.executable, "-c", CHILD, str(1000 * (k + 1) ** 3)], env=env,
+                              cwd=root, capture_output=True, text=True, timeout=600)
+        assert proc.returncode == 0, proc.stderr[-3000:]
+        seen.add(proc.stdout.strip().splitlines()[-1])
+    assert len(seen) == 1, seen
