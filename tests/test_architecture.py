@@ -53,8 +53,9 @@ FLOORS: tuple[tuple[str, ...], ...] = (
     # 2 the stages of the method: kinematics → Newton–Euler → projection → reactions →
     #   linearization, and what they share (kinematic measures)
     ("jourdain.measures", "jourdain.stages"),
-    # 3 numbers: generated and compiled code, evaluation
-    ("jourdain.numeric",),
+    # 3 numbers: generated and compiled code, evaluation; the elastic bodies' finite elements
+    #   and modal data (NumPy/SciPy only)
+    ("jourdain.numeric", "jourdain.elastic"),
     # 4 simulation and analysis of the equations, and the numbers of closed systems (the
     #   constraint stage's partition, assembly, M, k, q, reactions and motion on the manifold)
     ("jourdain.simulation", "jourdain.analysis", "jourdain.equilibrium", "jourdain.wrenches",

@@ -1,0 +1,20 @@
+"""Elastic bodies' modal data (issue 36, item 2): beam finite elements, import of any FE
+model's M and K, boundary conditions and reduction (modal truncation, Craig–Bampton, free modes
+with static correction), the floating-frame invariants (m, m·c, J, C_t, C_r, M_e, K_e) and a
+documented subset of the SID file format. Numbers only (NumPy, SciPy); the multibody
+integration builds on :class:`ModalData`. Guide: docs/elastic.md.
+"""
+
+from jourdain.elastic.beam import DOF_NAMES, Beam, FEModel, assemble, element_matrices
+from jourdain.elastic.modal import ModalData, modal_data
+from jourdain.elastic.reduction import (
+    constrain,
+    craig_bampton,
+    free_modes,
+    modal_truncation,
+    normal_modes,
+)
+
+__all__ = ["DOF_NAMES", "Beam", "FEModel", "assemble", "element_matrices", "ModalData",
+           "modal_data", "constrain", "craig_bampton", "free_modes", "modal_truncation",
+           "normal_modes"]

@@ -1,0 +1,206 @@
+"""Boundary conditions and model reduction of finite-element models to :class:`ModalData`.
+
+All three methods work on the DOFs left free by ``fixed`` (nodes, all their DOFs, or
+``(node, name)`` pairs), and expand the basis with zeros at the fixed DOFs, so that the
+invariants (:mod:`jourdain.elastic.modal`) count the whole body's mass:
+
+- :func:`modal_truncation`: the ``n_modes`` lowest normal modes, mass-normalized
+  (Φᵀ·M·Φ = E, Φᵀ·K·Φ = diag ω²).
+- :func:`craig_bampton` (Craig & Bampton 1968): at the interface DOFs ``b`` the constraint modes
+  Ψ = −K_ii⁻¹·K_ib (the static shapes of unit interface displacements, so any static load at the
+  interface is reproduced exactly) and ``n_modes`` fixed-interface normal modes of (K_ii, M_ii);
+  coordinates (u_b, η), basis [[E, 0], [Ψ, Φ_i]].
+- :func:`free_modes`: ``n_modes`` elastic free-free modes and, for each DOF in ``correction``,
+  a static correction mode (residual attachment mode with inertia relief, Craig & Chang 1977;
+  Géradin & Rixen, *Mechanical Vibrations*, §6.4): the elastic flexibility's response to a unit
+  load there, its rigid-body part removed by the projector P = E − M·Γ·Γᵀ (Γ the M-orthonormal
+  rigid-body modes) and the kept modes' part Σ φ·φᵀ/ω² subtracted; the augmented basis is
+  made M- and K-orthogonal. For a body whose rigid modes are not all free (``fixed`` given, or
+  a K that is regular), the plain flexibility K⁻¹ is used.
+
+Dense matrices are solved with LAPACK (``scipy.linalg.eigh``); ``scipy.sparse`` ones with a
+sparse LU and shift-invert Lanczos (``scipy.sparse.linalg.eigsh``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+from typing import Any
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from jourdain.elastic.beam import FEModel
+from jourdain.elastic.modal import ModalData, modal_data, rigid_fields
+from jourdain.errors import ModelError
+
+__all__ = ["dof_indices", "constrain", "normal_modes", "modal_truncation", "craig_bampton",
+           "free_modes"]
+
+DofSpec = int | tuple[int, str]
+
+
+def dof_indices(fe: FEModel, spec: Iterable[DofSpec]) -> list[int]:
+    """Positions in ``fe``'s matrices of the DOFs named by ``spec``: a node index (all its DOFs)
+    or a ``(node, name)`` pair; sorted, without repeats."""
+    out: set[int] = set()
+    for s in spec:
+        if isinstance(s, tuple):
+            out.add(fe.index(int(s[0]), str(s[1])))
+        else:
+            idx = [i for i, d in enumerate(fe.dofs) if d[0] == int(s)]
+            if not idx:
+                raise ModelError(f"{fe.name}: node {s} has no DOFs")
+            out.update(idx)
+    return sorted(out)
+
+
+def _sub(a: Any, rows: Sequence[int], cols: Sequence[int]) -> Any:
+    if a is None:
+        return None
+    if sp.issparse(a):
+        return sp.csr_matrix(a)[rows][:, cols]
+    return np.asarray(a)[np.ix_(rows, cols)]
+
+
+def constrain(fe: FEModel, fixed: Iterable[DofSpec]) -> FEModel:
+    """``fe`` with the DOFs ``fixed`` removed (held at zero)."""
+    drop = set(dof_indices(fe, fixed))
+    keep = [i for i in range(fe.n) if i not in drop]
+    return FEModel(nodes=fe.nodes, dofs=tuple(fe.dofs[i] for i in keep),
+                   M=_sub(fe.M, keep, keep), K=_sub(fe.K, keep, keep),
+                   G=_sub(fe.G, keep, keep), D=_sub(fe.D, keep, keep), name=fe.name,
+                   meta=dict(fe.meta))
+
+
+def _shift(K: object, M: object) -> float:
+    """A small negative shift for shift-invert that keeps K − σM regular with rigid modes."""
+    dk = np.abs(K.diagonal()).mean()  # type: ignore[attr-defined]
+    dm = np.abs(M.diagonal()).mean()  # type: ignore[attr-defined]
+    return -1e-6 * float(dk / dm) if dm > 0 else -1.0
+
+
+def normal_modes(K: object, M: object, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """The ``n`` lowest eigenpairs of K·φ = λ·M·φ: λ ascending and Φ with Φᵀ·M·Φ = E."""
+    size = K.shape[0]  # type: ignore[attr-defined]
+    if not 0 < n <= size:
+        raise ModelError(f"asked for {n} modes of a model with {size} DOFs")
+    if sp.issparse(K) or sp.issparse(M):
+        Ks, Ms = sp.csc_matrix(K), sp.csc_matrix(M)
+        if n < size - 1:
+            lam, Phi = spla.eigsh(Ks, k=n, M=Ms, sigma=_shift(Ks, Ms), which="LM")
+        else:
+            lam, Phi = sla.eigh(Ks.toarray(), Ms.toarray())
+    else:
+        lam, Phi = sla.eigh(np.asarray(K), np.asarray(M), subset_by_index=[0, n - 1])
+    order = np.argsort(lam)
+    lam, Phi = lam[order], Phi[:, order]
+    # M-normalize (eigsh's vectors are, up to rounding; make it exact)
+    norms = np.sqrt(np.einsum("ij,ij->j", Phi, np.asarray(M @ Phi)))
+    return lam, Phi / norms
+
+
+def _expand(fe: FEModel, keep: Sequence[int], basis: np.ndarray) -> np.ndarray:
+    out = np.zeros((fe.n, basis.shape[1]))
+    out[list(keep)] = basis
+    return out
+
+
+def _free_part(fe: FEModel, fixed: Iterable[DofSpec]) -> tuple[FEModel, list[int]]:
+    drop = set(dof_indices(fe, fixed))
+    keep = [i for i in range(fe.n) if i not in drop]
+    return constrain(fe, [fe.dofs[i] for i in sorted(drop)]), keep
+
+
+def modal_truncation(fe: FEModel, n_modes: int, fixed: Iterable[DofSpec] = ()) -> ModalData:
+    """The ``n_modes`` lowest normal modes of ``fe`` with ``fixed`` held (free-free with no
+    ``fixed``: the rigid-body modes come first, at ω ≈ 0)."""
+    sub, keep = _free_part(fe, fixed)
+    _, Phi = normal_modes(sub.K, sub.M, n_modes)
+    return modal_data(fe, _expand(fe, keep, Phi), "modal truncation", ("normal",) * n_modes)
+
+
+def _solve(A: object, B: np.ndarray) -> np.ndarray:
+    if sp.issparse(A):
+        return np.asarray(spla.splu(sp.csc_matrix(A)).solve(np.asarray(B, dtype=float)))
+    return np.asarray(sla.solve(np.asarray(A), B, assume_a="sym"))
+
+
+def craig_bampton(fe: FEModel, interface: Iterable[DofSpec], n_modes: int,
+                  fixed: Iterable[DofSpec] = ()) -> ModalData:
+    """Craig–Bampton reduction: constraint modes at the ``interface`` DOFs and ``n_modes``
+    fixed-interface normal modes (module docstring); ``fixed`` DOFs held at zero."""
+    sub, keep = _free_part(fe, fixed)
+    b = dof_indices(sub, interface)
+    if not b:
+        raise ModelError(f"{fe.name}: Craig–Bampton needs at least one interface DOF")
+    i = [k for k in range(sub.n) if k not in set(b)]
+    if n_modes > len(i):
+        raise ModelError(f"{fe.name}: {n_modes} fixed-interface modes asked, {len(i)} inner DOFs")
+    K_ii, K_ib = _sub(sub.K, i, i), _sub(sub.K, i, b)
+    K_ib = K_ib.toarray() if sp.issparse(K_ib) else np.asarray(K_ib)
+    Psi = -_solve(K_ii, np.asarray(K_ib))
+    basis = np.zeros((sub.n, len(b) + n_modes))
+    basis[b, : len(b)] = np.eye(len(b))
+    basis[i, : len(b)] = Psi
+    if n_modes:
+        _, Phi_i = normal_modes(K_ii, _sub(sub.M, i, i), n_modes)
+        basis[i, len(b):] = Phi_i
+    kinds = ("constraint",) * len(b) + ("normal",) * n_modes
+    return modal_data(fe, _expand(fe, keep, basis), "Craig-Bampton", kinds)
+
+
+def _rigid_modes(fe: FEModel) -> np.ndarray:
+    """M-orthonormal rigid-body modes of ``fe`` from its geometry (the six fields of
+    :func:`rigid_fields`), those with K·Γ ≠ 0 (held by supports) left out."""
+    Gt, Gr = rigid_fields(fe)
+    Gam = np.column_stack([Gt, Gr])
+    KG = np.asarray(fe.K @ Gam)
+    scale = np.abs(fe.K.diagonal()).max() * np.abs(Gam).max(axis=0)
+    free = np.abs(KG).max(axis=0) <= 1e-8 * np.maximum(scale, 1e-300)
+    Gam = Gam[:, free]
+    if Gam.shape[1] == 0:
+        return Gam
+    # M-orthonormalize (rank-revealing: a model with no rotation DOFs at a line of nodes ...)
+    Mg = Gam.T @ np.asarray(fe.M @ Gam)
+    w, V = np.linalg.eigh(0.5 * (Mg + Mg.T))
+    ok = w > 1e-12 * w.max()
+    return Gam @ (V[:, ok] / np.sqrt(w[ok]))
+
+
+def free_modes(fe: FEModel, n_modes: int, correction: Iterable[DofSpec] = (),
+               fixed: Iterable[DofSpec] = ()) -> ModalData:
+    """``n_modes`` elastic normal modes (the rigid-body modes skipped) and one static
+    correction mode per DOF in ``correction`` (module docstring)."""
+    sub, keep = _free_part(fe, fixed)
+    Gam = _rigid_modes(sub)
+    n_rigid = Gam.shape[1]
+    lam, Phi = normal_modes(sub.K, sub.M, n_modes + n_rigid)
+    lam, Phi = lam[n_rigid:], Phi[:, n_rigid:]
+    cols = dof_indices(sub, correction)
+    kinds = ["normal"] * n_modes
+    basis = Phi
+    if cols:
+        F = np.zeros((sub.n, len(cols)))
+        F[cols, range(len(cols))] = 1.0
+        if n_rigid:
+            MG = np.asarray(sub.M @ Gam)
+            F = F - MG @ (Gam.T @ F)  # inertia relief: Pᵀ·f has no rigid-body part
+            Ks = sub.K + (sp.csr_matrix(MG) @ sp.csr_matrix(MG.T) if sp.issparse(sub.K)
+                          else MG @ MG.T)
+            X = _solve(Ks, F)
+            X = X - Gam @ (Gam.T @ np.asarray(sub.M @ X))
+        else:
+            X = _solve(sub.K, F)
+        X = X - Phi @ ((Phi.T @ F) / lam[:, None])  # the kept modes' share removed
+        basis = np.column_stack([Phi, X])
+        # K- and M-orthogonal basis: the reduced eigenvectors (Ritz vectors)
+        Mr = basis.T @ np.asarray(sub.M @ basis)
+        Kr = basis.T @ np.asarray(sub.K @ basis)
+        _, V = sla.eigh(0.5 * (Kr + Kr.T), 0.5 * (Mr + Mr.T))
+        basis = basis @ V
+        kinds = ["ritz"] * basis.shape[1]  # modes and corrections mixed by the Ritz step
+    return modal_data(fe, _expand(fe, keep, basis), "free modes + static correction"
+                      if cols else "free modes", tuple(kinds))
