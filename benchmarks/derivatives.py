@@ -42,17 +42,24 @@ Pinocchio's mapped to jourdain's coordinates (tests/reference/pinocchio_derivati
 reference test tests/reference/test_derivatives_pinocchio.py holds the tolerances): the largest
 difference relative to the largest entry of Pinocchio's, per quantity.
 
-Measured on the 2-core development machine (µs per state, 1000 states, best of 7; jourdain's
-derivatives as of commit 6cac064, Pinocchio 4.1.0 net of its per-call floor of 1.2-1.4 µs):
+Measured on the 2-core development machine (µs per state, 1000 states, best of 7; load
+average about 3 from other work; Pinocchio 4.1.0 net of its per-call floor of 1.2-1.3 µs).
+jourdain's derivatives as of commit 17fdac9 (the recursions of screw joints,
+``numeric/derivative_screw.h``, and the forward derivatives' solves with M = LᵀL in the tree's
+sparsity, compiled at -O3):
 
     robot    f   forward: C batch / py 1 call / pin net   inverse: C batch / py 1 call / pin net
-    panda    7            20.8 / 56.4 / 4.9                        20.2 / 60.4 / 3.6
-    solo12  18            60.8 / 98.8 / 12.2                       53.9 / 96.5 / 7.9
-    talos   38           224.3 / 284.8 / 42.7                     169.7 / 229.2 / 21.1
+    panda    7             2.19 / 7.34 / 4.78                       1.35 / 7.34 / 3.68
+    solo12  18             7.40 / 16.4 / 18.3                       4.55 / 13.9 / 12.4
+    talos   38             30.3 / 36.1 / 43.4                       12.3 / 17.5 / 21.7
 
-so jourdain took 4.3-8.0 times Pinocchio's C++ time there; batched throughput forward 47 700,
-16 600 and 4 400 states/s, inverse 49 200, 18 700 and 5 700 states/s; one state per Python call
-adds 35-60 µs over the C batch.
+so jourdain's C takes 0.37-0.70 times Pinocchio's C++ time (forward 0.46, 0.41, 0.70; inverse
+0.37, 0.37, 0.56); one state per Python call adds 5-6 µs (Pinocchio's floor: 1.2 µs), so the
+Panda's single calls take 1.5-2.0 times Pinocchio's from Python. Batched throughput forward
+426 000, 85 000 and 33 000 states/s, inverse 653 000, 222 000 and 57 000 states/s.
+(Before the recursions of screw joints, at commit 6cac064, the forward mode of every
+intermediate quantity took 4.3-8.0 times Pinocchio's time; it still serves the models whose
+joints are not screws: absolute angles, general joints, springs between bodies.)
 
     .venv/bin/python benchmarks/derivatives.py                        # panda, solo12, talos
     .venv/bin/python benchmarks/derivatives.py --robot solo12 --states 2000
