@@ -6,6 +6,7 @@ integration builds on :class:`ModalData`. Guide: docs/elastic.md.
 """
 
 from jourdain.elastic.beam import DOF_NAMES, Beam, FEModel, assemble, element_matrices
+from jourdain.elastic.femodel import fe_model
 from jourdain.elastic.modal import ModalData, modal_data
 from jourdain.elastic.reduction import (
     constrain,
@@ -14,7 +15,8 @@ from jourdain.elastic.reduction import (
     modal_truncation,
     normal_modes,
 )
+from jourdain.elastic.sid import read_sid, sid_data, sid_text, write_sid
 
 __all__ = ["DOF_NAMES", "Beam", "FEModel", "assemble", "element_matrices", "ModalData",
            "modal_data", "constrain", "craig_bampton", "free_modes", "modal_truncation",
-           "normal_modes"]
+           "normal_modes", "fe_model", "read_sid", "write_sid", "sid_text", "sid_data"]
