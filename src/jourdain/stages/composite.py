@@ -36,6 +36,7 @@ from ..model.joints import Mat3, Vec3
 from ..symbolic import SymMatrix
 from .kinematics import Z3, _add, _cross, _dot, _mtv, _mv, _scale
 from .kinematics.frames import Node
+from .kinematics.vectors import _zero
 from .newton_euler import NewtonEuler
 
 ZERO = se.Integer(0)
@@ -97,12 +98,17 @@ def composite_projection(ne: NewtonEuler) -> tuple[SymMatrix, SymMatrix, SymMatr
                 q_terms[j].append(_pair(d, w))
             if g is not None:  # the weight m·g at the centre h/m, in b's frame
                 q_terms[j].append(_pair(d, (_cross(c[1], g), _scale(g, c[0]))))  # type: ignore[index]
-    return (SymMatrix.symmetric_from_terms(terms), SymMatrix.column(_sums(k_terms)),
+    rows = [[ZERO] * f for _ in range(f)]
+    for j in range(f):
+        for k, e in enumerate(_sums(terms[j][j:]), j):
+            rows[j][k] = rows[k][j] = e
+    return (SymMatrix.from_rows(rows), SymMatrix.column(_sums(k_terms)),
             SymMatrix.column(_sums(q_terms)))
 
 
 def _sums(terms: list[list[se.Basic]]) -> list[se.Basic]:
-    return [se.Add(*t) if t else ZERO for t in terms]
+    """The sum of each list of terms (a single term as it is: se.Add would copy a sum)."""
+    return [(t[0] if len(t) == 1 else se.Add(*t)) if t else ZERO for t in terms]
 
 
 def _upward(ne: NewtonEuler, common_g: bool
@@ -173,8 +179,9 @@ def _twist(a: Node, j: int) -> tuple[Vec3, Vec3]:
 
 
 def _pair(s: tuple[Vec3, Vec3], w: Wrench) -> se.Basic:
-    """s·w = ω·(moment) + v·(force)"""
-    return se.Add(_dot(s[0], w[0]), _dot(s[1], w[1]))
+    """s·w = ω·(moment) + v·(force), one sum of the non-zero products"""
+    return se.Add(*[a * b for a, b in zip((*s[0], *s[1]), (*w[0], *w[1]), strict=True)
+                    if not (_zero(a) or _zero(b))])
 
 
 def _momentum(c: Composite, s: tuple[Vec3, Vec3]) -> Wrench:
