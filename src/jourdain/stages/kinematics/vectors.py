@@ -94,7 +94,7 @@ def _product(rows: tuple[tuple[object, object, object], ...]) -> Callable[[Vec3]
                 out.append(a * v[k])
             else:
                 out.append(se.Add(*[a * v[k] for k, a in terms]))
-        return tuple(out)  # type: ignore[return-value]
+        return tuple(out)
 
     return apply
 
@@ -106,7 +106,7 @@ def _times(A: Mat3) -> Callable[[Vec3], Vec3]:
 
 def _times_t(A: Mat3) -> Callable[[Vec3], Vec3]:
     """v ↦ Aᵀ·v (:func:`_product`)."""
-    return _product(tuple(zip(*A, strict=True)))  # type: ignore[arg-type]
+    return _product(tuple(zip(*A, strict=True)))
 
 def _mtm(A: Mat3, B: Mat3) -> Mat3:
     """Aᵀ·B"""
