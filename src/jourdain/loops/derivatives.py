@@ -17,7 +17,7 @@ holonomic rows, the velocity map, the projection) and the complex step
 ``∂F/∂x_j = Im F(x + iη·e_j)/η``: exact to rounding, as the linearization of a general system
 (:mod:`jourdain.loops.general_linear`). It is evaluated in Python, walking the expression
 graph in complex arithmetic (:class:`jourdain.graph.complex_step.ComplexTape`, one evaluation
-per variable), not compiled: 15 ms per state for the four-bar (x of 2), 0.2–0.4 s for the
+per variable), not compiled: 3 ms per state for the four-bar (x of 2), 0.2–0.4 s for the
 benchmark bicycle (x of 10), where a tree's compiled derivatives take microseconds.
 """
 
