@@ -22,12 +22,18 @@ def test_derivation_benchmark_quick_case(capsys):
 def test_growth_and_targets():
     rows = [{"family": "chain", "n": n, "f": f, "jourdain_s": 1e-4 * f**2,
              "jourdain_rss_mb": 50.0 + 0.01 * f**2, "jourdain_delta_mb": 0.01 * f**2,
-             "sympy_s": None} for n, f in ((4, 7), (32, 63), (64, 127))]
+             "jourdain_ops_M": 20 * f**2, "jourdain_ops_f": 5 * f**2, "sympy_s": None}
+            for n, f in ((4, 7), (16, 31), (32, 63), (64, 127))]
     g = derivation.growth(rows)
-    assert (g["all"]["f_min"], g["top"]["f_min"], g["top"]["f_max"]) == (7, 63, 127)
-    assert all(math.isclose(s[k], 2.0) for s in g.values()
-               for k in ("jourdain_s", "jourdain_delta_mb"))
+    assert (g["fit"]["f_min"], g["top"]["f_min"], g["top"]["f_max"]) == (31, 63, 127)
+    assert all(math.isclose(s[k], 2.0) for s in g.values() for k in derivation.GROWTH)
     lines = derivation.summary(rows)
     assert any(line.startswith("targets at f = 127: 1.61 s (≤ 1.5 s: NOT met), peak RSS 211 MB "
-                               "(≤ 300 MB: met), growth f^2.00 (≤ f^2: met)")
-               for line in lines), lines
+                               "(≤ 300 MB: met), growth time f^2.00, operations f^2.00, memory "
+                               "f^2.00 (≤ f^2: met)") for line in lines), lines
+
+
+def test_fit_starts_where_the_composite_bodies_do():
+    from jourdain.stages.kinematics.result import SHARED_FROM_F
+
+    assert derivation.FIT_F_MIN == SHARED_FROM_F
