@@ -8,7 +8,7 @@ coordinate, zero at constrained DOFs), with the rigid-body fields of the frame `
 translations along x, y, z: u = e_k, θ = 0) and ``Γ_r`` (unit rotations about x, y, z through the
 frame's origin: u = e_k × c, θ = e_k), the invariants in the body frame are
 
-    m·E    = Γ_tᵀ·M·Γ_t          mass
+    m·E    = Γ_tᵀ·M·Γ_t          mass (the mean of the diagonal over the directions present)
     m·c̃ᵀ   = Γ_tᵀ·M·Γ_r          first moment (m·c = (x, y, z) read from the skew matrix)
     J      = Γ_rᵀ·M·Γ_r          inertia tensor about the frame's origin, ∫ρ(c̃ᵀc̃) dV
     C_t    = Γ_tᵀ·M·Φ            ∫ρ·Φ_t dV                       (3 × n_q)
@@ -147,7 +147,9 @@ def modal_data(fe: FEModel, Phi: np.ndarray, method: str, kinds: tuple[str, ...]
     MGt = np.asarray(M @ Gt)
     MGr = np.asarray(M @ Gr)
     mE = Gt.T @ MGt
-    mass = float(np.trace(mE) / 3.0)
+    # the directions the model has translations in (all three for beams and solids)
+    present = np.abs(Gt).sum(axis=0) > 0
+    mass = float(np.mean(np.diag(mE)[present])) if present.any() else 0.0
     # Γ_tᵀ·M·Γ_r = m·c̃ᵀ = −m·c̃
     S = -(Gt.T @ MGr)  # = m·c̃
     mc = np.array([S[2, 1] - S[1, 2], S[0, 2] - S[2, 0], S[1, 0] - S[0, 1]]) / 2.0

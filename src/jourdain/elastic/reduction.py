@@ -97,9 +97,12 @@ def normal_modes(K: object, M: object, n: int) -> tuple[np.ndarray, np.ndarray]:
         lam, Phi = sla.eigh(np.asarray(K), np.asarray(M), subset_by_index=[0, n - 1])
     order = np.argsort(lam)
     lam, Phi = lam[order], Phi[:, order]
-    # M-normalize (eigsh's vectors are, up to rounding; make it exact)
+    # M-normalize (eigsh's vectors are, up to rounding; make it exact), and fix the sign: the
+    # entry of largest magnitude positive, so that dense and sparse solvers, and repeated runs,
+    # give the same modes (and the same C_t, C_r)
     norms = np.sqrt(np.einsum("ij,ij->j", Phi, np.asarray(M @ Phi)))
-    return lam, Phi / norms
+    big = Phi[np.argmax(np.abs(Phi), axis=0), np.arange(Phi.shape[1])]
+    return lam, Phi * (np.sign(big) / norms)
 
 
 def _expand(fe: FEModel, keep: Sequence[int], basis: np.ndarray) -> np.ndarray:
