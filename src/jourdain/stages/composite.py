@@ -34,9 +34,9 @@ import symengine as se
 
 from ..model.joints import Mat3, Vec3
 from ..symbolic import SymMatrix
-from .kinematics import Z3, _add, _cross, _dot, _mtv, _mv, _scale
+from .kinematics import Z3, _add, _cross, _mtv, _mv, _scale
 from .kinematics.frames import Node
-from .kinematics.vectors import _zero
+from .kinematics.vectors import _times, _zero
 from .newton_euler import NewtonEuler
 
 ZERO = se.Integer(0)
@@ -218,19 +218,18 @@ def _move_composite(n: Node, c: Composite) -> Composite:
     """The composite body c of the frame after step n, in the frame before it."""
     m, h, I = c
     if n.A is not None:
-        A = n.A
-        AI = tuple(_mv(A, (I[0][b], I[1][b], I[2][b])) for b in range(3))  # columns of A·I
-        rows = tuple(_mv(A, (AI[0][a], AI[1][a], AI[2][a])) for a in range(3))  # of A·I·Aᵀ
-        return m, _mv(A, h), rows  # type: ignore[return-value]
+        A = _times(n.A)
+        AI = tuple(A((I[0][b], I[1][b], I[2][b])) for b in range(3))  # columns of A·I
+        rows = tuple(A((AI[0][a], AI[1][a], AI[2][a])) for a in range(3))  # of A·I·Aᵀ
+        return m, A(h), rows  # type: ignore[return-value]
     if n.d is None:
         return c
     d = n.d
-    # I + m(d·d E − d dᵀ) + 2(h·d)E − h dᵀ − d hᵀ  (parallel axes, first moment h about n)
-    dd = _scale((_dot(d, d),) * 3, m) if m != 0 else Z3
-    hd = _dot(h, d) if not _is_zero(h) else ZERO
+    # parallel axes with the first moment h about n's origin:
+    # I + m(d·d E − d dᵀ) + 2(h·d)E − h dᵀ − d hᵀ, the diagonal without the terms that cancel
     J = tuple(tuple(
-        se.Add(I[a][b], -m * d[a] * d[b], -h[a] * d[b], -d[a] * h[b],
-               *((dd[a], 2 * hd) if a == b else ()))
+        se.Add(I[a][a], *(m * d[b] ** 2 + 2 * h[b] * d[b] for b in range(3) if b != a))
+        if a == b else se.Add(I[a][b], -m * d[a] * d[b], -h[a] * d[b], -d[a] * h[b])
         for b in range(3)) for a in range(3))
     return m, _add(h, _scale(d, m)), J  # type: ignore[return-value]
 
