@@ -110,7 +110,7 @@ def eigenvalues(r: Rotor, speed: float, keep: Sequence[int] | None = None) -> np
     return lam[np.argsort(lam.imag)]
 
 
-def campbell(r: Rotor, speeds: Sequence[float], n_modes: int,
+def campbell(r: Rotor, speeds: Sequence[float] | np.ndarray, n_modes: int,
              keep: Sequence[int] | None = None) -> np.ndarray:
     """Damped natural frequencies ω_d = Im λ (rad/s) of the ``n_modes`` lowest modes
     (Im λ > 0) at each speed: an array (len(speeds), n_modes)."""
