@@ -83,7 +83,10 @@ def _shift(K: object, M: object) -> float:
 
 
 def normal_modes(K: object, M: object, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """The ``n`` lowest eigenpairs of K·φ = λ·M·φ: λ ascending and Φ with Φᵀ·M·Φ = E."""
+    """The ``n`` lowest eigenpairs of K·φ = λ·M·φ: λ ascending and Φ with Φᵀ·M·Φ = E, each
+    column's sign fixed (first entry of largest magnitude positive). Repeated eigenvalues
+    (a round section's two bending planes) have no unique modes: any M-orthonormal basis of
+    their eigenspace comes back."""
     size = K.shape[0]  # type: ignore[attr-defined]
     if not 0 < n <= size:
         raise ModelError(f"asked for {n} modes of a model with {size} DOFs")
@@ -98,10 +101,13 @@ def normal_modes(K: object, M: object, n: int) -> tuple[np.ndarray, np.ndarray]:
     order = np.argsort(lam)
     lam, Phi = lam[order], Phi[:, order]
     # M-normalize (eigsh's vectors are, up to rounding; make it exact), and fix the sign: the
-    # entry of largest magnitude positive, so that dense and sparse solvers, and repeated runs,
-    # give the same modes (and the same C_t, C_r)
+    # first entry within 1e-6 of the largest magnitude positive (antisymmetric modes have two
+    # of equal size), so that dense and sparse solvers, and repeated runs, give the same modes
+    # (and the same C_t, C_r)
     norms = np.sqrt(np.einsum("ij,ij->j", Phi, np.asarray(M @ Phi)))
-    big = Phi[np.argmax(np.abs(Phi), axis=0), np.arange(Phi.shape[1])]
+    mag = np.abs(Phi)
+    first = np.argmax(mag >= (1 - 1e-6) * mag.max(axis=0), axis=0)
+    big = Phi[first, np.arange(Phi.shape[1])]
     return lam, Phi * (np.sign(big) / norms)
 
 
