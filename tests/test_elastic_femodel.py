@@ -123,6 +123,19 @@ def test_sid_round_trip_is_exact(tmp_path: Path) -> None:
     assert back.method == "SID"
 
 
+def test_sid_reads_the_order_0_part_of_first_order_taylor_objects() -> None:
+    """Other tools write origin, J, mdCM with their first-order terms (m1): read m0."""
+    md = modal_truncation(assemble(BEAM), 2, fixed=[0])
+    text = sid_text(md)
+    start = text.index("   J\n")
+    stop = text.index("   end J\n")
+    block = text[start:stop].replace("order = 0", "order = 1", 1)
+    block += "      m1\n         m1(  1,  1,  2) = 0.5\n      end m1\n"
+    back = sid_data(text[:start] + block + text[stop:])
+    np.testing.assert_array_equal(back.J, md.J)
+    assert "sid first-order terms skipped: J" in back.meta
+
+
 def test_sid_skips_blocks_outside_the_subset_and_reads_transposed_ct() -> None:
     md = modal_truncation(assemble(BEAM), 4, fixed=[0])
     text = sid_text(md)
@@ -143,7 +156,10 @@ def test_sid_skips_blocks_outside_the_subset_and_reads_transposed_ct() -> None:
     (lambda t: t.replace("nelastq = 10", "nelastq = ten", 1), r"line 6: nelastq = 'ten'"),
     (lambda t: t.replace("end part\n", ""), r"block 'part' opened on line 2 is not closed"),
     (lambda t: t.replace("      end m0\n", "      m0(  1,  1,  1) = 1.0\n      end m0\n", 1),
-     "order-1 entries"),
+     "m0 entries have 2 indices"),
+    (lambda t: t.replace("      end m0\n", "      end m0\n      m1(  1,  1) = 1.0\n", 1),
+     r"m1 entry outside an m1 block \(in 'origin'\)"),
+    (lambda t: t.replace("order = 0", "order = 2", 1), "origin of order 2: 0 or 1 read"),
     (lambda t: t.replace("   Me\n", "   Mx\n   end Mx\n   Me2\n", 1), r"line \d+: 'end Me'"),
     (lambda t: t.replace("m0(  1,  1) = ", "m0(  1,  1) = 1.0.0 # ", 1), "not a number: '1.0.0'"),
     (lambda t: t.replace("      nrow = 10\n", "      nrow = 9\n", 1),

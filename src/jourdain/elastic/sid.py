@@ -31,7 +31,7 @@ layout (indentation free, one item per line, ``#`` or ``!`` starts a comment)::
        De   <n_q × n_q>     end De
     end part
 
-A Taylor object here is of order 0 only::
+A Taylor object as jourdain writes it (order 0)::
 
        order = 0
        nrow = <r>
@@ -44,9 +44,11 @@ A Taylor object here is of order 0 only::
        end m0
 
 Written values use 17 significant digits, so a file read back gives the same numbers. Read:
-every block of the layout above; other blocks (``Gr``, ``Ge``, ``Oe``, ``ksigma``, ``AP``,
-``m1`` parts of order 1, ...) are skipped whole, and their names are kept in
-``ModalData.meta`` keys ``"sid skipped: <name>"``. ``Ct``, ``Cr`` given as n_q × 3 (transposed)
+every block of the layout above; other blocks (``Gr``, ``Ge``, ``Oe``, ``ksigma``, ``AP``, ...)
+are skipped whole, and their names are kept in ``ModalData.meta`` keys
+``"sid skipped: <name>"``; Taylor objects of order 1 (as other tools write ``origin``, ``J``,
+``mdCM``) give their order-0 part, the ``m1`` block (entries ``m1( i, j, k) = v``, k the
+coordinate) read for its numbers and noted as ``"sid first-order terms skipped: <name>"``. ``Ct``, ``Cr`` given as n_q × 3 (transposed)
 are accepted where n_q ≠ 3. Numbers are read with ``float`` alone: nothing in the file is
 evaluated or executed. A file that does not follow the layout raises
 :class:`~jourdain.errors.ModelError` naming the file and line. The DOF map read back has six
@@ -146,12 +148,13 @@ def parse_sid(text: str, source: str = "<sid>") -> _Block:
                 raise fail(f"'{line}' closes no open block (open: {top.name!r})")
             stack.pop()
         elif m := _ENTRY.match(line):
-            if top.name != "m0":
-                raise fail(f"matrix entry outside an m0 block (in {top.name!r})")
-            if m.group(4) is not None:
-                raise fail("order-1 entries (three indices) are outside the subset")
+            if top.name != m.group(1):
+                raise fail(f"{m.group(1)} entry outside an {m.group(1)} block (in {top.name!r})")
+            if (m.group(4) is None) != (m.group(1) == "m0"):
+                raise fail(f"{m.group(1)} entries have {2 if m.group(1) == 'm0' else 3} indices")
+            idx = tuple(int(g) for g in m.group(2, 3, 4) if g is not None)
             try:
-                top.entries[(int(m.group(2)), int(m.group(3)))] = float(m.group(5))
+                top.entries[idx] = float(m.group(5))
             except ValueError:
                 raise fail(f"not a number: {m.group(5)!r}") from None
         elif line.startswith("new "):
@@ -189,10 +192,14 @@ def _int(blk: _Block, key: str, source: str) -> int:
         raise ModelError(f"{source}: line {n}: {key} = {text!r} is not an integer") from None
 
 
-def _matrix(blk: _Block, source: str) -> np.ndarray:
-    if _int(blk, "order", source) != 0:
-        raise ModelError(f"{source}: line {blk.line}: {blk.name} of order > 0 is outside the "
-                         "subset")
+def _matrix(blk: _Block, source: str, skipped: dict[str, float] | None = None) -> np.ndarray:
+    """The order-0 part A⁰ of a Taylor object; an order-1 part (``m1``: the first-order terms
+    in q_e, outside the subset) is checked for its numbers and noted in ``skipped``."""
+    order = _int(blk, "order", source)
+    if order not in (0, 1):
+        raise ModelError(f"{source}: line {blk.line}: {blk.name} of order {order}: 0 or 1 read")
+    if order == 1 and skipped is not None:
+        skipped[f"sid first-order terms skipped: {blk.name}"] = float(blk.line)
     r, c = _int(blk, "nrow", source), _int(blk, "ncol", source)
     a = np.zeros((r, c))
     for ch in blk.children:
@@ -243,23 +250,25 @@ def sid_data(text: str, source: str = "<sid>") -> ModalData:
         raise ModelError(f"{source}: line {mass_line}: mass = {mass_text!r} is not a number") \
             from None
     kinds = tuple(ref.values.get(f"ielastq({k + 1})", ("mode", 0))[0] for k in range(n_q))
+    meta: dict[str, float] = {}
     nodes_blk = [b for b in _child(part, "frame", source).children if b.name == "node"]
     nodes = np.zeros((len(nodes_blk), 3))
     Phi = np.zeros((6 * len(nodes_blk), n_q))
     for k, nb in enumerate(nodes_blk):
-        nodes[k] = _shape("origin", _matrix(_child(nb, "origin", source), source), (3, 1),
-                          nb, source)[:, 0]
+        nodes[k] = _shape("origin", _matrix(_child(nb, "origin", source), source, meta),
+                          (3, 1), nb, source)[:, 0]
         for name, rows in (("phi", slice(0, 3)), ("psi", slice(3, 6))):
             blk = _child(nb, name, source)
-            Phi[6 * k:6 * k + 6][rows] = _shape(name, _matrix(blk, source), (3, n_q), blk,
-                                                source)
+            Phi[6 * k:6 * k + 6][rows] = _shape(name, _matrix(blk, source, meta), (3, n_q),
+                                                blk, source)
     got = {}
     for name, shape in (("mdCM", (3, 1)), ("J", (3, 3)), ("Ct", (3, n_q)), ("Cr", (3, n_q)),
                         ("Me", (n_q, n_q)), ("Ke", (n_q, n_q)), ("De", (n_q, n_q))):
         blk = _child(part, name, source)
-        got[name] = _shape(name, _matrix(blk, source), shape, blk, source)
+        got[name] = _shape(name, _matrix(blk, source, meta), shape, blk, source)
     known = {"refmod", "frame", "mdCM", "J", "Ct", "Cr", "Me", "Ke", "De"}
-    meta = {f"sid skipped: {b.name}": float(b.line) for b in part.children if b.name not in known}
+    meta.update({f"sid skipped: {b.name}": float(b.line) for b in part.children
+                 if b.name not in known})
     try:
         lam = sla.eigh(got["Ke"], got["Me"], eigvals_only=True) if n_q else np.zeros(0)
     except np.linalg.LinAlgError:
