@@ -52,19 +52,24 @@ _WXI = 0.5 * _GAUSS_W
 class Beam:
     """A straight prismatic beam, meshed into ``n_elements`` equal elements.
 
-    Parameters
-    ----------
-    length, E, rho, A : length, Young's modulus, density, cross-section area.
-    I_y, I_z : second moments of area about the section's y and z axes (bending in the x–z and
-        x–y planes).
-    J : torsion constant (G·J the torsional stiffness; the polar moment for a circle).
-    G, nu : shear modulus, or Poisson's ratio (G = E/(2(1+ν))); exactly one of the two.
-    kappa : shear correction factor; ``None`` for Euler–Bernoulli (no shear deformation).
-    I_p : polar moment of area for the torsional and gyroscopic inertia (default I_y + I_z).
-    rotary_inertia : whether the mass has the bending rotations' inertia ρI·∫N_θᵀN_θ.
-    axis : direction of the beam's axis in the body frame; ``origin`` its first node.
-    up : a vector not along ``axis`` fixing the element's y axis (default: the body axis
-        closest to perpendicular).
+    Args:
+        length: length of the beam.
+        E: Young's modulus.
+        rho: density.
+        A: cross-section area.
+        I_y: second moment of area about the section's y axis (bending in the x–z plane).
+        I_z: second moment of area about the section's z axis (bending in the x–y plane).
+        J: torsion constant (G·J the torsional stiffness; the polar moment for a circle).
+        n_elements: number of equal elements.
+        G: shear modulus; give exactly one of G and nu.
+        nu: Poisson's ratio (G = E/(2(1+ν))).
+        kappa: shear correction factor; ``None`` for Euler–Bernoulli (no shear deformation).
+        I_p: polar moment of area for the torsional and gyroscopic inertia (default I_y + I_z).
+        rotary_inertia: whether the mass has the bending rotations' inertia ρI·∫N_θᵀN_θ.
+        axis: direction of the beam's axis in the body frame.
+        origin: position of its first node in the body frame.
+        up: a vector not along ``axis`` fixing the element's y axis (default: the body axis
+            after the one closest to ``axis``, cyclically: see :func:`frame_of_axis`).
     """
 
     length: float
