@@ -171,3 +171,27 @@ def test_malformed_sid_names_the_line(edit, match: str) -> None:  # type: ignore
     text = sid_text(md)
     with pytest.raises(ModelError, match=match):
         sid_data(edit(text), "beam.sid")
+
+
+@pytest.mark.parametrize("case", ["good", "indefinite_k", "singular_m"])
+def test_definiteness_by_inertia_on_large_models(case: str, monkeypatch) -> None:  # type: ignore[no-untyped-def]
+    """Beyond DENSE_LIMIT DOFs the signs of a symmetric factorization's pivots decide
+    (Sylvester's inertia): the same verdicts as the dense eigenvalues."""
+    import jourdain.elastic.femodel as femodel
+
+    monkeypatch.setattr(femodel, "DENSE_LIMIT", 10)
+    fe = assemble(BEAM, sparse=True)
+    M, K = fe.M.tolil(), fe.K.tolil()
+    if case == "indefinite_k":
+        K[9, 9] = -1e-6 * abs(fe.K).max()
+    elif case == "singular_m":
+        M[:, 3] = 0.0
+        M[3, :] = 0.0
+    args = (M.tocsr(), K.tocsr(), fe.nodes)
+    if case == "good":
+        assert fe_model(*args, dofs=fe.dofs).n == fe.n
+        return
+    what = "K: not positive semi-definite" if case == "indefinite_k" else \
+        "M: not positive definite"
+    with pytest.raises(ModelError, match=f"{what} \\(1 pivot"):
+        fe_model(*args, dofs=fe.dofs)

@@ -9,9 +9,10 @@ and the DOF map: for each row of the matrices the pair ``(node, name)``, name on
 Checks, each an :class:`~jourdain.errors.ModelError` that names the matrix and what is wrong:
 square and of the DOF map's size; finite (no NaN or inf, with the first bad entry); symmetric
 (max |A − Aᵀ| ≤ 1e-10·max |A|, with the worst entry); M positive definite and K positive
-semi-definite (a Cholesky of M; the lowest eigenvalues of K ≥ −1e-8·‖K‖ — a dense check up to
-3000 DOFs, a shift-invert Lanczos beyond); the DOF map's names, node indices and no DOF listed
-twice.
+semi-definite (the lowest eigenvalue of M > 0, of K ≥ −1e-8·max|K|: dense eigenvalues up to
+3000 DOFs; beyond, the signs of the pivots of a symmetric sparse factorization of M and of
+K + 1e-8·max|K|·E, Sylvester's law of inertia); the DOF map's names, node indices and no DOF
+listed twice.
 """
 
 from __future__ import annotations
@@ -72,23 +73,37 @@ def check_matrix(a: Any, what: str, n: int, definite: bool) -> None:
         i, j = np.unravel_index(int(np.argmax(np.abs(d))), d.shape)
         raise ModelError(f"{what}: not symmetric: |A[{i},{j}] − A[{j},{i}]| = {asym:.3g} "
                          f"(> {SYM_RTOL:g}·max|A| = {SYM_RTOL * scale:.3g})")
-    lowest = _lowest_eigenvalue(a, scale)
-    if definite and not lowest > 0:
-        raise ModelError(f"{what}: not positive definite (lowest eigenvalue {lowest:.3g})")
-    if lowest < -PSD_RTOL * scale:
-        raise ModelError(f"{what}: not positive semi-definite (lowest eigenvalue {lowest:.3g}, "
-                         f"max|A| = {scale:.3g})")
-
-
-def _lowest_eigenvalue(a: Any, scale: float) -> float:
-    n = a.shape[0]
-    if n <= DENSE_LIMIT:
+    shift = 0.0 if definite else PSD_RTOL * scale
+    if a.shape[0] <= DENSE_LIMIT:
         dense = a.toarray() if sp.issparse(a) else a
-        return float(sla.eigvalsh(0.5 * (dense + dense.T), subset_by_index=[0, 0])[0])
-    # shift-invert about a point below the spectrum's bottom (Gershgorin: ≥ −n·scale)
-    sigma = -1e-3 * scale
-    lam = spla.eigsh(sp.csc_matrix(a), k=1, sigma=sigma, which="LM", return_eigenvectors=False)
-    return float(lam[0])
+        lowest = float(sla.eigvalsh(0.5 * (dense + dense.T), subset_by_index=[0, 0])[0])
+        bad = not lowest > 0 if definite else lowest < -shift
+        detail = f"lowest eigenvalue {lowest:.3g}"
+    else:
+        negative = _negative_pivots(a, shift)
+        bad, detail = negative > 0, (f"{negative} pivot(s) ≤ 0 in the symmetric factorization "
+                                     f"of A + {shift:.3g}·E (Sylvester's inertia)")
+    if bad:
+        kind = "positive definite" if definite else "positive semi-definite"
+        raise ModelError(f"{what}: not {kind} ({detail}, max|A| = {scale:.3g})")
+
+
+def _negative_pivots(a: Any, shift: float) -> int:
+    """How many eigenvalues of A + shift·E are ≤ 0: the signs of the pivots of a sparse LU with
+    the same permutation of rows and columns (an LDLᵀ: Sylvester's law of inertia). Where
+    SuperLU had to pivot off the diagonal, the lowest eigenvalue from shift-invert Lanczos
+    about −shift instead."""
+    A = sp.csc_matrix(a + shift * sp.identity(a.shape[0], format="csc"))
+    try:
+        lu = spla.splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                       options={"SymmetricMode": True})
+    except RuntimeError:  # exactly singular: a zero pivot
+        return 1
+    if np.array_equal(lu.perm_r, lu.perm_c):
+        return int(np.count_nonzero(lu.U.diagonal() <= 0))
+    lam = spla.eigsh(A, k=1, sigma=-max(shift, 1e-300), which="LM", tol=1e-6,
+                     return_eigenvectors=False)
+    return int(lam[0] <= 0)
 
 
 def _dof_map(nodes: np.ndarray, dofs: Sequence[tuple[int, str]] | None,

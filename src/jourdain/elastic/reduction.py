@@ -15,8 +15,10 @@ invariants (:mod:`jourdain.elastic.modal`) count the whole body's mass:
   Géradin & Rixen, *Mechanical Vibrations*, §6.4): the elastic flexibility's response to a unit
   load there, its rigid-body part removed by the projector P = E − M·Γ·Γᵀ (Γ the M-orthonormal
   rigid-body modes) and the kept modes' part Σ φ·φᵀ/ω² subtracted; the augmented basis is
-  made M- and K-orthogonal. For a body whose rigid modes are not all free (``fixed`` given, or
-  a K that is regular), the plain flexibility K⁻¹ is used.
+  made M- and K-orthogonal. The elastic flexibility is applied by a solve with K on all DOFs
+  but a statically determinate set (pivoted QR of Γᵀ picks it), whose result is then made
+  M-orthogonal to Γ. For a body whose rigid modes are all held (``fixed``, or a regular K),
+  the plain flexibility K⁻¹ is used.
 
 Dense matrices are solved with LAPACK (``scipy.linalg.eigh``); ``scipy.sparse`` ones with a
 sparse LU and shift-invert Lanczos (``scipy.sparse.linalg.eigsh``).
@@ -197,9 +199,14 @@ def free_modes(fe: FEModel, n_modes: int, correction: Iterable[DofSpec] = (),
         if n_rigid:
             MG = np.asarray(sub.M @ Gam)
             F = F - MG @ (Gam.T @ F)  # inertia relief: Pᵀ·f has no rigid-body part
-            Ks = sub.K + (sp.csr_matrix(MG) @ sp.csr_matrix(MG.T) if sp.issparse(sub.K)
-                          else MG @ MG.T)
-            X = _solve(Ks, F)
+            # K·x = Pᵀ·f is consistent; one solution holds a statically determinate set of
+            # DOFs (as many as rigid modes, chosen by pivoted QR of Γᵀ) at zero, and the
+            # elastic one is that solution with its rigid-body part removed
+            _, _, piv = sla.qr(Gam.T, mode="economic", pivoting=True)
+            held = set(int(i) for i in piv[:n_rigid])
+            rest = [i for i in range(sub.n) if i not in held]
+            X = np.zeros_like(F)
+            X[rest] = _solve(_sub(sub.K, rest, rest), F[rest])
             X = X - Gam @ (Gam.T @ np.asarray(sub.M @ X))
         else:
             X = _solve(sub.K, F)
