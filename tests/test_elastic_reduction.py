@@ -197,3 +197,15 @@ def test_reduction_errors_name_what_is_wrong() -> None:
         craig_bampton(fe, [4], 40, fixed=[0])
     with pytest.raises(ModelError, match="modes of a model with"):
         modal_truncation(fe, 31)
+
+
+def test_free_modes_of_a_pinned_body_skip_its_three_rotations() -> None:
+    """Translations held at the middle node: the three rotations about it are the rigid
+    modes (combinations of the frame's fields about the origin), the elastic modes follow."""
+    fe = assemble(_beam(n=10))
+    pin = [(5, "ux"), (5, "uy"), (5, "uz")]
+    full = modal_truncation(fe, 10, fixed=pin)
+    tol = _eig_tol(constrain(fe, pin), np.ones(10))
+    assert np.all(full.omega[:3] ** 2 <= tol[:3]) and full.omega[3] ** 2 > 1e4 * tol[3]
+    fm = free_modes(fe, 4, fixed=pin, correction=[(10, "uy")])
+    np.testing.assert_allclose(fm.omega[:4], full.omega[3:7], rtol=1e-9)

@@ -164,21 +164,23 @@ def craig_bampton(fe: FEModel, interface: Iterable[DofSpec], n_modes: int,
 
 
 def _rigid_modes(fe: FEModel) -> np.ndarray:
-    """M-orthonormal rigid-body modes of ``fe`` from its geometry (the six fields of
-    :func:`rigid_fields`), those with K·Γ ≠ 0 (held by supports) left out."""
+    """M-orthonormal rigid-body modes of ``fe``: the combinations of the six fields of
+    :func:`rigid_fields` that K does not resist (K·Γ·v = 0: supports may hold some, e.g. a
+    pin leaves the rotations about itself), made M-orthonormal."""
     Gt, Gr = rigid_fields(fe)
     Gam = np.column_stack([Gt, Gr])
-    KG = np.asarray(fe.K @ Gam)
-    scale = np.abs(fe.K.diagonal()).max() * np.abs(Gam).max(axis=0)
-    free = np.abs(KG).max(axis=0) <= 1e-8 * np.maximum(scale, 1e-300)
-    Gam = Gam[:, free]
-    if Gam.shape[1] == 0:
-        return Gam
-    # M-orthonormalize (rank-revealing: a model with no rotation DOFs at a line of nodes ...)
+    # M-orthonormalize first (rank-revealing: a model without rotation DOFs on a line of
+    # nodes has fewer than six independent fields)
     Mg = Gam.T @ np.asarray(fe.M @ Gam)
     w, V = np.linalg.eigh(0.5 * (Mg + Mg.T))
     ok = w > 1e-12 * w.max()
-    return Gam @ (V[:, ok] / np.sqrt(w[ok]))
+    Gam = Gam @ (V[:, ok] / np.sqrt(w[ok]))
+    # the null space of K on their span: singular values of K·Γ below 1e-8 of ‖K‖·‖Γ‖
+    _, sv, Vt = np.linalg.svd(np.asarray(fe.K @ Gam), full_matrices=True)
+    k_norm = float(np.abs(fe.K).max())
+    rank = int(np.count_nonzero(sv > 1e-8 * k_norm * float(np.abs(Gam).max()) * fe.n))
+    Gam = Gam @ Vt[rank:].T
+    return Gam  # still M-orthonormal: Vt is orthogonal
 
 
 def free_modes(fe: FEModel, n_modes: int, correction: Iterable[DofSpec] = (),
