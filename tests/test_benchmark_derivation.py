@@ -13,6 +13,7 @@ def test_derivation_benchmark_quick_case(capsys):
     for row in rows:
         assert row["sympy_s"] is not None and row["jourdain_s"] > 0
         assert row["jourdain_rss_mb"] > 0 and row["sympy_rss_mb"] > 0
+        assert row["jourdain_heap_mb"] is None or row["jourdain_heap_mb"] >= 0
         assert row["max_rel_diff"] is not None and row["max_rel_diff"] < 1e-10
     assert rows[0]["jourdain_ops_M"] <= rows[0]["sympy_ops_M"]
     text = capsys.readouterr().out
@@ -22,6 +23,7 @@ def test_derivation_benchmark_quick_case(capsys):
 def test_growth_and_targets():
     rows = [{"family": "chain", "n": n, "f": f, "jourdain_s": 1e-4 * f**2,
              "jourdain_rss_mb": 50.0 + 0.01 * f**2, "jourdain_delta_mb": 0.01 * f**2,
+             "jourdain_heap_mb": 0.009 * f**2,
              "jourdain_ops_M": 20 * f**2, "jourdain_ops_f": 5 * f**2, "sympy_s": None}
             for n, f in ((4, 7), (16, 31), (32, 63), (64, 127))]
     g = derivation.growth(rows)
