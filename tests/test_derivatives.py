@@ -223,3 +223,56 @@ def test_joint_friction_is_refused_by_name():
     assert system.frictions
     with pytest.raises(jd.ModelError, match="joint friction"):
         jd.derivatives(system)
+
+
+def _mixed_joints():
+    """Every kind of screw joint on one tree, a fixed joint between, axes and offsets of
+    parameters, a torque input and two gravity elements."""
+    x, a, b1, b2, c1, c2, c3, p1, p2, p3, s1, s2 = jd.symbols(
+        "x a b1 b2 c1 c2 c3 p1 p2 p3 s1 s2")
+    L, m, tau = jd.symbols("L m tau")
+    box = jd.box(m, 0.3, 0.2, 0.1)
+    bodies = [
+        jd.Body("cart", "world", jd.Prismatic("slide", x, (1, L, 0)), mass=m, com=(0.1, 0, 0),
+                inertia=box),
+        jd.Body("arm", "cart", jd.Revolute("hinge", a, "z", position=(0, 0.2, 0)), mass=m,
+                com=(L / 2, 0, 0.05), inertia=box),
+        jd.Body("plate", "arm", jd.Fixed("weld", position=(L, 0, 0)), mass=m / 2,
+                com=(0, 0.1, 0), inertia=box),
+        jd.Body("fork", "plate", jd.Universal("cardan", [b1, b2], ("x", "y"),
+                                              position=(0.1, 0, 0)), mass=m, com=(0, 0, -L),
+                inertia=box),
+        jd.Body("ball", "fork", jd.Spherical("socket", [c1, c2, c3], "zyx",
+                                             position=(0, 0, -L)), mass=m, com=(0.1, 0.1, -0.2),
+                inertia=box),
+        jd.Body("puck", "arm", jd.Planar("plane", [p1, p2, p3], "z", position=(0, 0.3, 0)),
+                mass=m, com=(0.05, 0, 0), inertia=box),
+        jd.Body("sleeve", "puck", jd.Cylindrical("tube", [s1, s2], (0, 1, 1)), mass=m,
+                com=(0, 0.1, 0.1), inertia=box),
+    ]
+    return jd.System([x, a, b1, b2, c1, c2, c3, p1, p2, p3, s1, s2], bodies,
+                     [jd.Gravity((0, -9.81, 0)), jd.Gravity((0.5, 0, -1.0), name="tilt"),
+                      jd.GeneralizedForce("drive", a, 2 * tau)],
+                     parameters={"L": 0.7, "m": 1.3}, inputs=[tau], name="mixed joints")
+
+
+def test_every_screw_joint_kind_against_the_forward_mode():
+    from jourdain.numeric.derivative_screw import screw_columns
+    from jourdain.numeric.derivatives import compiled_derivatives
+
+    system = _mixed_joints()
+    assert screw_columns(system) is not None
+    screw, fwd = compiled_derivatives(system), compiled_derivatives(system, forward_mode=True)
+    rng = np.random.default_rng(23)
+    n_terms = 6 * len(system.bodies) + 6
+    for _ in range(3):
+        y, yd, ydd, u = _state(system, rng)
+        a, b = screw.inverse(y, yd, ydd, u), fwd.inverse(y, yd, ydd, u)
+        for x, z in ((a.tau, b.tau), (a.tau_y, b.tau_y), (a.tau_yd, b.tau_yd),
+                     (a.tau_ydd, b.tau_ydd), (a.tau_u, b.tau_u)):
+            scale = max(np.abs(z).max(), np.abs(b.tau_ydd @ ydd).max(), 1.0)
+            assert np.abs(x - z).max() <= eval_tol(n_terms, scale)
+        fa, fb = screw.forward(y, yd, u), fwd.forward(y, yd, u)
+        for x, z in ((fa.ydd, fb.ydd), (fa.ydd_y, fb.ydd_y), (fa.ydd_yd, fb.ydd_yd),
+                     (fa.ydd_u, fb.ydd_u)):
+            assert np.abs(x - z).max() <= solve_tol(b.tau_ydd, max(np.abs(z).max(), 1.0))
