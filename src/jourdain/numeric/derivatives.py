@@ -96,12 +96,14 @@ class Derivatives:
         if b is None:
             f, nu = self.f, self.n_u
             p = parameter_vector(self.system, None)
-            b = SimpleNamespace(y=np.zeros(f), yd=np.zeros(f), ydd=np.zeros(f),
+            b = SimpleNamespace(f=f, nu=nu, y=np.zeros(f), yd=np.zeros(f), ydd=np.zeros(f),
                                 u=np.zeros(max(nu, 1)), p=p if p.size else np.zeros(1),
                                 inv=np.empty(f + 3 * f * f + f * nu),
                                 fwd=np.empty(f + 2 * f * f + f * nu))
             for k in ("y", "yd", "ydd", "u", "p", "inv", "fwd"):
                 setattr(b, k + "_at", getattr(b, k).ctypes.data)
+            b.inverse_fn = self.lib.jd_inverse_derivatives
+            b.forward_fn = self.lib.jd_forward_derivatives
             self._local.b = b
         return b
 
@@ -114,7 +116,8 @@ class Derivatives:
             copyto(b.yd, yd)
             if inverse:
                 copyto(b.ydd, ydd)
-            if self.n_u:
+            f, nu = b.f, b.nu
+            if nu:
                 if u is None:
                     return None
                 copyto(b.u, u)
@@ -123,11 +126,9 @@ class Derivatives:
             tv = float(t)
         except (ValueError, TypeError):
             return None
-        f, nu = self.f, self.n_u
         FF = f * f
         if inverse:
-            status = self.lib.jd_inverse_derivatives(b.y_at, b.yd_at, b.ydd_at, tv, b.p_at,
-                                                     b.u_at, b.inv_at)
+            status = b.inverse_fn(b.y_at, b.yd_at, b.ydd_at, tv, b.p_at, b.u_at, b.inv_at)
             if status:
                 return None
             o = b.inv.copy()
@@ -135,7 +136,7 @@ class Derivatives:
                                       tau_yd=o[f + FF:f + 2 * FF].reshape(f, f),
                                       tau_u=o[f + 2 * FF:f + 2 * FF + f * nu].reshape(f, nu),
                                       tau_ydd=o[f + 2 * FF + f * nu:].reshape(f, f))
-        status = self.lib.jd_forward_derivatives(b.y_at, b.yd_at, tv, b.p_at, b.u_at, b.fwd_at)
+        status = b.forward_fn(b.y_at, b.yd_at, tv, b.p_at, b.u_at, b.fwd_at)
         if status:
             return None
         o = b.fwd.copy()
