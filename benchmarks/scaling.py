@@ -20,9 +20,10 @@ memory history; :func:`benchmarks.crosscheck.spawn`) and measures, in this order
   (interleaved; the output array preallocated and touched once);
 * ``derive s``: the symbolic ``system.equations_of_motion()`` (not needed for the numbers
   above, which come from the compiled recursion; measured last so that it cannot warm them);
-* ``derive MB``: the resident memory the derivation added and holds (current RSS after it
-  minus before it: the equations M, k, q and their stages; the peak of a process that derives
-  only, and sympy's, are in ``benchmarks/derivation.py``);
+* ``derive MB``: the memory the derivation added and holds, the C heap in use after it minus
+  before it (glibc's mallinfo2; 0 without it): the expression graph of M, k, q and their
+  stages. The peak RSS of a process that derives only, and sympy's, are in
+  ``benchmarks/derivation.py``;
 * ``RSS MB``: the child's peak resident memory over everything, derivation included;
 * ``wall s``: the child's wall time, interpreter start-up and imports included.
 
@@ -63,18 +64,6 @@ def _rss_mb() -> float:
     import resource
 
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0  # Linux: kB
-
-
-def _current_rss_mb() -> float:
-    """The resident memory now (not the peak), from /proc/self/statm; 0 where there is none."""
-    import os
-
-    try:
-        with open("/proc/self/statm") as fh:
-            pages = int(fh.read().split()[1])
-    except (OSError, IndexError, ValueError):
-        return 0.0
-    return pages * os.sysconf("SC_PAGE_SIZE") / 2**20
 
 
 def _source_bytes() -> int:
@@ -126,11 +115,15 @@ def case(kind: str, n: int, seed: int = 0, n_states: int = 1000, repeat: int = 3
     best = interleaved({"batch": lambda: fn.batch(Y, YD, 0.0, p, None, out=buf),
                         "dynamics": lambda: fd.dynamics(Y, YD, 0.0, p, None)}, repeat)
     del res
-    rss_before = _current_rss_mb()
+    from benchmarks.derivation import _heap_mb
+
+    heap_before = _heap_mb()
     t0 = time.perf_counter()
     eom = system.equations_of_motion()
     t_derive = time.perf_counter() - t0
-    derive_mb = _current_rss_mb() - rss_before
+    heap_after = _heap_mb()
+    derive_mb = (0.0 if heap_before is None or heap_after is None
+                 else heap_after - heap_before)
     del eom
     return {"kind": kind, "n": n, "seed": seed, "f": f, "bodies": len(system.bodies),
             "import_s": t_import, "build_s": t_build, "first_s": t_first,
