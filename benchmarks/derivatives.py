@@ -87,21 +87,12 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from benchmarks.per_state import interleaved  # noqa: E402
+
 #: example-robot-data: path below robots/, floating base, expected f
 ROBOTS = {"panda": ("panda_description/urdf/panda.urdf", False, 7),
           "solo12": ("solo_description/robots/solo12.urdf", True, 18),
           "talos": ("talos_data/robots/talos_reduced.urdf", True, 38)}
-
-
-def interleaved(fns: dict[str, Callable[[], object]], rounds: int) -> dict[str, float]:
-    """Best wall time of each callable over ``rounds`` rounds that run them all in turn."""
-    best = dict.fromkeys(fns, math.inf)
-    for _ in range(rounds):
-        for name, fn in fns.items():
-            t0 = time.perf_counter()
-            fn()
-            best[name] = min(best[name], time.perf_counter() - t0)
-    return best
 
 
 def robots_dir() -> Path:
