@@ -17,6 +17,26 @@ os.environ["JOURDAIN_CACHE"] = _given or _temporary
 os.environ["JOURDAIN_PREBUILT"] = ""
 
 
+def pytest_configure(config: pytest.Config) -> None:
+    config.addinivalue_line(
+        "markers", "own_hash_seeds: the test starts child processes with PYTHONHASHSEEDs of "
+        "its own, so the suite's second pass under another seed (make test) adds nothing")
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list) -> None:
+    """Tests marked ``own_hash_seeds`` run once per ``make test``: in its first pass
+    (PYTHONHASHSEED=0) or where no seed is set, and are skipped, with the reason, in the
+    second."""
+    seed = os.environ.get("PYTHONHASHSEED", "")
+    if seed in ("", "0", "random"):
+        return
+    skip = pytest.mark.skip(reason="spawns its own PYTHONHASHSEEDs: runs in the pass with "
+                                   "PYTHONHASHSEED=0 (or none)")
+    for item in items:
+        if "own_hash_seeds" in item.keywords:
+            item.add_marker(skip)
+
+
 def pytest_unconfigure(config: pytest.Config) -> None:
     if _temporary:
         shutil.rmtree(_temporary, ignore_errors=True)

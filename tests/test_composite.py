@@ -178,6 +178,7 @@ print(" ".join(out))
 """
 
 
+@pytest.mark.own_hash_seeds
 def test_composite_bodies_are_the_same_in_every_process():
     """The composite-body equations, as the C source of their graph, are the same whatever
     PYTHONHASHSEED and the memory layout (nothing keyed or ordered by id or hash)."""

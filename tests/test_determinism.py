@@ -10,6 +10,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 CHILD = r"""
 import hashlib, json, sys
 import numpy as np
@@ -48,6 +50,7 @@ print(json.dumps(out))
 """
 
 
+@pytest.mark.own_hash_seeds
 def test_same_sources_and_numbers_in_fresh_processes(tmp_path):
     root = Path(__file__).resolve().parent.parent
     results = []
@@ -78,6 +81,7 @@ print(json.dumps(out))
 """
 
 
+@pytest.mark.own_hash_seeds
 def test_same_study_results_in_fresh_processes(tmp_path):
     """A grid map, a Monte-Carlo run (drawn from its seed, simulated) and critical values by
     bisection: every variable, coordinate and attribute of the datasets equal to the bit in

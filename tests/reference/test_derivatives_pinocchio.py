@@ -465,6 +465,7 @@ print(json.dumps(out))
 """
 
 
+@pytest.mark.own_hash_seeds
 def test_derivatives_bit_identical_in_fresh_processes(tmp_path):
     results = []
     for seed in ("0", "12345"):

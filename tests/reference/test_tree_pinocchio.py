@@ -124,6 +124,7 @@ def test_joint_conventions_match_pinocchio(kind, rng):
         _check(compare(system, model, index, y, yd), kind)
 
 
+@pytest.mark.own_hash_seeds
 @pytest.mark.parametrize("size", list(SIZES))
 def test_fresh_processes_agree_with_pinocchio_and_each_other(size, tmp_path):
     n, seed, f = SIZES[size]
