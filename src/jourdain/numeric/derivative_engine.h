@@ -199,7 +199,7 @@ static int jdd_inverse(const double *y, const double *yd, const double *ydd, dou
     for (long m = 0; m < JDD_NPD; ++m) D[jdd_pd_dst[m]] = L[JDD_NL + m];
     double scratch[JDD_SCRATCH];
     for (int i = 0; i < JDD_P; ++i) {
-        int lam = jdd_parent[i], ny = jdd_ny[i];
+        int lam = jdd_parent[i];
         const double *Lb = L + 40 * i;
         jdd_t A = jdd_at(X, D, i, JQ_PARTS, 0), d = jdd_at(X, D, i, JQ_PARTS, 9);
         jdd_t wb = jdd_at(X, D, i, JQ_PARTS, 12), vb = jdd_at(X, D, i, JQ_PARTS, 15);
@@ -219,7 +219,6 @@ static int jdd_inverse(const double *y, const double *yd, const double *ydd, dou
         jdd_t w = jdd_at(X, D, i, JQ_W, 0), v = jdd_at(X, D, i, JQ_V, 0);
         jdd_t al = jdd_at(X, D, i, JQ_AL, 0), a = jdd_at(X, D, i, JQ_A, 0);
         jdd_t P = jdd_at(X, D, i, JQ_P, 0), cc = jdd_at(X, D, i, JQ_CC, 0);
-        jdd_t Wc = jdd_at(X, D, i, JQ_WC, 0);
         /* temporaries: values t*, tangents in scratch (3 rows, both blocks: 3*(ny+nv)) */
         double tv[12][3];
         int span = 3 * (jdd_ny[i] + jdd_nv[i]);
@@ -268,7 +267,6 @@ static int jdd_inverse(const double *y, const double *yd, const double *ydd, dou
             jdd_t V = jdd_at(X, D, i, JQ_VCOLS, 6 * cl);
             jdd_axpy(ydd[jdd_col_coord[c]], V, P, 6);
         }
-        (void)ny;
         /* centre of mass c = r_O + S com; its acceleration with ÿ */
         jdd_mv(R, com, T[0], 0);                        /* cw */
         jdd_copy(o, cc, 3); jdd_axpy(1.0, T[0], cc, 3);
@@ -301,7 +299,6 @@ static int jdd_inverse(const double *y, const double *yd, const double *ydd, dou
         jdd_mv(R, T[11], T[0], 0);
         jdd_axpy(1.0, T[0], Wm, 3);
         jdd_copy(T[6], WF, 3);
-        (void)Wc;
     }
     /* sub-tree sums, children first; the derivatives each body brings in reach the columns
        above it; tau and the prefix derivatives at each body's own columns */
@@ -442,13 +439,11 @@ static int jdd_forward_with(const double *y, const double *yd, double t, const d
     if (status) return status;
     for (long i = 0; i < F; ++i) ydd[i] = q[i] - k[i];
     jdd_solve(M, ydd, JDD_F, 1);
-    double *tau = out + F, *ty = G, *tyd = G + FF, *tu = G + 2 * FF;
     /* tau_y, tau_yd, tau_u at ÿ, into scratch; then the columns −M⁻¹[τ_y τ_ẏ τ_u] */
     double *ty_s = out + F, *tyd_s = out + F + FF, *tu_s = out + F + 2 * FF;
     double tau_v[JDD_F];
     status = jdd_inverse(y, yd, ydd, t, p, u, tau_v, ty_s, tyd_s, tu_s, X, D);
     if (status) return status;
-    (void)tau; (void)ty; (void)tyd; (void)tu;
     for (long i = 0; i < F; ++i) {
         for (long j = 0; j < F; ++j) {
             G[i * NC + j] = -ty_s[i * F + j];

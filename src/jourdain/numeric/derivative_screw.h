@@ -199,7 +199,6 @@ static void jda_dynamics(const double *yd, const double *ydd, jda_work *W, int d
         int lam = jda_parent[i];
         if (lam >= 0) for (int r = 0; r < 6; ++r) W->F[6 * lam + r] += W->F[6 * i + r];
     }
-    (void)z6;
     for (int r = 0; r < JDA_F; ++r) tau[r] = -W->K[3 + r];  /* − the generalized forces */
     for (int j = 0; j < JDA_NC; ++j) {
         int i = jda_body[j];
