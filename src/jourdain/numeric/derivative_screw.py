@@ -26,7 +26,7 @@ import symengine as se
 from ..model.forces import GeneralizedForce, Gravity
 from ..model.joints import Rot, Trans
 from .ccode import HEADER, argument_names, function_source
-from .recursive import layout
+from .recursive import c_table, layout
 
 if TYPE_CHECKING:
     from ..model.system import System
@@ -128,16 +128,12 @@ def screw_source(system: System, cols: list[tuple[int, int]]) -> str:
              for e, x in enumerate(lay.exprs)]
     consts += function_source("jda_local", local, names)
 
-    def table(name: str, values: list[int]) -> str:
-        body = ", ".join(map(str, values)) if values else "0"
-        return f"static const int {name}[{max(len(values), 1)}] = {{{body}}};\n"
-
     head = (f"#define JDA_P {p}\n#define JDA_F {f}\n#define JDA_NU {nu}\n"
             f"#define JDA_NC {len(cols)}\n#define JDA_NL {len(lay.exprs)}\n"
             f"#define JDA_NK {3 + f + f * nu}\n"
-            + table("jda_parent", list(lay.parent))
-            + table("jda_body", [b for b, _ in cols])
-            + table("jda_coord", [c for _, c in cols])
-            + table("jda_pred", pred) + table("jda_vcol", vcol)
-            + table("jda_lcol", [lcol[c] for _, c in cols]))
+            + c_table("jda_parent", list(lay.parent))
+            + c_table("jda_body", [b for b, _ in cols])
+            + c_table("jda_coord", [c for _, c in cols])
+            + c_table("jda_pred", pred) + c_table("jda_vcol", vcol)
+            + c_table("jda_lcol", [lcol[c] for _, c in cols]))
     return HEADER + consts + head + SCREW + ENTRY

@@ -25,7 +25,7 @@ import symengine as se
 from ..errors import ModelError
 from ..graph import jet
 from .ccode import HEADER, argument_names, function_source
-from .recursive import BODY_BLOCK, COLUMN_BLOCK, layout
+from .recursive import BODY_BLOCK, COLUMN_BLOCK, c_table, layout
 
 if TYPE_CHECKING:
     from ..model.system import System
@@ -69,16 +69,6 @@ def _group(q: str, r: int) -> tuple[int, int]:
     if q == "COLS":
         return r - r % 3, 3
     return next(g for g in PART_GROUPS if g[0] <= r < g[0] + g[1])
-
-
-def _table(name: str, values: list[int]) -> str:
-    body = ", ".join(str(v) for v in values) if values else "0"
-    return f"static const int {name}[{max(len(values), 1)}] = {{{body}}};\n"
-
-
-def _ltable(name: str, values: list[int]) -> str:
-    body = ", ".join(str(v) for v in values) if values else "0"
-    return f"static const long {name}[{max(len(values), 1)}] = {{{body}}};\n"
 
 
 def derivative_layout(system: System) -> DerivativeLayout:
@@ -221,18 +211,18 @@ def derivative_layout(system: System) -> DerivativeLayout:
             f"#define JDD_NVAL {n_values}\n#define JDD_NX {n_values + n_local + len(partials)}\n"
             f"#define JDD_NTAN {max(n_tan, 1)}\n#define JDD_SCRATCH {max(scratch, 1)}\n"
             f"#if {nq} != 12\n#error quantities\n#endif\n"
-            + _table("jdd_parent", list(lay.parent))
-            + _table("jdd_col_start", col_start)
-            + _table("jdd_col_coord", [k for cs in lay.columns for k in cs])
-            + _table("jdd_col_rate", col_rate)
-            + _table("jdd_ny", [len(v) for v in vars_y])
-            + _table("jdd_nv", [len(v) for v in vars_v])
-            + _table("jdd_vars_y", flat_y) + _table("jdd_vars_y_start", starts_y)
-            + _table("jdd_vars_v", flat_v) + _table("jdd_vars_v_start", starts_v)
-            + _table("jdd_val", val_off) + _table("jdd_off", tan_off)
-            + _ltable("jdd_pd_dst", dst)
+            + c_table("jdd_parent", list(lay.parent))
+            + c_table("jdd_col_start", col_start)
+            + c_table("jdd_col_coord", [k for cs in lay.columns for k in cs])
+            + c_table("jdd_col_rate", col_rate)
+            + c_table("jdd_ny", [len(v) for v in vars_y])
+            + c_table("jdd_nv", [len(v) for v in vars_v])
+            + c_table("jdd_vars_y", flat_y) + c_table("jdd_vars_y_start", starts_y)
+            + c_table("jdd_vars_v", flat_v) + c_table("jdd_vars_v_start", starts_v)
+            + c_table("jdd_val", val_off) + c_table("jdd_off", tan_off)
+            + c_table("jdd_pd_dst", dst, "long")
             + f"#define JDD_NZERO {len(zero_off)}\n"
-            + _ltable("jdd_zero_off", zero_off) + _table("jdd_zero_len", zero_len)
-            + _table("jdd_live", live_flags) + _table("jdd_live_start", live_start))
+            + c_table("jdd_zero_off", zero_off, "long") + c_table("jdd_zero_len", zero_len)
+            + c_table("jdd_live", live_flags) + c_table("jdd_live_start", live_start))
     source = HEADER + parts + head + ENGINE + ENTRY
     return DerivativeLayout(tuple(vars_y), tuple(vars_v), source)

@@ -113,9 +113,10 @@ def _disjoint(columns: tuple[tuple[int, ...], ...]) -> bool:
     return len(flat) == len(set(flat))
 
 
-def _table(name: str, values: list[int]) -> str:
+def c_table(name: str, values: list[int], ctype: str = "int") -> str:
+    """A static C array of integers (one 0 where there are none: C has no empty arrays)."""
     body = ", ".join(str(v) for v in values) if values else "0"
-    return f"static const int {name}[{max(len(values), 1)}] = {{{body}}};\n"
+    return f"static const {ctype} {name}[{max(len(values), 1)}] = {{{body}}};\n"
 
 
 def recursive_units(system: System, full: bool = False, directions: tuple | None = None,
@@ -179,10 +180,10 @@ def _parts(system: System, full: bool, directions: tuple | None) -> tuple[str, s
             f"#define JD_ABA {1 if aba else 0}\n"
             # the work of the recursion on the stack when small (no malloc per evaluation)
             f"#define JD_WORK_STACK {1 if 8 * (58 * p + 6 * len(col_coord)) <= 65536 else 0}\n"
-            + _table("jd_parent", list(lay.parent))
-            + _table("jd_col_start", col_start)
-            + _table("jd_col_coord", col_coord)
-            + _table("jd_dir_start", dir_start if lay.directions else [0]))
+            + c_table("jd_parent", list(lay.parent))
+            + c_table("jd_col_start", col_start)
+            + c_table("jd_col_coord", col_coord)
+            + c_table("jd_dir_start", dir_start if lay.directions else [0]))
     return local, head + ENGINE.replace("/* LDL_SOLVE */\n", LDL_SOLVE), aba
 
 
