@@ -101,8 +101,8 @@ class ClosedDerivatives:
         return ev, evc, x0, s0, uv, tv, x_names
 
     def _steps(self, evc: GeneralEvaluator, x0: np.ndarray, s0: dict, uv: np.ndarray,
-               t: float, value: Any) -> tuple[np.ndarray, np.ndarray]:
-        """The complex-step derivatives of ``value(state)`` by x and by u."""
+               value: Any, n: int) -> tuple[np.ndarray, np.ndarray]:
+        """The complex-step derivatives of ``value(state)`` (``n`` numbers) by x and by u."""
         yref = np.asarray(s0["y"]).astype(complex)
         cols_x = []
         for j in range(len(x0)):
@@ -118,7 +118,6 @@ class ClosedDerivatives:
             evc.y_guess = yref.copy()
             evc.u = uc
             cols_u.append(np.imag(value(evc, x0.astype(complex))) / STEP)
-        n = len(np.atleast_1d(value(evc, x0.astype(complex))))
         return (np.array(cols_x).T.reshape(n, len(x0)),
                 np.array(cols_u).T.reshape(n, len(uv)))
 
@@ -126,8 +125,8 @@ class ClosedDerivatives:
                 parameters: Mapping[str, float] | None = None) -> ClosedForwardDerivatives:
         """``ẋ`` and its derivatives at the state given by the tree's ``y``, ``yd``."""
         ev, evc, x0, s0, uv, tv, x_names = self._setup(y, yd, u, t, parameters)
-        xd_x, xd_u = self._steps(evc, x0, s0, uv, tv,
-                                 lambda e, x: e.accelerations(x, tv)["xd"])
+        xd_x, xd_u = self._steps(evc, x0, s0, uv,
+                                 lambda e, x: e.accelerations(x, tv)["xd"], len(x0))
         return ClosedForwardDerivatives(x_names, x0, np.real(s0["xd"]), xd_x, xd_u,
                                         np.real(s0["y"]), np.real(s0["yd"]),
                                         np.real(s0["ydd"]))
@@ -147,7 +146,7 @@ class ClosedDerivatives:
             s = e.state(x, tv)
             return s["M"] @ zdv + s["k"] - s["q"]
 
-        tau_x, tau_u = self._steps(evc, x0, s0, uv, tv, tau)
+        tau_x, tau_u = self._steps(evc, x0, s0, uv, tau, g)
         M = np.real(s0["M"])
         return ClosedInverseDerivatives(x_names, x0,
                                         M @ zdv + np.real(s0["k"] - s0["q"]), tau_x, M, tau_u)
