@@ -89,6 +89,7 @@ def energy(kin: Kinematics) -> Energy:
     noncons: list[str] = []
     rates = {str(r) for r in yd}
     inputs = set(sys.input_names)
+    rows: dict[se.Basic, tuple[se.Basic, dict[se.Basic, se.Basic], str]] = {}
     for fe in sys.forces:
         if isinstance(fe, Gravity):
             for body in sys.bodies:
@@ -114,19 +115,13 @@ def energy(kin: Kinematics) -> Energy:
                 else:
                     V_terms.append(V)
                 continue
-            value = fe.value.subs({deflection: c, deflection_d: rate(c)})
-            damping = value.diff(rate(c))
-            spring = value.subs({rate(c): 0}) if damping != 0 else value
-            b = spring.diff(c)
-            names = free_names([spring])
-            linear = (not (free_names([b]) & (set(sys.coordinate_names) | rates | inputs | {"t"}))
-                      and not (names & (rates | inputs | {"t"}))
-                      and not (names & set(sys.coordinate_names) - {str(c)}))
-            if linear:
-                a = spring.subs({c: 0})
-                V_terms.append(-(a * c + se.Rational(1, 2) * b * c**2))
-            if not linear or damping != 0:
+            row = _linear_row(fe, sys, rates | inputs)
+            if row is None:
                 noncons.append(fe.name)
+            else:
+                rows[c], damped = (*row[:2], fe.name), row[2]
+                if damped:
+                    noncons.append(fe.name)
         elif isinstance(fe, Bushing):
             V = _bushing_potential(kin, fe, sys, rates | inputs)
             if V is None:
@@ -135,6 +130,9 @@ def energy(kin: Kinematics) -> Energy:
                 V_terms.append(V)
         elif isinstance(fe, Force | Torque):
             noncons.append(fe.name)
+    V_rows, unpaired = _linear_potential(rows)
+    V_terms.extend(V_rows)
+    noncons.extend(unpaired)
     rheonomic = False
     for body in sys.bodies:
         j = body.joint
@@ -145,6 +143,46 @@ def energy(kin: Kinematics) -> Energy:
             rheonomic = True
     V = se.Add(*V_terms) if V_terms else ZERO
     return Energy(kin, T, V, not noncons and not rheonomic, tuple(noncons), rheonomic)
+
+
+def _linear_row(fe: GeneralizedForce, sys: object, varying: set[str]
+                ) -> tuple[se.Basic, dict[se.Basic, se.Basic], bool] | None:
+    """A generalized force on a coordinate whose spring part (the value at zero rates) is
+    ``a + Σ_j B_j·y_j`` with constant a, B_j: (a, {y_j: B_j}, damped); None otherwise."""
+    c = fe.coordinate
+    value = fe.value.subs({deflection: c, deflection_d: rate(c)})
+    coords = sys.coordinates  # type: ignore[attr-defined]
+    rate_syms = [rate(y) for y in coords]
+    free = value.free_symbols
+    damped = any(r in free for r in rate_syms)
+    spring = value.subs({r: 0 for r in rate_syms if r in free}) if damped else value
+    names = free_names([spring])
+    if names & (varying | {"t"}):
+        return None
+    B = {y: spring.diff(y) for y in coords if y in spring.free_symbols}
+    if not all(_constant(b, sys, varying) for b in B.values()):
+        return None
+    a = spring.subs({y: 0 for y in B}) if B else spring
+    return a, B, damped
+
+
+def _linear_potential(rows: dict[se.Basic, tuple[se.Basic, dict[se.Basic, se.Basic], str]]
+                      ) -> tuple[list[se.Basic], list[str]]:
+    """``V = −Σ a_k·y_k − ½ Σ B_kj·y_k·y_j`` of the linear generalized forces ``rows``
+    (coordinate -> (a, {y_j: B_kj}, force name)) where B is symmetric among them (a spring
+    between coordinates, such as an elastic body's −K_e·q_e); the forces whose row has no
+    symmetric partner are returned by name, as non-conservative."""
+    terms: list[se.Basic] = []
+    bad: list[str] = []
+    for c, (a, B, name) in rows.items():
+        ok = all(y in rows and se.expand(rows[y][1].get(c, ZERO) - b) == 0
+                 for y, b in B.items())
+        if not ok:
+            bad.append(name)
+            continue
+        terms.append(-a * c)
+        terms.extend(-se.Rational(1, 2) * b * c * y for y, b in B.items())
+    return terms, bad
 
 
 def _point(kin: Kinematics, body: str, p: tuple) -> tuple:

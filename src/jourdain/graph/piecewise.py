@@ -135,3 +135,45 @@ def switches_at(switches: Sequence[Switch], values: Mapping[str, float],
     """:func:`check_switches` with :func:`jourdain.graph.evaluate_float` at ``values``
     (symbols without a value are not checked: the caller's evaluation reports them)."""
     check_switches(switches, lambda exprs: evaluate_float(exprs, values))
+
+
+_PIECEWISE_TYPES = (se.Max, se.Min, se.Abs, type(se.sign(se.Symbol("x"))))
+
+
+def _step(d: Any) -> Any:
+    """H(d) = (1 + sign(d))/2, the branch indicator, as an expression."""
+    return HALF + HALF * se.sign(d)
+
+
+def diff(e: Any, x: Any) -> Any:
+    """∂e/∂x, with ``max``, ``min``, ``abs`` and ``sign`` differentiated on their branches
+    (``∂max(a, b)/∂a = H(a − b)``, ``∂|a|/∂a = sign(a)``, ``∂sign(a)/∂a = 0``, H the step
+    ``(1 + sign)/2``): exact on either side of a switching point, where SymEngine's own
+    ``diff`` leaves an unevaluated ``Derivative`` (a prescribed motion ``Ω·max(t − T, 0)``)."""
+    pieces = [a for a in e.atoms(*_PIECEWISE_TYPES) if x in a.free_symbols]
+    if not pieces:
+        return se.diff(e, x)
+    # the outermost pieces: those inside no other piece
+    inner = {b for a in pieces for arg in a.args for b in arg.atoms(*_PIECEWISE_TYPES)}
+    outer = sorted((a for a in pieces if a not in inner), key=str)
+    dummies = [se.Dummy(f"pw{k}") for k in range(len(outer))]
+    back = dict(zip(dummies, outer, strict=True))
+    e_d = e.xreplace(dict(zip(outer, dummies, strict=True)))
+    total = se.diff(e_d, x)
+    for dummy, piece in zip(dummies, outer, strict=True):
+        args = piece.args
+        name = type(piece).__name__
+        if name == "sign":
+            continue
+        if name == "Abs":
+            d_piece = se.sign(args[0]) * diff(args[0], x)
+        else:
+            d_piece = se.Integer(0)
+            for k, a in enumerate(args):
+                coeff = ONE
+                for j, b in enumerate(args):
+                    if j != k:
+                        coeff = coeff * _step(a - b if name == "Max" else b - a)
+                d_piece = d_piece + coeff * diff(a, x)
+        total = total + se.diff(e_d, dummy) * d_piece
+    return total.xreplace(back)

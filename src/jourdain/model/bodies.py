@@ -238,3 +238,40 @@ def _axis_diag(axis: str, along: object, across: object, what: str) -> Mat3:
     d = [across, across, across]
     d["xyz".index(axis)] = along
     return _diag(*d)
+
+
+class BodyGroup:
+    """A body made of several of the method's bodies, such as an elastic body
+    (:class:`jourdain.elastic.ElasticBody`: its reference frame, the nodes that carry its mass,
+    the frames at which joints and forces attach). Listed among a :class:`~jourdain.System`'s
+    bodies, it is expanded there into its coordinates (appended to ``y`` unless listed),
+    bodies (in its place) and force elements (appended), by :meth:`expand`; the system keeps
+    the group itself in ``System.groups`` for the stages that draw or report it."""
+
+    name: str
+
+    def expand(self) -> tuple[tuple[se.Symbol, ...], tuple[Body, ...], tuple[object, ...]]:
+        """(coordinates, bodies, force elements) of the group."""
+        raise NotImplementedError
+
+
+def expand_groups(coordinates: tuple[se.Symbol, ...], bodies: Iterable[object],
+                  forces: Iterable[object]
+                  ) -> tuple[tuple[se.Symbol, ...], list[object], list[object],
+                             tuple[BodyGroup, ...]]:
+    """The coordinates, bodies and force elements of a system with its :class:`BodyGroup`\\ s
+    expanded (coordinates of a group appended unless already listed, in the group's order)."""
+    y = list(coordinates)
+    out: list[object] = []
+    extra: list[object] = []
+    groups: list[BodyGroup] = []
+    for b in bodies:
+        if not isinstance(b, BodyGroup):
+            out.append(b)
+            continue
+        cs, bs, fs = b.expand()
+        y.extend(c for c in cs if c not in y)
+        out.extend(bs)
+        extra.extend(fs)
+        groups.append(b)
+    return tuple(y), out, [*forces, *extra], tuple(groups)

@@ -14,7 +14,7 @@ from typing import Self
 import symengine as se
 
 from ..errors import ModelError
-from .bodies import Body
+from .bodies import Body, BodyGroup, expand_groups
 from .closing import ClosingJoint, grubler
 from .contacts import CONTACT_TYPES, Contact, check_linear
 from .expressions import as_expr, magnitude_problem, t
@@ -56,12 +56,14 @@ class System:
     ----------
     coordinates : sequence of symbols or names
         The generalized coordinates ``y`` (f of them). Their rates are named ``<name>_d``.
-    bodies : sequence of Body
+    bodies : sequence of Body or BodyGroup
         Each hangs from ``"world"`` or from another body through its joint. The order is kept:
         it is the order of :attr:`bodies`, of the body rows of M̄, J̄, q̄^c, q̄^e and of the
         joints in the reactions g. Every parent must come before its children (any such order
         is valid for the method); a child listed before its parent raises a ModelError naming
-        both and their positions.
+        both and their positions. A :class:`~jourdain.model.bodies.BodyGroup` (an elastic
+        body) is expanded in its place into its bodies; its coordinates join ``y`` (after
+        those given, unless listed) and its force elements the forces (:attr:`groups`).
     forces : sequence of force elements
         Gravity, Force, Torque, SpringDamper, GeneralizedForce (RotationalSpringDamper),
         Bushing. Their laws may use kinematic quantities
@@ -107,6 +109,7 @@ class System:
     contacts: tuple[Contact, ...] = ()
     speeds: tuple[tuple[str, se.Basic], ...] | None = None
     frictions: tuple[JointFriction, ...] = ()
+    groups: tuple[BodyGroup, ...] = ()
 
     def __init__(self, coordinates: Sequence[object] | str, bodies: Sequence[Body],
                  forces: Sequence[ForceElement | JointFriction] = (), parameters: Mapping[str, float] | None = None,
@@ -114,7 +117,8 @@ class System:
                  name: str = "system", closing: Sequence[ClosingJoint] = (),
                  independent: Sequence[str] | None = None, contacts: Sequence[Contact] = (),
                  speeds: Sequence[str] | Mapping[str, object] | None = None) -> None:
-        y = _symbol_list(coordinates, "coordinates")
+        y, bodies, forces, groups = expand_groups(_symbol_list(coordinates, "coordinates"),
+                                                  bodies, forces)
         u = _symbol_list(inputs, "inputs")
         params = dict(parameters or {})
         set_ = object.__setattr__
@@ -156,6 +160,7 @@ class System:
         set_(self, "independent", _independent(self, independent))
         set_(self, "speeds", _speeds(self, speeds))
         set_(self, "frictions", check_frictions(self, frictions))
+        set_(self, "groups", groups)
 
     def __hash__(self) -> int:
         """The hash of the fields, computed once: the memoized stages (``mkq_function(system)``
@@ -201,6 +206,7 @@ class System:
         if tree is None:
             tree = type(self)(self.coordinates, self.bodies, self.forces,
                               dict(self.parameters), self.inputs, dict(self.units), self.name)
+            object.__setattr__(tree, "groups", self.groups)
             object.__setattr__(self, "_tree", tree)
         return tree
 
@@ -209,11 +215,13 @@ class System:
         """This tree closed by the ``closing`` joints (a new system of the same class), with
         the ``independent`` coordinates chosen (else by the partition at the initial
         configuration)."""
-        return type(self)(self.coordinates, self.bodies, (*self.forces, *self.frictions),
-                          dict(self.parameters), self.inputs, dict(self.units),
-                          self.name if name is None else name,
-                          closing=(*self.closing, *closing), independent=independent,
-                          contacts=self.contacts, speeds=_speed_arg(self.speeds))
+        closed = type(self)(self.coordinates, self.bodies, (*self.forces, *self.frictions),
+                            dict(self.parameters), self.inputs, dict(self.units),
+                            self.name if name is None else name,
+                            closing=(*self.closing, *closing), independent=independent,
+                            contacts=self.contacts, speeds=_speed_arg(self.speeds))
+        object.__setattr__(closed, "groups", self.groups)
+        return closed
 
     def grubler(self) -> int:
         """Degrees of freedom by the Grübler–Kutzbach count (spatial: 6 per body), the tree's

@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 
 import symengine as se
 
+from ...graph.piecewise import diff as pw_diff
 from ...identity import IdentityMap
 from ...model.joints import IDENTITY, Joint, Mat3, Rot, Trans, Vec3, rotation_matrix
 
@@ -82,15 +83,15 @@ class _Rates:
         for sym in free:
             j = ctx.index.get(sym)
             if j is not None:
-                self.dy[j] = se.diff(s, sym)
-        self.dt = se.diff(s, ctx.t) if ctx.t in free else ZERO
+                self.dy[j] = pw_diff(s, sym)
+        self.dt = pw_diff(s, ctx.t) if ctx.t in free else ZERO
         self.d1 = sum((c * ctx.yd[j] for j, c in self.dy.items()), self.dt)
         # d²s/dt² without the ÿ terms: d/dt of ṡ at constant ÿ
-        d2 = se.diff(self.d1, ctx.t) if (ctx.t in free) else ZERO
+        d2 = pw_diff(self.d1, ctx.t) if (ctx.t in free) else ZERO
         for sym in free:
             j = ctx.index.get(sym)
             if j is not None:
-                d2 = d2 + se.diff(self.d1, sym) * ctx.yd[j]
+                d2 = d2 + pw_diff(self.d1, sym) * ctx.yd[j]
         self.d2_local = d2
 
     @property

@@ -1,0 +1,234 @@
+"""An elastic body in the method: the floating frame of reference with nodal masses.
+
+A material point of the body is at ``R = r + S·(c + u(c, q_e))``: ``r``, ``S`` are the body's
+reference frame, moved by its joint like any rigid body's frame, and ``u`` the elastic
+displacement from the elastic coordinates ``q_e`` (issue 36; Schwertassek & Wallrapp 1999).
+Here the body's mass sits at its nodes (lumped masses ``m_n``, point masses), each at
+
+    R_n = r + S·(c_n + Φ_t,n·q_e + ½·q_eᵀ·Ψ_n·q_e),
+
+with the modes' nodal translations ``Φ_t,n`` and, for beams, the foreshortening ``Ψ_n`` that
+carries the geometric stiffening (:mod:`jourdain.elastic.stiffening`). The body is expanded
+into the method's own bodies (:class:`jourdain.model.bodies.BodyGroup`):
+
+- ``<name>``: its reference frame (massless), hanging from the parent by the given joint;
+- ``<name>_n<k>``: one point mass per node with mass, on a General joint whose translation is
+  the node's position above (so every node's Jacobian columns carry the elastic coordinates);
+- ``<name>_<label>``: a massless frame at each node named in ``attach``, translated as the node
+  and turned by its small rotation ``θ_n = Φ_r,n·q_e`` (three elementary rotations), from which
+  joints and force elements of the rest of the model hang;
+- ``<name>_q<k>``: a massless carrier per elastic coordinate, displaced along the frame's x
+  axis by ``q_k``, on which the elastic forces ``−K_e·q_e − D_e·q̇_e`` act as generalized
+  forces (a force pair across the carrier's joint; J̄ᵀ projects it onto ``q_k`` alone).
+
+So M̄, J̄, q̄^c, q̄^e hold the body's nodes as rows; ``M = J̄ᵀ·M̄·J̄`` is the exact mass matrix of
+the discretized body (all orders in q_e, so energy is conserved exactly where the model is
+conservative), and every stage (reactions, linearization, simulation, FMU, reports) takes the
+body as it takes rigid ones. The invariants of the SID (m, m·c, J, C_t, C_r, M_e, ...) are the
+sums over these nodes (:func:`jourdain.elastic.modal.modal_data` of the lumped mass gives them;
+``tests/test_elastic_body.py`` checks that the projected M at q_e = 0 equals them). Left out:
+the nodes' rotary inertia (the sections' ρI, and with it the gyroscopic terms of a spinning
+shaft's own mass: a rotor's discs are rigid bodies at attachment frames); a body with many
+nodes costs in proportion to them, which the invariant form would not.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, replace
+
+import numpy as np
+import symengine as se
+
+from jourdain.elastic.beam import Beam, FEModel, assemble, frame_of_axis
+from jourdain.elastic.modal import ModalData
+from jourdain.elastic.reduction import modal_truncation
+from jourdain.elastic.stiffening import foreshortening
+from jourdain.errors import ModelError
+from jourdain.model.bodies import Body, BodyGroup
+from jourdain.model.forces import GeneralizedForce
+from jourdain.model.joints import General, Joint, Rot, Trans
+
+__all__ = ["ElasticBody", "lumped_masses"]
+
+_ZERO = se.Integer(0)
+
+
+def _num(x: float) -> se.Basic:
+    return _ZERO if x == 0.0 else se.RealDouble(float(x))
+
+
+def _linear(coefs: np.ndarray, q: Sequence[se.Symbol], const: float = 0.0,
+            quad: np.ndarray | None = None) -> se.Basic:
+    """const + Σ coefs_k·q_k (+ ½ Σ_jk quad_jk·q_j·q_k), zero coefficients left out."""
+    terms: list[se.Basic] = [] if const == 0.0 else [_num(const)]
+    terms += [_num(c) * qk for c, qk in zip(coefs, q, strict=True) if c != 0.0]
+    if quad is not None:
+        for j in range(len(q)):
+            for k in range(j, len(q)):
+                c = quad[j, k] * (0.5 if j == k else 1.0)
+                if c != 0.0:
+                    terms.append(_num(c) * q[j] * q[k])
+    return se.Add(*terms) if terms else _ZERO
+
+
+def lumped_masses(fe: FEModel) -> np.ndarray:
+    """The nodes' masses by HRZ lumping (Hinton, Rock & Zienkiewicz 1976): each node gets the
+    share of its translational diagonal entries of M in the sum of all of them, times the
+    body's mass (Γ_tᵀ·M·Γ_t), so the lumped body keeps its mass exactly."""
+    diag = np.asarray(fe.M.diagonal() if hasattr(fe.M, "diagonal") else np.diag(fe.M))
+    per_node = np.zeros(len(fe.nodes))
+    total = np.zeros(3)
+    counts = np.zeros(3)
+    for i, (node, name) in enumerate(fe.dofs):
+        if name in ("ux", "uy", "uz"):
+            per_node[node] += diag[i]
+            total[("ux", "uy", "uz").index(name)] += diag[i]
+            counts[("ux", "uy", "uz").index(name)] += 1
+    ones = np.zeros(fe.n)
+    mass = []
+    for k, name in enumerate(("ux", "uy", "uz")):
+        if counts[k]:
+            ones[:] = [1.0 if d[1] == name else 0.0 for d in fe.dofs]
+            mass.append(float(ones @ np.asarray(fe.M @ ones)))
+    m = float(np.mean(mass)) if mass else 0.0
+    s = per_node.sum()
+    if not s > 0:
+        raise ModelError(f"{fe.name}: the mass matrix has no translational mass to lump")
+    return per_node * (m / s)
+
+
+@dataclass(frozen=True, eq=False)
+class ElasticBody(BodyGroup):
+    """An elastic body (module docstring) hanging from ``parent`` by ``joint``.
+
+    ``modal`` gives the nodes, the modes' nodal translations and rotations (``Phi_t``,
+    ``Phi_r``), K_e and D_e; ``node_mass`` (one per node) the lumped masses; ``Psi``
+    (n_nodes, 3, n_q, n_q) the second-order field (geometric stiffening) or None;
+    ``attach`` maps labels to node indices for the frames ``<name>_<label>``. Build one from a
+    beam with :meth:`beam`.
+    """
+
+    name: str
+    parent: str
+    joint: Joint
+    modal: ModalData
+    node_mass: np.ndarray
+    Psi: np.ndarray | None = None
+    attach: tuple[tuple[str, int], ...] = ()
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not self.name.isidentifier():
+            raise ModelError(f"elastic body name {self.name!r} must be an identifier")
+        n = len(self.modal.nodes)
+        m = np.asarray(self.node_mass, dtype=float)
+        if m.shape != (n,) or not np.all(np.isfinite(m)) or np.any(m < 0) or not m.sum() > 0:
+            raise ModelError(f'elastic body "{self.name}": node_mass must be {n} finite '
+                             "non-negative masses, not all zero")
+        for label, node in self.attach:
+            if not (isinstance(label, str) and label.isidentifier()):
+                raise ModelError(f'elastic body "{self.name}": attachment label {label!r} must '
+                                 "be an identifier")
+            if not 0 <= int(node) < n:
+                raise ModelError(f'elastic body "{self.name}": attachment "{label}" at node '
+                                 f"{node}, but the body has nodes 0 … {n - 1}")
+        if self.Psi is not None and np.shape(self.Psi) != (n, 3, self.n_q, self.n_q):
+            raise ModelError(f'elastic body "{self.name}": Psi of shape {np.shape(self.Psi)}, '
+                             f"expected {(n, 3, self.n_q, self.n_q)}")
+
+    # value semantics (arrays compared by content, never by identity)
+    def _key(self) -> tuple:
+        arrays = (self.modal.nodes, self.modal.Phi, self.modal.K_e, self.modal.D_e,
+                  self.node_mass, self.Psi if self.Psi is not None else np.zeros(0))
+        return (self.name, self.parent, self.joint, self.attach,
+                tuple(np.ascontiguousarray(a, dtype=float).tobytes() for a in arrays))
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, ElasticBody) and self._key() == other._key()
+
+    def __hash__(self) -> int:
+        return hash(self._key())
+
+    @property
+    def n_q(self) -> int:
+        return self.modal.n_q
+
+    @property
+    def coordinates(self) -> tuple[se.Symbol, ...]:
+        return tuple(se.Symbol(f"{self.name}_q{k + 1}") for k in range(self.n_q))
+
+    def node_position(self, node: int) -> tuple[se.Basic, se.Basic, se.Basic]:
+        """The node's position in the body frame as expressions of q_e."""
+        q = self.coordinates
+        Pt = self.modal.Phi_t[node]
+        quad = None if self.Psi is None else self.Psi[node]
+        c = self.modal.nodes[node]
+        return tuple(_linear(Pt[i], q, float(c[i]), None if quad is None else quad[i])
+                     for i in range(3))  # type: ignore[return-value]
+
+    def expand(self) -> tuple[tuple[se.Symbol, ...], tuple[Body, ...], tuple[object, ...]]:
+        q = self.coordinates
+        qd = [se.Symbol(f"{s}_d") for s in q]
+        none = (0, 0, 0)
+        bodies = [Body(self.name, self.parent, self.joint, mass=0, inertia=none)]
+        for k, qk in enumerate(q):
+            bodies.append(Body(f"{self.name}_q{k + 1}", self.name,
+                               General(f"{self.name}_mode{k + 1}", [Trans("x", qk)],
+                                       coordinates=[qk]), mass=0, inertia=none))
+        for node, m in enumerate(np.asarray(self.node_mass, dtype=float)):
+            if m > 0:
+                bodies.append(Body(f"{self.name}_n{node}", self.name,
+                                   General(f"{self.name}_node{node}",
+                                           [Trans(vector=self.node_position(node))]),
+                                   mass=se.RealDouble(float(m)), inertia=none))
+        for label, node in self.attach:
+            theta = [_linear(self.modal.Phi_r[node][i], q) for i in range(3)]
+            steps: list[Rot | Trans] = [Trans(vector=self.node_position(node))]
+            steps += [Rot(axis, th) for axis, th in zip("xyz", theta, strict=True) if th != 0]
+            bodies.append(Body(f"{self.name}_{label}", self.name,
+                               General(f"{self.name}_{label}_node", steps), mass=0,
+                               inertia=none))
+        K, D = self.modal.K_e, self.modal.D_e
+        forces = [GeneralizedForce(f"{self.name}_elastic{k + 1}", qk,
+                                   -_linear(K[k], q) - _linear(D[k], qd))
+                  for k, qk in enumerate(q)]
+        return q, tuple(bodies), tuple(forces)
+
+    @classmethod
+    def beam(cls, name: str, parent: str, joint: Joint, beam: Beam, n_modes: int, *,
+             clamped: Iterable[int] = (0,), keep: Sequence[str] | None = None,
+             attach: Mapping[str, int] | None = None, stiffening: bool = True,
+             damping_ratio: float = 0.0) -> ElasticBody:
+        """A beam body: ``beam`` meshed (:func:`jourdain.elastic.beam.assemble`), its
+        ``n_modes`` lowest normal modes with the nodes ``clamped`` held in the reference frame
+        (the cantilever's modes for the default, node 0 at ``beam.origin``), node masses ρA
+        per length lumped at the nodes (:func:`lumped_masses`), modal damping ``damping_ratio``
+        (D_e = 2ζ·diag ω), and the foreshortening of :mod:`~jourdain.elastic.stiffening` when
+        ``stiffening``. ``keep`` (DOF names such as ``("uy", "rz")``) restricts the modes to
+        those DOFs, every other one held at every node: a beam bending in one plane only."""
+        fe = assemble(beam)
+        clamped = [int(c) for c in clamped]
+        fixed: list[int | tuple[int, str]] = list(clamped)
+        if keep is not None:
+            bad = sorted(set(keep) - {"ux", "uy", "uz", "rx", "ry", "rz"})
+            if bad:
+                raise ModelError(f'elastic body "{name}": unknown DOF names {bad} in keep')
+            fixed += [d for d in fe.dofs if d[1] not in keep and d[0] not in clamped]
+        if not clamped:
+            raise ModelError(f'elastic body "{name}": give the clamped nodes (the reference '
+                             "frame holds them); free-free beam bodies are not built here")
+        modal = modal_truncation(fe, n_modes, fixed=fixed)
+        if damping_ratio:
+            modal = _with_damping(modal, float(damping_ratio))
+        Psi = None
+        if stiffening:
+            R = frame_of_axis(beam.axis, beam.up)
+            Psi = foreshortening(modal.nodes, R, modal.Phi_t, modal.Phi_r, clamped[0])
+        return cls(name, parent, joint, modal, lumped_masses(fe), Psi,
+                   tuple((str(k), int(v)) for k, v in (attach or {}).items()))
+
+
+def _with_damping(modal: ModalData, zeta: float) -> ModalData:
+    if not (np.isfinite(zeta) and zeta >= 0):
+        raise ModelError(f"damping_ratio must be a finite number ≥ 0, got {zeta!r}")
+    return replace(modal, D_e=2.0 * zeta * np.diag(modal.omega) @ modal.M_e)

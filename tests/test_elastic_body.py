@@ -1,0 +1,172 @@
+"""Elastic bodies in the method (jourdain.elastic.body): the nodal floating frame of reference,
+checked against values computed outside it — the invariants of the modal data (another route
+to the same integrals), the cantilever's βL roots and the frequency equation with a tip mass,
+energy conservation, and the Kane–Ryan–Banerjee spin-up (bounded with geometric stiffening,
+diverging without).
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+import scipy.optimize as so
+import symengine as se
+
+import jourdain as jd
+from jourdain.elastic import Beam, assemble, modal_data
+from jourdain.elastic.body import ElasticBody, lumped_masses
+from jourdain.errors import ModelError
+from jourdain.graph.piecewise import diff as pw_diff
+from jourdain.model.joints import General, Rot
+
+L, E, RHO, A, I = 1.0, 2.1e11, 7850.0, 1e-4, 8.33e-10
+BETA_L = np.array([1.875104068711961, 4.694091132974175, 7.854757438237613])
+
+
+def _skew(v: np.ndarray) -> np.ndarray:
+    return np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
+
+
+def _cantilever(n_el: int, n_modes: int, tip_mass: float = 0.0) -> jd.System:
+    beam = Beam(length=L, E=E, rho=RHO, A=A, I_y=I, I_z=I, J=2 * I, nu=0.3, n_elements=n_el)
+    eb = ElasticBody.beam("b", "world", jd.Fixed("wall"), beam, n_modes, keep=("uy", "rz"),
+                          attach={"tip": n_el})
+    bodies: list[object] = [eb]
+    if tip_mass:
+        bodies.append(jd.Body("m", "b_tip", jd.Fixed("glue"), mass=tip_mass, inertia=[0, 0, 0]))
+    return jd.System([], bodies, [])
+
+
+def _frequencies(system: jd.System) -> np.ndarray:
+    lin = system.linearize({c: 0 for c in system.coordinate_names})
+    m = jd.modes(lin)
+    return np.sort(m.natural_frequencies[m.oscillating()])
+
+
+def test_projected_mass_is_the_modal_invariants() -> None:
+    """M = J̄ᵀM̄J̄ of the expanded body on a free joint, at q_e = 0, equals the SID block
+    [[m·E, m·c̃ᵀ, C_t], [m·c̃, J, C_r], [C_tᵀ, C_rᵀ, M_e]] that modal_data forms from the
+    lumped mass matrix (projections of M on the rigid-body fields): a skewed 3-D beam with
+    all six DOFs per node."""
+    beam = Beam(length=2.0, E=2e11, rho=7800.0, A=1e-3, I_y=2e-7, I_z=1e-7, J=3e-7, nu=0.3,
+                n_elements=6, axis=(1.0, 0.5, 0.2), origin=(0.1, 0.2, 0.3))
+    eb = ElasticBody.beam("arm", "world", jd.Free("base", ["x", "y", "z", "a", "b", "c"]),
+                          beam, 4)
+    system = jd.System(["x", "y", "z", "a", "b", "c"], [eb], [])
+    assert system.coordinate_names[6:] == ["arm_q1", "arm_q2", "arm_q3", "arm_q4"]
+    assert system.groups == (eb,)
+    M = system.evaluate(np.zeros(10), np.zeros(10))["M"]
+    fe = assemble(beam)
+    m_node = lumped_masses(fe)
+    assert m_node.sum() == pytest.approx(7800.0 * 1e-3 * 2.0, rel=1e-14)
+    M_lumped = np.diag([m_node[n] if d in ("ux", "uy", "uz") else 0.0 for n, d in fe.dofs])
+    md = modal_data(replace(fe, M=M_lumped), eb.modal.Phi, "lumped", ())
+    ref = np.block([[md.mass * np.eye(3), _skew(md.mc).T, md.C_t],
+                    [_skew(md.mc), md.J, md.C_r],
+                    [md.C_t.T, md.C_r.T, md.M_e]])
+    scale = np.abs(ref).max()
+    assert np.abs(M - ref).max() <= 100 * np.finfo(float).eps * scale
+
+
+def test_cantilever_frequencies_converge_at_the_lumped_rate() -> None:
+    """Bending frequencies of the clamped beam (the body on a fixed joint, linearized) against
+    β_nL = 1.875104, 4.694091, 7.854757: lumped masses converge like h² (the error falls by
+    4 per halving of the elements), from below."""
+    w0 = BETA_L**2 * np.sqrt(E * I / (RHO * A * L**4))
+    errors = [(_frequencies(_cantilever(n, 3))[:3] - w0) / w0 for n in (10, 20, 40)]
+    for e in errors:
+        assert np.all(e < 0)
+    order = np.log2(np.abs(errors[1]) / np.abs(errors[2]))
+    assert np.all((order > 1.9) & (order < 2.1)), order
+    assert np.abs(errors[2][0]) < 5e-4
+
+
+def test_tip_mass_at_an_attachment_frame() -> None:
+    """A point mass hung from the tip's attachment frame: the first frequency against the root
+    of 1 + cos x·cosh x + μ·x·(cos x·sinh x − sin x·cosh x) = 0 (μ = m_tip/(ρAL) = 0.5),
+    within the h² lumping error at 80 elements (≈ 7e-5 from the test above's rate)."""
+    mu = 0.5
+
+    def f(x: float) -> float:
+        return (1 + np.cos(x) * np.cosh(x)
+                + mu * x * (np.cos(x) * np.sinh(x) - np.sin(x) * np.cosh(x)))
+
+    x1 = so.brentq(f, 0.5, BETA_L[0])
+    w_ref = x1**2 * np.sqrt(E * I / (RHO * A * L**4))
+    w = _frequencies(_cantilever(80, 6, tip_mass=mu * RHO * A * L))[0]
+    assert abs(w - w_ref) / w_ref < 2e-4
+
+
+def test_flexible_pendulum_conserves_energy() -> None:
+    """An undamped beam pendulum in gravity (axial and in-plane bending modes, geometric
+    stiffening on): the elastic forces have the potential ½·q_eᵀ·K_e·q_e, so the energy is
+    conserved to the integrator's tolerance."""
+    beam = Beam(length=1.0, E=7e10, rho=2700.0, A=1e-4, I_y=1e-10, I_z=8.33e-11, J=1e-10,
+                nu=0.3, n_elements=8)
+    eb = ElasticBody.beam("arm", "world", jd.Revolute("pivot", "phi", "z"), beam, 3,
+                          keep=("ux", "uy", "rz"))
+    system = jd.System(["phi"], [eb], [jd.Gravity((0, -9.81, 0))])
+    rtol = 1e-10
+    r = system.simulate(t_span=(0, 2), y0=[0.5, 0, 0, 0], yd0=[0, 0, 0, 0], rtol=rtol,
+                        atol=1e-12)
+    assert r.conservative
+    E_tot = np.asarray(r.total_energy)
+    scale = np.abs(np.asarray(r.kinetic_energy)).max() + np.abs(E_tot).max()
+    assert np.abs(E_tot - E_tot[0]).max() <= 10 * rtol * scale
+    # it did bend: the modes moved
+    assert np.abs(np.asarray(r.y)[:, 1:]).max() > 1e-7
+
+
+def _spin_up(stiffening: bool, n_el: int = 10, n_modes: int = 3
+             ) -> tuple[ElasticBody, jd.System]:
+    """Kane, Ryan & Banerjee (1987): L = 10 m, ρA = 1.2 kg/m, EI = 1.4e4 N·m², spun up to
+    Ω_s = 6 rad/s over T_s = 15 s by a prescribed hub angle."""
+    t = se.Symbol("t")
+    Ws, Ts = 6.0, 15.0
+    tau = se.Min(t, Ts)
+    theta = ((Ws / Ts) * (tau**2 / 2 + (Ts / (2 * np.pi))**2 * (se.cos(2 * np.pi * tau / Ts) - 1))
+             + Ws * se.Max(t - Ts, 0))
+    beam = Beam(length=10.0, E=7e10, rho=3000.0, A=4e-4, I_y=2e-7, I_z=2e-7, J=4e-7, nu=0.3,
+                n_elements=n_el)
+    eb = ElasticBody.beam("beam", "world", General("hub", [Rot("z", theta)]), beam, n_modes,
+                          keep=("uy", "rz"), stiffening=stiffening)
+    return eb, jd.System([], [eb], [])
+
+
+def test_spin_up_bounded_only_with_geometric_stiffening() -> None:
+    """The hub outruns the first bending frequency (3.8 rad/s < 6 rad/s): with the
+    foreshortening the tip deflection stays below 1 m; the linear modal beam diverges."""
+    for stiffening in (True, False):
+        eb, system = _spin_up(stiffening)
+        r = system.simulate(t_span=(0, 20), y0=[0, 0, 0], yd0=[0, 0, 0], rtol=1e-8)
+        tip = np.asarray(r.y) @ eb.modal.Phi_t[-1, 1, :]
+        if stiffening:
+            assert np.abs(tip).max() < 1.0
+            assert np.abs(tip).max() > 0.1  # it did bend back under the spin-up
+        else:
+            assert np.abs(tip).max() > 100.0
+
+
+def test_piecewise_time_derivatives() -> None:
+    """∂/∂t of max/min/abs on either side of their switching points, against the branch's
+    own derivative (a prescribed motion such as Ω·max(t − T, 0))."""
+    t = se.Symbol("t")
+    e = se.Min(t, 15) ** 2 + 6 * se.Max(t - 15, 0) + se.Abs(se.sin(t))
+    d = pw_diff(e, t)
+    for tv, ref in ((3.0, 6.0 + np.cos(3.0) * np.sign(np.sin(3.0))),
+                    (16.0, 6.0 + np.cos(16.0) * np.sign(np.sin(16.0)))):
+        assert float(d.subs({t: tv})) == pytest.approx(ref, rel=1e-14)
+    assert "Derivative" not in str(pw_diff(pw_diff(e, t), t))
+
+
+def test_bad_elastic_body_input_is_named() -> None:
+    beam = Beam(length=1.0, E=E, rho=RHO, A=A, I_y=I, I_z=I, J=2 * I, nu=0.3, n_elements=4)
+    with pytest.raises(ModelError, match='"b": attachment "tip" at node 9'):
+        ElasticBody.beam("b", "world", jd.Fixed("wall"), beam, 2, attach={"tip": 9})
+    with pytest.raises(ModelError, match=r"unknown DOF names \['uq'\]"):
+        ElasticBody.beam("b", "world", jd.Fixed("wall"), beam, 2, keep=("uy", "uq"))
+    eb = ElasticBody.beam("b", "world", jd.Fixed("wall"), beam, 2)
+    with pytest.raises(ModelError, match="node_mass must be 5"):
+        ElasticBody("b", "world", jd.Fixed("wall"), eb.modal, np.ones(3))
