@@ -170,3 +170,38 @@ def test_bad_elastic_body_input_is_named() -> None:
     eb = ElasticBody.beam("b", "world", jd.Fixed("wall"), beam, 2)
     with pytest.raises(ModelError, match="node_mass must be 5"):
         ElasticBody("b", "world", jd.Fixed("wall"), eb.modal, np.ones(3))
+
+
+def test_model_file_elastic_body_equals_the_python_one() -> None:
+    """examples/spinning_beam.toml builds the same system as the Python API: equal M, k, q at
+    a state, and the file's settings count the elastic coordinates."""
+    from pathlib import Path
+
+    model = jd.load_model(Path(__file__).parent.parent / "examples" / "spinning_beam.toml")
+    _, ref = _spin_up(True)
+    assert model.system.coordinate_names == ref.coordinate_names
+    assert len(model.simulation.y0) == 3
+    y, yd = np.array([0.01, -0.002, 0.001]), np.array([0.1, 0.0, -0.05])
+    a, b = model.system.evaluate(y, yd, t=3.0), ref.evaluate(y, yd, t=3.0)
+    for key in ("M", "k", "q"):
+        assert np.allclose(a[key], b[key], rtol=1e-13, atol=1e-13 * np.abs(b[key]).max())
+
+
+def test_model_file_elastic_errors_name_the_line() -> None:
+    text = """
+[model]
+name = "bad"
+[bodies.arm]
+parent = "world"
+mass = 1.0
+joint = { type = "revolute", coordinate = "phi", axis = "z" }
+elastic = { modes = 2, beam = { length = 1.0, E = 7e10, rho = 2700.0, A = 1e-4, I_y = 1e-10, \
+I_z = 1e-10, J = 1e-10, nu = 0.3 } }
+[coordinates]
+phi = "rad"
+"""
+    with pytest.raises(jd.ModelFileError, match=r"bad.toml:6: .*elastic: its mass comes from"):
+        jd.io.modelfile.loads_model(text, "bad.toml")
+    text = text.replace("mass = 1.0\n", "").replace("E = 7e10", "E = -1")
+    with pytest.raises(jd.ModelFileError, match=r"Beam: E must be a positive"):
+        jd.io.modelfile.loads_model(text, "bad.toml")

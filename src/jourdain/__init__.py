@@ -53,6 +53,7 @@ if TYPE_CHECKING:  # the same names for type checkers and readers; at run time _
     from .analysis.reactions import evaluate_reactions, joint_reactions
     from .analysis.state_space import state_space
     from .analysis.sweep import sweep
+    from .elastic.body import ElasticBody
     from .equilibrium import Equilibrium, NoEquilibrium, find_equilibria, find_equilibrium
     from .errors import (
         AssemblyError,
@@ -153,6 +154,7 @@ _WHERE: dict[str, tuple[str, ...]] = {
     "equilibrium": ("Equilibrium", "NoEquilibrium", "find_equilibria", "find_equilibrium"),
     "errors": ("AssemblyError", "ClosedSystemError", "EvaluationError", "JourdainError",
         "JourdainWarning", "ModelError", "SingularConfiguration", "SingularMassMatrix"),
+    "elastic.body": ("ElasticBody",),
     "io": ("ModelFile", "ModelFileError", "load_model"),
     "io.casadi": ("CasadiDynamics", "to_casadi"),
     "io.urdf": ("load_urdf",),
@@ -213,7 +215,7 @@ __all__ = [
     "Gravity", "Force", "Torque", "SpringDamper", "GeneralizedForce", "RotationalSpringDamper",
     "Bushing", "JointFriction", "rate", "acceleration", "elongation", "elongation_d", "deflection",
     "deflection_d",
-    "ClosingJoint", "RollingDisc", "KnifeEdge", "VelocityConstraint",
+    "ClosingJoint", "RollingDisc", "KnifeEdge", "VelocityConstraint", "ElasticBody",
     "Quantity", "position", "velocity", "point_acceleration", "angular_velocity",
     "relative_position", "relative_velocity", "distance", "distance_rate",
     # functions for expressions in models (SymEngine's)

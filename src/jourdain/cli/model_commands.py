@@ -19,9 +19,10 @@ EXIT_OK = 0
 
 def cmd_check(args: argparse.Namespace) -> int:
     model = load(args.model)
-    if has_capability("reactions"):
+    if has_capability("reactions") and not model.system.groups:
         # the joints' constrained directions must satisfy the orthogonality J̄ᵀQ̄ = 0, joint by
-        # joint and assembled (the numeric reactions' own checks, without the symbolic N̂)
+        # joint and assembled (the numeric reactions' own checks, without the symbolic N̂);
+        # an elastic body's reactions are not formed (jourdain.stages.reactions.checks)
         try:
             check_reactions(model.system.tree)  # the closing joints' rows: loop_summary
         except JourdainError as exc:

@@ -164,7 +164,7 @@ class ElasticBody(BodyGroup):
         quad = None if self.Psi is None else self.Psi[node]
         c = self.modal.nodes[node]
         return tuple(_linear(Pt[i], q, float(c[i]), None if quad is None else quad[i])
-                     for i in range(3))  # type: ignore[return-value]
+                     for i in range(3))
 
     def expand(self) -> tuple[tuple[se.Symbol, ...], tuple[Body, ...], tuple[object, ...]]:
         q = self.coordinates

@@ -111,14 +111,15 @@ class System:
     frictions: tuple[JointFriction, ...] = ()
     groups: tuple[BodyGroup, ...] = ()
 
-    def __init__(self, coordinates: Sequence[object] | str, bodies: Sequence[Body],
-                 forces: Sequence[ForceElement | JointFriction] = (), parameters: Mapping[str, float] | None = None,
+    def __init__(self, coordinates: Sequence[object] | str,
+                 bodies: Sequence[Body | BodyGroup],
+                 forces: Sequence[ForceElement | JointFriction | object] = (), parameters: Mapping[str, float] | None = None,
                  inputs: Sequence[object] | str = (), units: Mapping[str, str] | None = None,
                  name: str = "system", closing: Sequence[ClosingJoint] = (),
                  independent: Sequence[str] | None = None, contacts: Sequence[Contact] = (),
                  speeds: Sequence[str] | Mapping[str, object] | None = None) -> None:
-        y, bodies, forces, groups = expand_groups(_symbol_list(coordinates, "coordinates"),
-                                                  bodies, forces)
+        y, body_list, force_list, groups = expand_groups(
+            _symbol_list(coordinates, "coordinates"), bodies, forces)
         u = _symbol_list(inputs, "inputs")
         params = dict(parameters or {})
         set_ = object.__setattr__
@@ -141,16 +142,15 @@ class System:
             pvals.append((k, fv))
         set_(self, "parameters", tuple(pvals))
         set_(self, "units", tuple((str(k), str(v)) for k, v in (units or {}).items()))
-        bodies = list(bodies)
-        for b in bodies:
+        for b in body_list:
             if not isinstance(b, Body):
                 raise ModelError(f"bodies: expected Body objects, got {type(b).__name__} {b!r}")
-        forces, frictions = split_frictions(list(forces))
+        forces, frictions = split_frictions(force_list)
         for f in forces:
             if not isinstance(f, Gravity | Force | Torque | SpringDamper | GeneralizedForce
                               | Bushing):
                 raise ModelError(f"forces: expected force elements, got {type(f).__name__} {f!r}")
-        set_(self, "bodies", parents_first(bodies))
+        set_(self, "bodies", parents_first(body_list))  # type: ignore[arg-type]
         set_(self, "forces", tuple(forces))
         set_(self, "quantities", tuple(quantities_in(
             [e for f in forces for e in force_expressions(f)]).values()))

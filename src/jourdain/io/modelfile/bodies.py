@@ -32,15 +32,15 @@ from ...model.bodies import mass_data_problem, planar_inertia
 from ...model.forces import _axes
 from ...model.joints import orientation_problem
 from ..toml_positions import Path, line_of
+from .elastic import _Elastic
 from .errors import ModelFileError, _type_name
 from .schema import _JOINT_COMMON, _JOINT_KEYS, _SHAPES
-from .values import _Values
 
 #: the planar inertia: the moment about the plane's normal alone (jourdain.planar_inertia)
 _PLANAR = {"planar": {"moment", "axis"}}
 
 
-class _Bodies(_Values):
+class _Bodies(_Elastic):
     # --- bodies ---------------------------------------------------------------------------
     def read_bodies(self, data: dict) -> list[Body]:
         path: Path = ("bodies",)
@@ -54,8 +54,11 @@ class _Bodies(_Values):
             if bname == WORLD:
                 raise self.fail((*path, bname), '"world" is the inertial frame, not a body name')
         self.body_names = list(tbl)
+        made_by = self.attachment_names(tbl)
+        self.body_names += list(made_by)
         bodies = [self.read_body(bname, spec) for bname, spec in tbl.items()]
         parents = {b.name: b.parent for b in bodies}
+        parents.update({frame: body for frame, body in made_by.items()})
         for b in bodies:
             seen = [b.name]
             while parents.get(seen[-1], WORLD) != WORLD:
@@ -67,7 +70,8 @@ class _Bodies(_Values):
                 seen.append(nxt)
         # the bodies keep the file's order (the rows of the equations follow it), so a child
         # written before its parent is an error here as in the Python API
-        position = {name: k for k, name in enumerate(self.body_names)}
+        position = {name: k for k, name in enumerate(tbl)}
+        position.update({frame: position[body] for frame, body in made_by.items()})
         for k, b in enumerate(bodies):
             if b.parent != WORLD and position[b.parent] > k:
                 line = line_of(self.lines, (*path, b.parent))
@@ -80,7 +84,8 @@ class _Bodies(_Values):
 
     def read_body(self, bname: str, spec: object) -> Body:
         p: Path = ("bodies", bname)
-        spec = self.table(spec, p, {"parent", "joint", "mass", "com", "inertia", "description"})
+        spec = self.table(spec, p, {"parent", "joint", "mass", "com", "inertia", "description",
+                                    "elastic"})
         parent = self.string(self.require(spec, "parent", p), (*p, "parent"))
         if parent != WORLD and parent not in self.body_names:
             others = [b for b in self.body_names if b != bname]  # a body is not its own parent
@@ -89,6 +94,11 @@ class _Bodies(_Values):
                             + (f" or one of the bodies {', '.join(others)}" if others else ""))
         if parent == bname:
             raise self.fail((*p, "parent"), "a body cannot be its own parent")
+        if "elastic" in spec:
+            joint = self.joint(self.require(spec, "joint", p), (*p, "joint"), bname)
+            if "description" in spec:
+                self.descriptions[bname] = self.string(spec["description"], (*p, "description"))
+            return self.read_elastic(bname, spec, parent, joint)
         params = set(self.params)
         ctx = "mass data (parameters only)"
         mass = self.expr(self.require(spec, "mass", p), (*p, "mass"), params, ctx)

@@ -14,6 +14,7 @@ from typing import Any
 import symengine as se
 
 from ...errors import JourdainError, ModelError
+from ...model.bodies import Body
 from ...model.expressions import magnitude_problem
 from ...pipeline import System  # jourdain.System: the model with its stages (issue 16)
 from ...simulation.simulate import (
@@ -75,6 +76,9 @@ class _Loader(_Forces):
         self.read_inputs(data)
         self.check_names()
         bodies = self.read_bodies(data)
+        for b in bodies:  # an elastic body's coordinates, for the forces and the settings
+            self.coords.extend(str(c) for c in getattr(b, "coordinates", ())
+                               if not isinstance(b, Body) and str(c) not in self.coords)
         self.read_quantities(data)
         forces = self.read_forces(data)
         try:
@@ -103,6 +107,11 @@ class _Loader(_Forces):
 
     def read_coordinates(self, data: dict) -> None:
         path: Path = ("coordinates",)
+        bodies = data.get("bodies")
+        elastic = isinstance(bodies, dict) and any(isinstance(b, dict) and "elastic" in b
+                                                   for b in bodies.values())
+        if "coordinates" not in data and elastic:  # the elastic coordinates may be all
+            return
         if "coordinates" not in data:
             raise self.missing("missing table [coordinates] (the generalized coordinates)")
         coords = data["coordinates"]
@@ -124,7 +133,7 @@ class _Loader(_Forces):
                 self.units[cname] = self.line_string(spec["unit"], (*p, "unit"))
             if "description" in spec:
                 self.descriptions[cname] = self.string(spec["description"], (*p, "description"))
-        if not self.coords:
+        if not self.coords and not elastic:
             raise self.fail(path, "the model needs at least one coordinate")
 
     def read_parameters(self, data: dict) -> None:
