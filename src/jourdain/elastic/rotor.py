@@ -72,7 +72,9 @@ class Rotor:
 def rotor(shaft: Beam, discs: Sequence[Disc] = (), bearings: Sequence[Bearing] = ()) -> Rotor:
     """The rotor of ``shaft`` with ``discs`` and ``bearings`` (module docstring)."""
     fe = assemble(shaft)
-    M, K, G = fe.dense("M"), fe.dense("K"), fe.dense("G")
+    # copies: the discs and bearings go into the rotor's matrices, not the shaft's (dense()
+    # hands out the FE model's own array where it is dense)
+    M, K, G = (fe.dense(x).copy() for x in ("M", "K", "G"))
     C = np.zeros_like(M)
     R = frame_of_axis(shaft.axis, shaft.up)
     n_nodes = len(fe.nodes)
