@@ -43,9 +43,11 @@ import symengine as se
 from jourdain.elastic.beam import Beam, FEModel, assemble, frame_of_axis
 from jourdain.elastic.modal import ModalData
 from jourdain.elastic.reduction import modal_truncation
+from jourdain.elastic.rotor import Bearing, Disc, rotor
 from jourdain.elastic.stiffening import foreshortening
 from jourdain.errors import ModelError
 from jourdain.model.bodies import Body, BodyGroup
+from jourdain.model.expressions import as_expr
 from jourdain.model.forces import GeneralizedForce
 from jourdain.model.joints import General, Joint, Rot, Trans
 
@@ -116,6 +118,8 @@ class ElasticBody(BodyGroup):
     node_mass: np.ndarray
     Psi: np.ndarray | None = None
     attach: tuple[tuple[str, int], ...] = ()
+    node_inertia: np.ndarray | None = None
+    spin: tuple[tuple[float, float, float], se.Basic] | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name.isidentifier():
@@ -132,6 +136,23 @@ class ElasticBody(BodyGroup):
             if not 0 <= int(node) < n:
                 raise ModelError(f'elastic body "{self.name}": attachment "{label}" at node '
                                  f"{node}, but the body has nodes 0 … {n - 1}")
+        if self.node_inertia is not None:
+            I_n = np.asarray(self.node_inertia, dtype=float)
+            if I_n.shape != (n, 3, 3) or not np.all(np.isfinite(I_n)):
+                raise ModelError(f'elastic body "{self.name}": node_inertia must be {n} finite '
+                                 "3×3 tensors")
+            if self.spin is not None:
+                a = np.asarray(self.spin[0], dtype=float)
+                a = a / np.linalg.norm(a)
+                P = np.eye(3) - np.outer(a, a)
+                for k, Ik in enumerate(I_n):  # axisymmetric about the spin axis
+                    scale = max(float(np.abs(Ik).max()), 1e-300)
+                    side = P @ Ik @ P
+                    iso = np.trace(side) / 2 * P
+                    if (np.abs(Ik @ a - (a @ Ik @ a) * a).max() > 1e-12 * scale
+                            or np.abs(side - iso).max() > 1e-12 * scale):
+                        raise ModelError(f'elastic body "{self.name}": node {k}\'s inertia is '
+                                         "not axisymmetric about the spin axis")
         if self.Psi is not None and np.shape(self.Psi) != (n, 3, self.n_q, self.n_q):
             raise ModelError(f'elastic body "{self.name}": Psi of shape {np.shape(self.Psi)}, '
                              f"expected {(n, 3, self.n_q, self.n_q)}")
@@ -139,8 +160,9 @@ class ElasticBody(BodyGroup):
     # value semantics (arrays compared by content, never by identity)
     def _key(self) -> tuple:
         arrays = (self.modal.nodes, self.modal.Phi, self.modal.K_e, self.modal.D_e,
-                  self.node_mass, self.Psi if self.Psi is not None else np.zeros(0))
-        return (self.name, self.parent, self.joint, self.attach,
+                  self.node_mass, self.Psi if self.Psi is not None else np.zeros(0),
+                  self.node_inertia if self.node_inertia is not None else np.zeros(0))
+        return (self.name, self.parent, self.joint, self.attach, self.spin,
                 tuple(np.ascontiguousarray(a, dtype=float).tobytes() for a in arrays))
 
     def __eq__(self, other: object) -> bool:
@@ -175,24 +197,52 @@ class ElasticBody(BodyGroup):
             bodies.append(Body(f"{self.name}_q{k + 1}", self.name,
                                General(f"{self.name}_mode{k + 1}", [Trans("x", qk)],
                                        coordinates=[qk]), mass=0, inertia=none))
+        inertia = self.node_inertia
         for node, m in enumerate(np.asarray(self.node_mass, dtype=float)):
-            if m > 0:
+            I_n = None if inertia is None or not np.any(inertia[node]) else inertia[node]
+            if m > 0 or I_n is not None:
+                steps: list[Rot | Trans] = [Trans(vector=self.node_position(node))]
+                if I_n is not None:  # the section turns with the node (and spins)
+                    steps += self._rotations(node)
+                    if self.spin is not None:
+                        steps.append(Rot(self.spin[0], self.spin[1]))
                 bodies.append(Body(f"{self.name}_n{node}", self.name,
-                                   General(f"{self.name}_node{node}",
-                                           [Trans(vector=self.node_position(node))]),
-                                   mass=se.RealDouble(float(m)), inertia=none))
+                                   General(f"{self.name}_node{node}", steps),
+                                   mass=_num(float(m)),
+                                   inertia=none if I_n is None else
+                                   [[_num(float(x)) for x in row] for row in I_n]))
         for label, node in self.attach:
-            theta = [_linear(self.modal.Phi_r[node][i], q) for i in range(3)]
-            steps: list[Rot | Trans] = [Trans(vector=self.node_position(node))]
-            steps += [Rot(axis, th) for axis, th in zip("xyz", theta, strict=True) if th != 0]
+            frame: list[Rot | Trans] = [Trans(vector=self.node_position(node))]
+            frame += self._rotations(node)
             bodies.append(Body(f"{self.name}_{label}", self.name,
-                               General(f"{self.name}_{label}_node", steps), mass=0,
+                               General(f"{self.name}_{label}_node", frame), mass=0,
                                inertia=none))
         K, D = self.modal.K_e, self.modal.D_e
         forces = [GeneralizedForce(f"{self.name}_elastic{k + 1}", qk,
                                    -_linear(K[k], q) - _linear(D[k], qd))
                   for k, qk in enumerate(q)]
         return q, tuple(bodies), tuple(forces)
+
+    def _rotations(self, node: int) -> list[Rot | Trans]:
+        """The node's small rotation θ = Φ_r·q_e as elementary rotations about x, y, z."""
+        q = self.coordinates
+        theta = [_linear(self.modal.Phi_r[node][i], q) for i in range(3)]
+        return [Rot(axis, th) for axis, th in zip("xyz", theta, strict=True) if th != 0]
+
+    @classmethod
+    def rotor(cls, name: str, parent: str, joint: Joint, shaft: Beam, n_modes: int, *,
+              spin: object, discs: Sequence[Disc] = (), bearings: Sequence[Bearing] = (),
+              attach: Mapping[str, int] | None = None) -> ElasticBody:
+        """A flexible rotor: the ``shaft`` (along a body axis) with rigid ``discs`` and
+        linear ``bearings`` (:mod:`jourdain.elastic.rotor`), its frame held by ``joint`` (not
+        spinning), the shaft's material spinning by the angle ``spin`` (an expression such as
+        ``Omega*t``). The basis: the ``n_modes`` lowest bending modes of the rotor on its
+        bearings at rest (K_e, D_e with the bearings, cross-coupled terms kept). Each node
+        carries its lumped mass (shaft ρA and discs) and a section that turns with the node's
+        small rotation and spins: the lumped shaft inertia ρ·(I_p, I_y, I_z) per length and
+        the discs' (I_p, I_d, I_d), so the gyroscopic terms come from the method itself."""
+        return _rotor_body(cls, name, parent, joint, shaft, discs, bearings, n_modes, spin,
+                           attach)
 
     @classmethod
     def beam(cls, name: str, parent: str, joint: Joint, beam: Beam, n_modes: int, *,
@@ -226,6 +276,46 @@ class ElasticBody(BodyGroup):
             Psi = foreshortening(modal.nodes, R, modal.Phi_t, modal.Phi_r, clamped[0])
         return cls(name, parent, joint, modal, lumped_masses(fe), Psi,
                    tuple((str(k), int(v)) for k, v in (attach or {}).items()))
+
+
+def _rotor_body(cls: type[ElasticBody], name: str, parent: str, joint: Joint, shaft: Beam,
+                discs: Sequence[Disc], bearings: Sequence[Bearing], n_modes: int, spin: object,
+                attach: Mapping[str, int] | None) -> ElasticBody:
+    """:meth:`ElasticBody.rotor`."""
+    r = rotor(shaft, discs, bearings)
+    R = frame_of_axis(shaft.axis, shaft.up)
+    k = int(np.argmax(np.abs(R[:, 0])))
+    if not np.isclose(abs(R[k, 0]), 1.0, rtol=0, atol=1e-12):
+        raise ModelError(f'elastic body "{name}": a rotor\'s shaft must lie along a body axis '
+                         f"(x, y or z), got {shaft.axis}")
+    keep = {f"u{a}" for a in "xyz" if a != "xyz"[k]} | {f"r{a}" for a in "xyz" if a != "xyz"[k]}
+    fe = replace(r.fe, M=r.M, K=r.K, D=r.C, G=r.G)
+    fixed = [d for d in fe.dofs if d[1] not in keep]
+    # the Ritz basis: normal modes of the symmetric part at rest (bearings in K); K_e and D_e
+    # keep the cross-coupled bearings' skew parts (modal_data would symmetrize them)
+    sym = replace(fe, K=0.5 * (r.K + r.K.T), D=None, G=None)
+    modal = modal_truncation(sym, n_modes, fixed=fixed)
+    Phi = modal.Phi
+    modal = replace(modal, K_e=Phi.T @ r.K @ Phi, D_e=Phi.T @ r.C @ Phi,
+                    G_e=Phi.T @ r.G @ Phi)
+    mass = lumped_masses(r.fe)
+    n = len(fe.nodes)
+    inertia = np.zeros((n, 3, 3))
+    share = np.zeros(n)
+    le = shaft.length / int(shaft.n_elements)
+    share[:-1] += le / 2
+    share[1:] += le / 2
+    Id = shaft.rho * np.array([shaft.polar, shaft.I_y if shaft.rotary_inertia else 0.0,
+                               shaft.I_z if shaft.rotary_inertia else 0.0])
+    for node in range(n):
+        inertia[node] = share[node] * (R @ np.diag(Id) @ R.T)
+    for d in discs:
+        mass[d.node] += d.m
+        inertia[d.node] += R @ np.diag([d.Ip, d.Id, d.Id]) @ R.T
+    axis = tuple(float(x) for x in R[:, 0])
+    return cls(name, parent, joint, modal, mass, None,
+               tuple((str(a), int(v)) for a, v in (attach or {}).items()),
+               inertia, (axis, as_expr(spin, f'elastic body "{name}" spin')))  # type: ignore[arg-type]
 
 
 def _with_damping(modal: ModalData, zeta: float) -> ModalData:

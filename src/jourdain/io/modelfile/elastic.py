@@ -11,7 +11,9 @@
 The beam's data are numbers (the modes are computed from them once). Optional keys:
 ``clamped`` (nodes held by the frame, default ``[0]``), ``keep`` (the DOF names the modes use),
 ``attach`` (label -> node: the frames ``<name>_<label>`` other bodies and forces use),
-``stiffening`` (geometric stiffening, default true) and ``damping_ratio``. jourdain.elastic
+``stiffening`` (geometric stiffening, default true) and ``damping_ratio``. A rotor has
+``spin`` (the shaft's angle, ``"Omega*t"``), ``discs`` (``{ node, m, Id, Ip }``) and
+``bearings`` (``{ node, k_yy, k_zz, k_yz, k_zy, c_yy, ... }``) instead. jourdain.elastic
 (SciPy's sparse eigensolvers) is imported only for files that have such a body.
 """
 
@@ -23,7 +25,10 @@ from ...errors import ModelError
 from ..toml_positions import Path
 from .values import _Values
 
-_ELASTIC_KEYS = {"beam", "modes", "clamped", "keep", "attach", "stiffening", "damping_ratio"}
+_ELASTIC_KEYS = {"beam", "modes", "clamped", "keep", "attach", "stiffening", "damping_ratio",
+                 "spin", "discs", "bearings"}
+_DISC_KEYS = {"node", "m", "Id", "Ip"}
+_BEARING_KEYS = {"node", "k_yy", "k_zz", "k_yz", "k_zy", "c_yy", "c_zz", "c_yz", "c_zy"}
 _BEAM_NUMBERS = ("length", "E", "rho", "A", "I_y", "I_z", "J", "G", "nu", "kappa", "I_p")
 _BEAM_KEYS = {*_BEAM_NUMBERS, "n_elements", "axis", "origin", "rotary_inertia"}
 
@@ -80,6 +85,12 @@ class _Elastic(_Values):
             self.name(label, (*p, "attach", label), "attachment")
         stiffening = self.flag(el.get("stiffening", True), (*p, "stiffening"))
         zeta = self.number(el.get("damping_ratio", 0.0), (*p, "damping_ratio"))
+        if "spin" in el:
+            return self.read_rotor(bname, el, parent, joint, kw, modes, attach)
+        for key in ("discs", "bearings"):
+            if key in el:
+                raise self.fail((*p, key), f"{key} belong to a rotor: give its spin as well "
+                                '(spin = "Omega*t")')
         try:
             beam = Beam(**kw)
             return ElasticBody.beam(bname, parent, joint, beam, modes, clamped=clamped,
@@ -88,6 +99,42 @@ class _Elastic(_Values):
         except ModelError as exc:
             where = bp if str(exc).startswith("Beam") else p
             raise self.fail(where, str(exc)) from None
+
+    def read_rotor(self, bname: str, el: dict, parent: str, joint: Any, kw: dict[str, Any],
+                   modes: int, attach: dict[str, int]) -> Any:
+        """A flexible rotor (:meth:`jourdain.elastic.ElasticBody.rotor`): ``spin`` (the shaft's
+        angle, an expression of parameters and t), ``discs`` and ``bearings`` (arrays of
+        tables with numbers)."""
+        from ...elastic.beam import Beam
+        from ...elastic.body import ElasticBody
+        from ...elastic.rotor import Bearing, Disc
+
+        p: Path = ("bodies", bname, "elastic")
+        for key in ("clamped", "keep", "stiffening", "damping_ratio"):
+            if key in el:
+                raise self.fail((*p, key), f"a rotor (with spin) takes no {key}: its modes are "
+                                "the bending modes on its bearings")
+        spin = self.expr(el["spin"], (*p, "spin"), set(self.params) | {"t"},
+                         "the shaft's spin angle (parameters and t)")
+        parts: dict[str, list[Any]] = {"discs": [], "bearings": []}
+        for key, keys, cls in (("discs", _DISC_KEYS, Disc), ("bearings", _BEARING_KEYS,
+                                                              Bearing)):
+            for i, item in enumerate(self.list_of(el.get(key, []), (*p, key))):
+                tbl = self.table(item, (*p, key, i), keys)
+                vals = {k: self.number(v, (*p, key, i, k), integer=k == "node")
+                        for k, v in tbl.items() if k != "node"}
+                node = int(self.number(self.require(tbl, "node", (*p, key, i)),
+                                       (*p, key, i, "node"), integer=True))
+                try:
+                    parts[key].append(cls(node, **vals))
+                except TypeError as exc:
+                    raise self.fail((*p, key, i), f"{key[:-1]}: {exc}") from None
+        try:
+            return ElasticBody.rotor(bname, parent, joint, Beam(**kw), modes, spin=spin,
+                                     discs=parts["discs"], bearings=parts["bearings"],
+                                     attach=attach)
+        except ModelError as exc:
+            raise self.fail(p, str(exc)) from None
 
     def flag(self, value: object, path: Path) -> bool:
         if not isinstance(value, bool):

@@ -11,6 +11,7 @@ import numpy as np
 from ...errors import JourdainError
 from ...workflow import has_capability
 from .. import capabilities
+from .campbell import campbell_section
 from .figures import Figures, eigen_plot, multiplier_plot
 from .html import SYM, esc, headline_lin, html_table, mathml, matrix_table, note, numstr, snap
 from .state import Run
@@ -104,6 +105,8 @@ def linearization_section(run: Run) -> str:
                 s.append(f"<p>Stability: <span class='{cls}'>{esc(st.verdict)}</span> — "
                          f"{esc(st.reason)}</p>")
                 info.summary_lines.append(f"  about {nominal.name}: {st.verdict}")
+            if m is not None and res["time_invariant"]:  # a rotor's speed: its Campbell diagram
+                s.append(campbell_section(run, nominal.name, res["linearization"]))
             lj = capabilities.jsonable(res)
             fn_ = out / f"linearization-{nominal.name}.json"
             fn_.write_text(json.dumps(lj, indent=1), encoding="utf-8")
