@@ -83,12 +83,13 @@ def _frequencies(lam: np.ndarray) -> np.ndarray:
     return out
 
 
-def _critical(lin: Any, name: str, values: np.ndarray, freqs: np.ndarray) -> list[float]:
+def _critical(lin: Any, name: str, values: np.ndarray, freqs: np.ndarray,
+              params: dict[str, float]) -> list[float]:
     """Speeds where a frequency branch (k-th ascending) crosses the 1× line."""
     out: list[float] = []
 
     def branch(v: float, k: int) -> float:
-        f = _frequencies(sweep(lin, name, [v]).eigenvalues)[0]
+        f = _frequencies(sweep(lin, name, [v], parameters=params).eigenvalues)[0]
         return float(f[k] - v) if k < len(f) else float("nan")
 
     for k in range(freqs.shape[1]):
@@ -115,15 +116,16 @@ def campbell_section(run: Run, nominal: str, lin: Any) -> str:
     value = float(run.params.get(name, system.parameter_values[name]))
     top = 2.0 * abs(value) or 1.0
     values = np.linspace(0.0, top, POINTS)
+    params = {k: float(v) for k, v in run.params.items() if k != name}
     try:
-        sw = sweep(lin, name, values)
+        sw = sweep(lin, name, values, parameters=params)
         freqs = _frequencies(sw.eigenvalues)
-        critical = _critical(lin, name, values, freqs)
+        critical = _critical(lin, name, values, freqs, params)
         bounds = []
         for i in range(len(values) - 1):
             if (sw.verdicts[i] == UNSTABLE) != (sw.verdicts[i + 1] == UNSTABLE):
                 bounds.append(stability_boundary(lin, name, float(values[i]),
-                                                 float(values[i + 1])))
+                                                 float(values[i + 1]), parameters=params))
     except JourdainError as exc:
         run.info.notes.append(f"Campbell diagram about {nominal}: {exc}")
         return note(f"the Campbell diagram over {name} is not available: {exc}")

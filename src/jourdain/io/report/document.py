@@ -31,6 +31,7 @@ from .equations import (
     equations_section,
     set_pending,
 )
+from .elastic import elastic_html
 from .figures import Figures, prepare_worker
 from .html import CSS, esc, note
 from .linearization import linearization_section, nominal_placeholder
@@ -48,7 +49,7 @@ def compute_sections(run: Run, sections: list[str], display: Future[Display] | N
     their data files (so that an interruption leaves the sections finished before it). The
     symbolic display (section 2) is ``run.display`` (from the cache), else the worker's
     ``display``, else computed here in turn."""
-    sections.append(model_section(run))
+    sections.append(model_section(run) + elastic_html(run))
     if run.model.system.is_general:  # velocity constraints: numbers in z, steady motions
         sections.append(rolling.equations_section(run))
         sections.append(rolling.numbers_section(run))

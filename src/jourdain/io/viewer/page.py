@@ -86,8 +86,9 @@ def page(sc: Mapping[str, Any]) -> str:
                     for n in sc.get("notes", []))
     help_ = (f"<div class='jv-help'>{name}: bodies as {shape} (same mass and principal "
              "inertia, at the centre of mass) or meshes; triads: body frames (x red, y green, "
-             "z blue), fainter ones the joint frames; purple lines: spring-dampers. Drag to "
-             "orbit, wheel to zoom, right-drag to pan.</div>")
+             "z blue), fainter ones the joint frames; purple lines: spring-dampers"
+             + ("; dark blue lines: elastic bodies through their nodes" if sc.get("elastic")
+                else "") + ". Drag to orbit, wheel to zoom, right-drag to pan.</div>")
     speeds = "".join(f"<option value='{s}'{' selected' if s == '1' else ''}>{s}×</option>"
                      for s in ("0.1", "0.25", "0.5", "1", "2", "4"))
     return ("<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"

@@ -119,6 +119,11 @@ def _camera(motion: np.ndarray, points: np.ndarray, up: np.ndarray
     return center, extent, d, ground
 
 
+def _node_index(name: str) -> int:
+    """k of an elastic body's node body ``<body>_n<k>``."""
+    return int(name.rsplit("_n", 1)[1])
+
+
 def scene(results: Results, visuals: Any = None,
           shape: str = "box", max_frames: int | None = None) -> dict[str, Any]:
     """The scene of the page as a JSON-ready dict (``"format": "jourdain-view/1"``): bodies
@@ -162,9 +167,14 @@ def scene(results: Results, visuals: Any = None,
     mmax = max((m for m, _, _, _ in raw), default=0.0)
 
     budget = [MAX_TRIANGLES]
+    # an elastic body's mass nodes: small beads on its line (viewer.js joins them)
+    beads = {f"{g.name}_n{k}" for g in getattr(system, "groups", ())
+             for k in range(len(getattr(g, "node_mass", ())))}
     for i, (b, (m, com, sides, V)) in enumerate(zip(system.bodies, raw, strict=True)):
         if m <= 0:
             kind, size = "none", np.zeros(3)
+        elif b.name in beads:
+            kind, size = "sphere", np.full(3, 0.012 * L)
         elif sides.max() <= 1e-9 * L:  # a point mass: volume by mass
             kind = "sphere"
             size = np.full(3, max(0.06 * L * (m / mmax) ** (1 / 3), 0.02 * L))
@@ -203,11 +213,15 @@ def scene(results: Results, visuals: Any = None,
                                         ).tolist(),
                         "point_b": _vec(c.point_b, values, f'closing joint "{c.name}" point_b'
                                         ).tolist()})
+    names = {b.name for b in system.bodies}
+    elastic = [{"name": g.name, "nodes": [n for n in sorted(beads & names, key=_node_index)
+                                          if n.startswith(f"{g.name}_n")]}
+               for g in getattr(system, "groups", ())]
     poses = np.concatenate([r, quaternions(S)], axis=-1)  # (n, p, 7)
     return {"format": SCENE_FORMAT, "name": system.name, "n_frames": int(len(times)),
             "times": _b64(times, "<f8"), "poses": _b64(poses.reshape(-1), "<f4"),
             "bodies": bodies, "world_visuals": world_visuals, "springs": springs,
-            "closing": closing,
+            "closing": closing, "elastic": elastic,
             "up": up.tolist(),
             "center": center.tolist(), "extent": float(L), "view_dir": view_dir.tolist(),
             "distance": float(distance), "ground": ground.tolist(), "notes": notes,

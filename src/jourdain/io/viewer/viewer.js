@@ -4,7 +4,8 @@
  * three.js (the global JD3 of three_bundle.js): one group per body, placed at each time by the
  * body frame's inertial position r_O and orientation S (as a quaternion), with the body's
  * equivalent box or ellipsoid (or its visuals) and a triad of the body frame inside it, a triad of
- * each joint frame fixed to the parent, and the spring-dampers as lines between their points;
+ * each joint frame fixed to the parent, and the spring-dampers as lines between their points
+ * (an elastic body: its nodes joined by a line that bends with it);
  * a closed system's closing joints: red lines from each body's origin to its point, a marker.
  *
  * Poses: a Float32Array (base64) of n_frames × n_bodies × 7 numbers (x, y, z, qx, qy, qz, qw);
@@ -180,6 +181,19 @@
   if (closing.length) world.add(closeLines);
   var ZERO = [0, 0, 0];
 
+  // elastic bodies: their nodes joined in order (the deflected line, moving with the modes)
+  var elastic = [];
+  (scene.elastic || []).forEach(function (e) {
+    for (var k = 0; k + 1 < e.nodes.length; k++) elastic.push([e.nodes[k], e.nodes[k + 1]]);
+  });
+  var elasticGeo = new T.BufferGeometry();
+  var elasticPos = new Float32Array(6 * Math.max(elastic.length, 1));
+  elasticGeo.setAttribute("position", new T.BufferAttribute(elasticPos, 3));
+  var elasticLines = new T.LineSegments(elasticGeo,
+                                        new T.LineBasicMaterial({ color: 0x1f3b73 }));
+  elasticLines.frustumCulled = false;
+  if (elastic.length) world.add(elasticLines);
+
   function springPoint(body, p, out, k) {
     pa.fromArray(p);
     if (body !== "world") pa.applyMatrix4(groups[body].matrixWorld);
@@ -225,6 +239,11 @@
       springPoint(s.body_b, s.point_b, springPos, 6 * n + 3);
     });
     springGeo.attributes.position.needsUpdate = true;
+    elastic.forEach(function (e, n) {
+      springPoint(e[0], ZERO, elasticPos, 6 * n);
+      springPoint(e[1], ZERO, elasticPos, 6 * n + 3);
+    });
+    elasticGeo.attributes.position.needsUpdate = true;
     closing.forEach(function (c, n) {
       var o = 18 * n;
       springPoint(c.body_a, ZERO, closePos, o);
