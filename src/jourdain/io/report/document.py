@@ -22,6 +22,7 @@ from ..interrupted import LATE, deaf_to_ctrl_c, write_text
 from ..modelfile import ModelFile
 from ..workers import fork_workers, ignore_interrupt
 from . import loops, rolling
+from .elastic import elastic_html
 from .equations import (
     Display,
     cached,
@@ -31,7 +32,6 @@ from .equations import (
     equations_section,
     set_pending,
 )
-from .elastic import elastic_html
 from .figures import Figures, prepare_worker
 from .html import CSS, esc, note
 from .linearization import linearization_section, nominal_placeholder
