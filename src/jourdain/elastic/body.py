@@ -223,6 +223,10 @@ class ElasticBody(BodyGroup):
                   for k, qk in enumerate(q)]
         return q, tuple(bodies), tuple(forces)
 
+    def internal_joints(self) -> tuple[str, ...]:
+        _, bodies, _ = self.expand()
+        return tuple(b.joint.name for b in bodies if b.name != self.name)
+
     def _rotations(self, node: int) -> list[Rot | Trans]:
         """The node's small rotation θ = Φ_r·q_e as elementary rotations about x, y, z."""
         q = self.coordinates

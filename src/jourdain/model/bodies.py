@@ -254,6 +254,11 @@ class BodyGroup:
         """(coordinates, bodies, force elements) of the group."""
         raise NotImplementedError
 
+    def internal_joints(self) -> tuple[str, ...]:
+        """The joints inside the group (moved by its shared coordinates: no joint reactions
+        of their own); its other joints, such as the one it hangs from, are ordinary."""
+        return ()
+
 
 def expand_groups(coordinates: tuple[se.Symbol, ...], bodies: Iterable[object],
                   forces: Iterable[object]

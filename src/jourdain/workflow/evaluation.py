@@ -82,9 +82,12 @@ def evaluate_all(model: Any, y: np.ndarray, yd: np.ndarray, t: float,
     if error:
         missing.update({k: f"the reaction forces could not be formed: {error}"
                         for k in REACTION_NAMES})
+    why = extra.get("reactions_note")  # elastic bodies: g of the ordinary joints only
     for k in REACTION_NAMES:
         if k not in values and k not in missing:
-            missing[k] = "the reaction forces are not available yet in this version of jourdain"
+            missing[k] = (f"not formed: {why}" if why else
+                          "the reaction forces are not available yet in this version of "
+                          "jourdain")
     try:
         values.update(linearization_at(model, y, yd, t, parameters, inputs))
     except NotAvailable as exc:
