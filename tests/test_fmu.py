@@ -405,3 +405,19 @@ def test_cli(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["fmu", model, "--out", str(out), "--force", "--set", "m_b=-1"]) == 1
     capsys.readouterr()
     shutil.rmtree(tmp_path, ignore_errors=True)
+
+
+@needs_cc
+def test_elastic_body_against_jourdain(tmp_path: Path) -> None:
+    """An FMU of a model with an elastic body (the flexible pendulum: its elastic coordinates
+    are states like any other) against jourdain's simulation of the same model."""
+    mf = load_model(str(ROOT / "examples" / "flexible_pendulum.toml"))
+    info = export_fmu(mf, tmp_path / "flexible_pendulum.fmu")
+    T = 1.0
+    y0 = [0.8, 0.0, 0.0, 0.0]
+    ref = _reference(mf, T, 101, y0, [0.0] * 4)
+    names = mf.system.coordinate_names
+    r = simulate_fmu(str(info.path), fmi_type="CoSimulation", stop_time=T, output_interval=0.01,
+                     relative_tolerance=FMU_RTOL, output=names)
+    got = np.column_stack([r[n] for n in names])
+    assert np.abs(got - ref.y).max() < TRAJ_TOL
