@@ -64,6 +64,10 @@ def campbell_plot(values: np.ndarray, freqs: np.ndarray, unstable: np.ndarray, n
     for c in critical:
         ax.axvline(c, color="C2", linewidth=0.8, linestyle=":")
     top = float(np.nanmax(freqs)) if freqs.size else 1.0
+    # the frequencies that matter for the speeds shown: up to 2.5× the top speed (the rest,
+    # of stiff modes far above, would squeeze the crossings into the bottom of the plot)
+    if values[-1] > 0:
+        top = min(top, 2.5 * float(values[-1]))
     ax.set_ylim(0.0, 1.05 * max(top, 1e-12))
     ax.set_xlabel(f"{name} / (rad/s)")
     ax.set_ylabel("|Im λ| / (rad/s)")
