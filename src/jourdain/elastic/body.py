@@ -234,6 +234,26 @@ class ElasticBody(BodyGroup):
         return [Rot(axis, th) for axis, th in zip("xyz", theta, strict=True) if th != 0]
 
     @classmethod
+    def from_fe(cls, name: str, parent: str, joint: Joint, fe: FEModel, n_modes: int, *,
+                clamped: Iterable[int | tuple[int, str]] = (0,),
+                attach: Mapping[str, int] | None = None,
+                damping_ratio: float = 0.0) -> ElasticBody:
+        """An elastic body from any finite-element model (:func:`jourdain.elastic.fe_model`:
+        M and K as arrays, SciPy sparse matrices or MatrixMarket files, with node
+        coordinates): its ``n_modes`` lowest normal modes with the ``clamped`` nodes (or
+        ``(node, dof)`` pairs) held by the frame, the mass lumped at the nodes by HRZ
+        (:func:`lumped_masses`). No geometric stiffening (it needs a beam's axis)."""
+        clamped = list(clamped)
+        if not clamped:
+            raise ModelError(f'elastic body "{name}": give the clamped nodes (the reference '
+                             "frame holds them)")
+        modal = modal_truncation(fe, n_modes, fixed=clamped)
+        if damping_ratio:
+            modal = _with_damping(modal, float(damping_ratio))
+        return cls(name, parent, joint, modal, lumped_masses(fe), None,
+                   tuple((str(k), int(v)) for k, v in (attach or {}).items()))
+
+    @classmethod
     def rotor(cls, name: str, parent: str, joint: Joint, shaft: Beam, n_modes: int, *,
               spin: object, discs: Sequence[Disc] = (), bearings: Sequence[Bearing] = (),
               attach: Mapping[str, int] | None = None) -> ElasticBody:
