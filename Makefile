@@ -83,6 +83,9 @@ bench: $(BIN)/.installed
 	$(BIN)/python benchmarks/rolling.py --quick
 	$(BIN)/python benchmarks/per_call.py --repeat 50
 	$(BIN)/python benchmarks/setup.py --quick
+	mkdir -p build
+	$(BIN)/python benchmarks/peers.py --tiny --json build/peers.json
+	$(BIN)/python benchmarks/elastic.py --tiny --json build/elastic.json
 
 # the 3-D view's three.js bundle (src/jourdain/io/viewer/three_bundle.js, committed): rebuilt from
 # the npm versions pinned in tools/viewer/package-lock.json; needs node and npm, nothing else does
