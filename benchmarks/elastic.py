@@ -115,44 +115,24 @@ TINY = {"modes": 4, "n_el": 6, "trials": 1, "speeds": 5, "rounds": 1, "spin_roun
 
 # ------------------------------------------------------------------------------- the models
 
-def _shaft_section() -> tuple[float, float, float]:
-    """Area, second moment and Cowper's shear factor of the hollow shaft."""
-    A = math.pi * (OD**2 - ID**2) / 4
-    I = math.pi * (OD**4 - ID**4) / 64  # noqa: E741 - the second moment of area
-    m2 = (ID / OD) ** 2
-    kappa = 6 * (1 + NU) * (1 + m2) ** 2 / ((7 + 6 * NU) * (1 + m2) ** 2 + (20 + 12 * NU) * m2)
-    return A, I, kappa
-
-
 def _discs_and_bearings(n_el: int) -> tuple[list[tuple], list[dict]]:
-    """(node, m, Id, Ip) of the two discs and the bearings' coefficients, at the nodes of an
-    ``n_el``-element mesh (a multiple of 6: the discs at a third and two thirds)."""
-    k = n_el // 6
-    discs = [(2 * k, 32.59, 0.17809, 0.32956), (4 * k, 25.0, 0.12, 0.2)]
-    bearings = [{"node": 0, "k_yy": 1e6, "k_zz": 8e5, "k_yz": 2e5, "k_zy": -1e5, "c_yy": 300.0,
-                 "c_zz": 200.0},
-                {"node": n_el, "k_yy": 1.5e6, "k_zz": 7e5, "c_yy": 150.0, "c_zz": 250.0}]
-    return discs, bearings
+    """(node, m, Id, Ip) of the two discs and the bearings' coefficients of
+    :func:`jourdain.models.elastic.rotor_parts` (ROSS's own test rotor), for ROSS."""
+    from jourdain.models.elastic import rotor_parts
+
+    discs, bearings = rotor_parts(n_el)
+    return ([(d.node, d.m, d.Id, d.Ip) for d in discs],
+            [{"node": b.node, "k_yy": b.k_yy, "k_zz": b.k_zz, "k_yz": b.k_yz, "k_zy": b.k_zy,
+              "c_yy": b.c_yy, "c_zz": b.c_zz} for b in bearings])
 
 
 def jourdain_rotor(n_el: int, n_modes: int) -> Any:
     """The flexible rotor as an elastic body of the method, spinning by ``Omega*t``
-    (examples/flexible_rotor.toml with ``n_modes`` modes)."""
-    import symengine as se
+    (:func:`jourdain.models.elastic.flexible_rotor`: examples/flexible_rotor.toml with
+    ``n_modes`` modes)."""
+    from jourdain.models.elastic import flexible_rotor
 
-    import jourdain as jd
-    from jourdain.elastic import Beam
-    from jourdain.elastic.body import ElasticBody
-    from jourdain.elastic.rotor import Bearing, Disc
-
-    A, I, kappa = _shaft_section()
-    beam = Beam(length=LENGTH, E=E_STEEL, rho=RHO_STEEL, A=A, I_y=I, I_z=I, J=2 * I, nu=NU,
-                kappa=kappa, n_elements=n_el, axis=(0.0, 0.0, 1.0))
-    discs, bearings = _discs_and_bearings(n_el)
-    body = ElasticBody.rotor("shaft", "world", jd.Fixed("mount"), beam, n_modes,
-                             spin=se.Symbol("Omega") * jd.t, discs=[Disc(*d) for d in discs],
-                             bearings=[Bearing(**b) for b in bearings])
-    return jd.System([], [body], [], parameters={"Omega": OMEGA})
+    return flexible_rotor(n_el, n_modes, OMEGA)
 
 
 def ross_rotor(rs: Any, n_el: int) -> Any:
@@ -170,26 +150,12 @@ def ross_rotor(rs: Any, n_el: int) -> Any:
 
 
 def spin_up(n_el: int, n_modes: int) -> tuple[Any, Any]:
-    """The Kane–Ryan–Banerjee spin-up (examples/spinning_beam.toml; tests/test_elastic_body.py):
-    L = 10 m, ρA = 1.2 kg/m, EI = 1.4e4 N·m², the hub spun up to 6 rad/s over 15 s by a
-    prescribed angle; in-plane bending modes with geometric stiffening."""
-    import symengine as se
+    """The Kane–Ryan–Banerjee spin-up (:func:`jourdain.models.elastic.spinning_beam`:
+    examples/spinning_beam.toml) with geometric stiffening: (its elastic body, the system)."""
+    from jourdain.models.elastic import spinning_beam
 
-    import jourdain as jd
-    from jourdain.elastic import Beam
-    from jourdain.elastic.body import ElasticBody
-    from jourdain.model.joints import General, Rot
-
-    t = jd.t
-    Ws, Ts = 6.0, 15.0
-    tau = se.Min(t, Ts)
-    theta = ((Ws / Ts) * (tau**2 / 2 + (Ts / (2 * np.pi))**2 * (se.cos(2 * np.pi * tau / Ts) - 1))
-             + Ws * se.Max(t - Ts, 0))
-    beam = Beam(length=10.0, E=7e10, rho=3000.0, A=4e-4, I_y=2e-7, I_z=2e-7, J=4e-7, nu=0.3,
-                n_elements=n_el)
-    eb = ElasticBody.beam("beam", "world", General("hub", [Rot("z", theta)]), beam, n_modes,
-                          keep=("uy", "rz"), stiffening=True)
-    return eb, jd.System([], [eb], [])
+    system = spinning_beam(n_el, n_modes)
+    return system.groups[0], system
 
 
 # ------------------------------------------------------------ part 1: fresh processes (child)

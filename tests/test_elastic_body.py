@@ -21,7 +21,7 @@ from jourdain.elastic import Beam, assemble, modal_data
 from jourdain.elastic.body import ElasticBody, lumped_masses
 from jourdain.errors import ModelError
 from jourdain.graph.piecewise import diff as pw_diff
-from jourdain.model.joints import General, Rot
+from jourdain.models.elastic import spinning_beam
 
 L, E, RHO, A, I = 1.0, 2.1e11, 7850.0, 1e-4, 8.33e-10
 BETA_L = np.array([1.875104068711961, 4.694091132974175, 7.854757438237613])
@@ -124,17 +124,10 @@ def test_flexible_pendulum_conserves_energy() -> None:
 def _spin_up(stiffening: bool, n_el: int = 10, n_modes: int = 3
              ) -> tuple[ElasticBody, jd.System]:
     """Kane, Ryan & Banerjee (1987): L = 10 m, ρA = 1.2 kg/m, EI = 1.4e4 N·m², spun up to
-    Ω_s = 6 rad/s over T_s = 15 s by a prescribed hub angle."""
-    t = se.Symbol("t")
-    Ws, Ts = 6.0, 15.0
-    tau = se.Min(t, Ts)
-    theta = ((Ws / Ts) * (tau**2 / 2 + (Ts / (2 * np.pi))**2 * (se.cos(2 * np.pi * tau / Ts) - 1))
-             + Ws * se.Max(t - Ts, 0))
-    beam = Beam(length=10.0, E=7e10, rho=3000.0, A=4e-4, I_y=2e-7, I_z=2e-7, J=4e-7, nu=0.3,
-                n_elements=n_el)
-    eb = ElasticBody.beam("beam", "world", General("hub", [Rot("z", theta)]), beam, n_modes,
-                          keep=("uy", "rz"), stiffening=stiffening)
-    return eb, jd.System([], [eb], [])
+    Ω_s = 6 rad/s over T_s = 15 s by a prescribed hub angle
+    (:func:`jourdain.models.elastic.spinning_beam`)."""
+    system = spinning_beam(n_el, n_modes, stiffening)
+    return system.groups[0], system
 
 
 def test_spin_up_bounded_only_with_geometric_stiffening() -> None:
