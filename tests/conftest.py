@@ -21,20 +21,27 @@ def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line(
         "markers", "own_hash_seeds: the test starts child processes with PYTHONHASHSEEDs of "
         "its own, so the suite's second pass under another seed (make test) adds nothing")
+    config.addinivalue_line(
+        "markers", "no_jourdain: the test checks an external reference and does not import "
+        "jourdain, so the suite's second pass under another seed adds nothing")
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list) -> None:
-    """Tests marked ``own_hash_seeds`` run once per ``make test``: in its first pass
-    (PYTHONHASHSEED=0) or where no seed is set, and are skipped, with the reason, in the
-    second."""
+    """Tests marked ``own_hash_seeds`` or ``no_jourdain`` run once per ``make test``: in its
+    first pass (PYTHONHASHSEED=0) or where no seed is set, and are skipped, with the reason,
+    in the second."""
     seed = os.environ.get("PYTHONHASHSEED", "")
     if seed in ("", "0", "random"):
         return
     skip = pytest.mark.skip(reason="spawns its own PYTHONHASHSEEDs: runs in the pass with "
                                    "PYTHONHASHSEED=0 (or none)")
+    external = pytest.mark.skip(reason="an external reference's own check (jourdain not "
+                                       "imported): runs in the pass with PYTHONHASHSEED=0")
     for item in items:
         if "own_hash_seeds" in item.keywords:
             item.add_marker(skip)
+        elif "no_jourdain" in item.keywords:
+            item.add_marker(external)
 
 
 def pytest_unconfigure(config: pytest.Config) -> None:
