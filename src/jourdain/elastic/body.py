@@ -244,12 +244,7 @@ class ElasticBody(BodyGroup):
         ``(node, dof)`` pairs) held by the frame, the mass lumped at the nodes by HRZ
         (:func:`lumped_masses`). No geometric stiffening (it needs a beam's axis)."""
         clamped = list(clamped)
-        if not clamped:
-            raise ModelError(f'elastic body "{name}": give the clamped nodes (the reference '
-                             "frame holds them)")
-        modal = modal_truncation(fe, n_modes, fixed=clamped)
-        if damping_ratio:
-            modal = _with_damping(modal, float(damping_ratio))
+        modal = _clamped_modes(name, fe, n_modes, clamped, clamped, damping_ratio)
         return cls(name, parent, joint, modal, lumped_masses(fe), None,
                    tuple((str(k), int(v)) for k, v in (attach or {}).items()))
 
@@ -288,12 +283,7 @@ class ElasticBody(BodyGroup):
             if bad:
                 raise ModelError(f'elastic body "{name}": unknown DOF names {bad} in keep')
             fixed += [d for d in fe.dofs if d[1] not in keep and d[0] not in clamped]
-        if not clamped:
-            raise ModelError(f'elastic body "{name}": give the clamped nodes (the reference '
-                             "frame holds them); free-free beam bodies are not built here")
-        modal = modal_truncation(fe, n_modes, fixed=fixed)
-        if damping_ratio:
-            modal = _with_damping(modal, float(damping_ratio))
+        modal = _clamped_modes(name, fe, n_modes, clamped, fixed, damping_ratio)
         Psi = None
         if stiffening:
             R = frame_of_axis(beam.axis, beam.up)
@@ -340,6 +330,17 @@ def _rotor_body(cls: type[ElasticBody], name: str, parent: str, joint: Joint, sh
     return cls(name, parent, joint, modal, mass, None,
                tuple((str(a), int(v)) for a, v in (attach or {}).items()),
                inertia, (axis, as_expr(spin, f'elastic body "{name}" spin')))  # type: ignore[arg-type]
+
+
+def _clamped_modes(name: str, fe: FEModel, n_modes: int, clamped: Sequence[object],
+                   fixed: Sequence[int | tuple[int, str]], damping_ratio: float) -> ModalData:
+    """The ``n_modes`` lowest normal modes with ``fixed`` held (the ``clamped`` nodes, which
+    the reference frame holds, among them), with modal damping ``damping_ratio``."""
+    if not clamped:
+        raise ModelError(f'elastic body "{name}": give the clamped nodes (the reference frame '
+                         "holds them); free-free bodies are not built here")
+    modal = modal_truncation(fe, n_modes, fixed=fixed)
+    return _with_damping(modal, float(damping_ratio)) if damping_ratio else modal
 
 
 def _with_damping(modal: ModalData, zeta: float) -> ModalData:
