@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from ..extras import missing, require
+from ..io.interrupted import deferred_ctrl_c
 from ..simulation.labelled import results_dataset
 from .compute import VERDICTS, WRENCH_COMPONENTS, Context, output_layout
 
@@ -182,15 +183,18 @@ def _attrs(ctx: Context, name: str, units: dict[str, str]) -> dict[str, Any]:
 def write_netcdf(ds: Any, path: str | Path) -> Path:
     """Write ``ds`` to NetCDF-4 (HDF5) at ``path`` (via a temporary file and a rename).
 
-    Uses h5netcdf, else netCDF4; a missing one is named with the extra that installs it."""
+    Uses h5netcdf, else netCDF4; a missing one is named with the extra that installs it.
+    A Ctrl-C while the file is written is raised when it is complete (KeyboardInterrupt
+    after the rename): cut inside its ``File`` constructor, h5netcdf's destructor printed a
+    traceback at exit, and the study's computed results would have been lost."""
     import os
 
     path = Path(path)
     engine = _engine()
     tmp = path.with_name(path.name + ".tmp")
-    with _scheduler_for(ds):
+    with deferred_ctrl_c(), _scheduler_for(ds):
         ds.to_netcdf(tmp, engine=engine)
-    os.replace(tmp, path)
+        os.replace(tmp, path)
     return path
 
 
