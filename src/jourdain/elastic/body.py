@@ -189,6 +189,16 @@ class ElasticBody(BodyGroup):
                      for i in range(3))
 
     def expand(self) -> tuple[tuple[se.Symbol, ...], tuple[Body, ...], tuple[object, ...]]:
+        """(coordinates, bodies, force elements), formed once per body (the expressions of
+        every node: System expands the body, and each System.evaluate asks for its inner
+        joints, :meth:`internal_joints`)."""
+        parts = self.__dict__.get("_parts")
+        if parts is None:
+            parts = self._expand()
+            object.__setattr__(self, "_parts", parts)
+        return parts
+
+    def _expand(self) -> tuple[tuple[se.Symbol, ...], tuple[Body, ...], tuple[object, ...]]:
         q = self.coordinates
         qd = [se.Symbol(f"{s}_d") for s in q]
         none = (0, 0, 0)
