@@ -14,23 +14,19 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-import symengine as se
 from scipy.optimize import brentq
 
 from ...analysis.modes import UNSTABLE
-from ...analysis.sweep import stability_boundary, sweep
+from ...analysis.sweep import sweep
 from ...errors import JourdainError
 from ...model.validation import force_expressions
 from .figures import plot_axes, svg
 from .html import esc, note, numstr
+from .rolling import _names, _stable_range
 from .state import Run
 
 #: speeds of the diagram
 POINTS = 121
-
-
-def _names(exprs: Any) -> set[str]:
-    return {str(x) for e in exprs for x in se.sympify(e).free_symbols}
 
 
 def speed_parameter(system: Any) -> str | None:
@@ -75,11 +71,16 @@ def campbell_plot(values: np.ndarray, freqs: np.ndarray, unstable: np.ndarray, n
     return svg(fig)
 
 
+def _oscillating(row: np.ndarray) -> np.ndarray:
+    """The eigenvalues of one speed with Im λ > 0 (one per oscillating pair), by Im λ."""
+    osc = row[row.imag > 1e-9 * max(1.0, float(np.abs(row).max()))]
+    return osc[np.argsort(osc.imag)]
+
+
 def _frequencies(lam: np.ndarray) -> np.ndarray:
     """|Im λ| of the oscillating eigenvalues (Im λ > 0), ascending, one row per speed; NaN
     where a speed has fewer."""
-    rows = [np.sort(row.imag[row.imag > 1e-9 * max(1.0, float(np.abs(row).max()))])
-            for row in lam]
+    rows = [_oscillating(row).imag for row in lam]
     n = max((len(r) for r in rows), default=0)
     out = np.full((len(rows), n), np.nan)
     for i, r in enumerate(rows):
@@ -125,18 +126,13 @@ def campbell_section(run: Run, nominal: str, lin: Any) -> str:
         sw = sweep(lin, name, values, parameters=params)
         freqs = _frequencies(sw.eigenvalues)
         critical = _critical(lin, name, values, freqs, params)
-        bounds = []
-        for i in range(len(values) - 1):
-            if (sw.verdicts[i] == UNSTABLE) != (sw.verdicts[i + 1] == UNSTABLE):
-                bounds.append(stability_boundary(lin, name, float(values[i]),
-                                                 float(values[i + 1]), parameters=params))
+        bounds = _stable_range(lin, name, values, sw.verdicts, params)
     except JourdainError as exc:
         run.info.notes.append(f"Campbell diagram about {nominal}: {exc}")
         return note(f"the Campbell diagram over {name} is not available: {exc}")
     unstable = np.zeros_like(freqs, dtype=bool)
     for i, row in enumerate(sw.eigenvalues):
-        osc = row[row.imag > 1e-9 * max(1.0, float(np.abs(row).max()))]
-        osc = osc[np.argsort(osc.imag)]
+        osc = _oscillating(row)
         unstable[i, :len(osc)] = osc.real > 0
     fn = run.out / f"campbell-{nominal}.csv"
     n = freqs.shape[1]

@@ -118,14 +118,16 @@ def sweep_plot(values: np.ndarray, real: np.ndarray, name: str, bounds: list[flo
     return svg(fig)
 
 
-def _stable_range(lin: Any, name: str, values: np.ndarray, verdicts: Sequence[str]
-                  ) -> list[float]:
+def _stable_range(lin: Any, name: str, values: np.ndarray, verdicts: Sequence[str],
+                  parameters: dict[str, float] | None = None) -> list[float]:
     """The boundaries of the stability verdict over ``values``, each to 1e-10 by
-    :func:`jourdain.stability_boundary`."""
+    :func:`jourdain.stability_boundary` (the other parameters at ``parameters``, else at
+    the linearization's own)."""
     out = []
     for i in range(len(values) - 1):
         if (verdicts[i] == UNSTABLE) != (verdicts[i + 1] == UNSTABLE):
-            out.append(stability_boundary(lin, name, float(values[i]), float(values[i + 1])))
+            out.append(stability_boundary(lin, name, float(values[i]), float(values[i + 1]),
+                                          parameters=parameters))
     return out
 
 
