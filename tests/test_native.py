@@ -1,6 +1,7 @@
 """Code compiled for this machine (``-march=native``, numeric/toolchain.py): the same numbers,
 bit for bit, as the portable build, a cache key that names the processor, and portable code
-where the native build fails."""
+where the native build fails. The optimization levels (``JOURDAIN_OPTIMIZE``, which the suite
+sets to 1): the same numbers, bit for bit, as the default -O2/-O3 build."""
 
 from __future__ import annotations
 
@@ -11,6 +12,7 @@ import numpy as np
 import pytest
 
 from jourdain import numeric
+from jourdain.errors import JourdainError
 from jourdain.models import n_link_pendulum_on_cart
 from jourdain.numeric import toolchain
 from jourdain.simulation import problem
@@ -19,8 +21,12 @@ native = pytest.mark.skipif(toolchain.native_target() is None,
                             reason="the compiler here does not take -march=native")
 
 
-def _run(monkeypatch, native_on: bool):
+def _run(monkeypatch, native_on: bool, optimize: str | None = None):
     monkeypatch.setenv("JOURDAIN_NATIVE", "1" if native_on else "0")
+    if optimize is None:
+        monkeypatch.delenv("JOURDAIN_OPTIMIZE", raising=False)
+    else:
+        monkeypatch.setenv("JOURDAIN_OPTIMIZE", optimize)
     numeric.clear_cache()
     problem.integrator_library.cache_clear()
     s = n_link_pendulum_on_cart(5)
@@ -55,16 +61,47 @@ def test_native_build_gives_the_portable_numbers_bit_for_bit(monkeypatch):
         r_nat, m_nat = _run(monkeypatch, True)
         r_por, m_por = _run(monkeypatch, False)
     finally:
-        monkeypatch.delenv("JOURDAIN_NATIVE")
+        monkeypatch.undo()
         numeric.clear_cache()
         problem.integrator_library.cache_clear()
-    assert r_nat.nfev == r_por.nfev and r_nat.n_accepted == r_por.n_accepted
-    assert np.array_equal(r_nat.t, r_por.t)
-    assert np.array_equal(r_nat.y, r_por.y) and np.array_equal(r_nat.yd, r_por.yd)
-    for a, b in zip(m_nat, m_por, strict=True):
+    _assert_same_runs((r_nat, m_nat), (r_por, m_por))
+
+
+def _assert_same_runs(one, other) -> None:
+    (r_a, m_a), (r_b, m_b) = one, other
+    assert r_a.nfev == r_b.nfev and r_a.n_accepted == r_b.n_accepted
+    assert np.array_equal(r_a.t, r_b.t)
+    assert np.array_equal(r_a.y, r_b.y) and np.array_equal(r_a.yd, r_b.yd)
+    for a, b in zip(m_a, m_b, strict=True):
         assert a.keys() == b.keys() and {"M", "k", "q"} <= a.keys()
         for name in a:
             assert _same(a[name], b[name]), name
+
+
+def test_optimization_levels_give_the_same_numbers_bit_for_bit(monkeypatch):
+    """-O0 and -O1 (JOURDAIN_OPTIMIZE) against the default -O2, with the integrator's -O3
+    kernels: no flag lets the compiler reorder or contract arithmetic, so the trajectory, the
+    step counts and the matrices are the same to the last bit; each level has its own keys."""
+    native_on = toolchain.native_target() is not None
+    try:
+        keys = {}
+        runs = {}
+        for level in (None, "1", "0"):
+            runs[level] = _run(monkeypatch, native_on, level)
+            keys[level] = toolchain.content_key("same source")
+    finally:
+        monkeypatch.undo()
+        numeric.clear_cache()
+        problem.integrator_library.cache_clear()
+    assert len(set(keys.values())) == 3
+    _assert_same_runs(runs["1"], runs[None])
+    _assert_same_runs(runs["0"], runs[None])
+
+
+def test_an_unknown_optimization_level_is_refused(monkeypatch):
+    monkeypatch.setenv("JOURDAIN_OPTIMIZE", "fast")
+    with pytest.raises(JourdainError, match="JOURDAIN_OPTIMIZE='fast'"):
+        toolchain.content_key("any source")
 
 
 @native

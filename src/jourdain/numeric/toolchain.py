@@ -27,6 +27,9 @@ ms; probably its AVX code beside the model's SSE code). ``JOURDAIN_NATIVE=0`` co
 architecture's baseline instead (valgrind, for one, does not know AVX-512). FMUs are not built
 here and stay portable (:mod:`jourdain.io.fmu.binary`).
 
+``JOURDAIN_OPTIMIZE=0``/``1``: ``-O0``/``-O1`` for ``-O2``/``-O3``, compiled in a tenth/quarter of the
+time, slower code, the same numbers bit for bit (no flag reorders arithmetic; test_native.py).
+
 Loading a library runs its code, so a library is loaded only from a directory that belongs to
 the user and that no one else may write to, and only if the file itself belongs to the user and
 is not writable by others (as Python's own caches are trusted only when private): a library
@@ -197,6 +200,20 @@ def _native_target(cc: str) -> str | None:
 _native_failed: set[str] = set()
 
 
+def optimization() -> str | None:
+    """``-O0``/``-O1`` for every optimization flag (``JOURDAIN_OPTIMIZE``; module docstring) or
+    None for the default flags; JourdainError for another value."""
+    level = os.environ.get("JOURDAIN_OPTIMIZE", "").strip()
+    if level not in ("0", "1", "", "2"):
+        raise JourdainError(f"JOURDAIN_OPTIMIZE={level!r}: give 0 or 1 (faster compiling, "
+                            "slower code), or 2 / nothing for the default optimization")
+    return f"-O{level}" if level in ("0", "1") else None
+
+
+def _optimized(flags: Sequence[str]) -> list[str]:
+    return [optimization() or f if f.startswith("-O") else f for f in flags]
+
+
 def host_flags() -> tuple[str, ...]:
     """The flags for this machine's instruction set (empty where native code is off)."""
     return NATIVE_FLAGS if native_target() is not None else ()
@@ -206,7 +223,8 @@ def content_key(*parts: str) -> str:
     """SHA-256 of the parts, the compiler flags, the native target, the Python platform and
     the format of the cache's files (:data:`jourdain.numeric.cachefile.FORMAT`)."""
     h = hashlib.sha256()
-    for part in (*parts, " ".join(CFLAGS), native_target() or "portable", sys.platform, FORMAT):
+    for part in (*parts, " ".join(CFLAGS), optimization() or "", native_target() or "portable",
+                 sys.platform, FORMAT):
         h.update(part.encode())
         h.update(b"\0")
     return h.hexdigest()[:32]
@@ -274,13 +292,14 @@ def compile_shared(sources: Mapping[str, str | bytes], units: Sequence[str], out
     unit, follow them for that unit alone (``-O3`` overrides ``-O2``). CompilerError names the
     unit."""
     cc = os.path.abspath(compiler())  # the compiler runs in the build folder
-    compile_flags = [f for f in flags if f != "-shared"]
+    compile_flags = [f for f in _optimized(flags) if f != "-shared"]
     work = Path(tempfile.mkdtemp(prefix=".build-", dir=out.parent))
     try:
         for name, text in sources.items():
             (work / name).write_bytes(text if isinstance(text, bytes) else text.encode())
         objects = [f"{Path(u).stem}.o" for u in units]
-        own = list(unit_flags) if unit_flags is not None else [()] * len(units)
+        own = ([_optimized(f) for f in unit_flags] if unit_flags is not None
+               else [[]] * len(units))
         procs = [subprocess.Popen([cc, *compile_flags, *fl, "-I.", "-c", "-o", o, u], cwd=work,
                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
                  for u, o, fl in zip(units, objects, own, strict=True)]
