@@ -58,3 +58,18 @@ def test_elastic_parts_of_the_report_and_the_view(tmp_path: Path) -> None:
     r = model.system.simulate(t_span=(0, 0.1), y0=[0.5, 0, 0, 0], yd0=[0, 0, 0, 0])
     sc = jd.view(r).scene
     assert sc["elastic"] == [{"name": "arm", "nodes": [f"arm_n{k}" for k in range(9)]}]
+
+
+def test_the_view_draws_a_consistent_body_through_its_gauss_points() -> None:
+    """With mass = "consistent" the beam's mass sits at its elements' Gauss points: the line
+    of the 3-D view joins those 32 bodies (8 elements), in order along the beam."""
+    text = (EXAMPLES / "flexible_pendulum.toml").read_text(encoding="utf-8")
+    assert "elastic = { modes = 3," in text
+    model = jd.io.modelfile.loads_model(
+        text.replace("elastic = { modes = 3,", 'elastic = { modes = 3, mass = "consistent",'),
+        "flexible_pendulum.toml")
+    r = model.system.simulate(t_span=(0, 0.02), y0=[0.5, 0, 0, 0], yd0=[0, 0, 0, 0])
+    sc = jd.view(r).scene
+    assert sc["elastic"] == [{"name": "arm", "nodes": [f"arm_g{k}" for k in range(32)]}]
+    beads = [b for b in sc["bodies"] if b["name"].startswith("arm_g")]
+    assert len(beads) == 32 and all(b["shape"]["kind"] == "sphere" for b in beads)

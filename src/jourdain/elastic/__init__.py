@@ -8,9 +8,10 @@ Guide: docs/elastic.md.
 """
 
 from jourdain.elastic.beam import DOF_NAMES, Beam, FEModel, assemble, element_matrices
-from jourdain.elastic.body import ElasticBody, lumped_masses
+from jourdain.elastic.body import ElasticBody
 from jourdain.elastic.femodel import fe_model
 from jourdain.elastic.modal import ModalData, modal_data
+from jourdain.elastic.quadrature import MassPoints, gauss_points, lumped_masses
 from jourdain.elastic.reduction import (
     constrain,
     craig_bampton,
@@ -20,6 +21,6 @@ from jourdain.elastic.reduction import (
 )
 from jourdain.elastic.sid import read_sid, sid_data, sid_text, write_sid
 
-__all__ = ["ElasticBody", "lumped_masses", "DOF_NAMES", "Beam", "FEModel", "assemble", "element_matrices", "ModalData",
+__all__ = ["ElasticBody", "lumped_masses", "MassPoints", "gauss_points", "DOF_NAMES", "Beam", "FEModel", "assemble", "element_matrices", "ModalData",
            "modal_data", "constrain", "craig_bampton", "free_modes", "modal_truncation",
            "normal_modes", "fe_model", "read_sid", "write_sid", "sid_text", "sid_data"]

@@ -39,7 +39,8 @@ import scipy.sparse as sp
 
 from jourdain.errors import ModelError
 
-__all__ = ["Beam", "FEModel", "element_matrices", "assemble", "frame_of_axis", "DOF_NAMES"]
+__all__ = ["Beam", "FEModel", "element_matrices", "assemble", "frame_of_axis", "DOF_NAMES",
+           "section_fields"]
 
 DOF_NAMES = ("ux", "uy", "uz", "rx", "ry", "rz")
 
@@ -263,6 +264,23 @@ def element_matrices(beam: Beam, L: float) -> tuple[np.ndarray, np.ndarray, np.n
     Gm = rho * beam.polar * (Ntheta["y"].T @ (w[:, None] * Ntheta["z"])
                              - Ntheta["z"].T @ (w[:, None] * Ntheta["y"]))
     return K, M, Gm
+
+
+def section_fields(beam: Beam, L: float, xi: float) -> tuple[np.ndarray, np.ndarray]:
+    """The element's fields at ``ξ = x/L``: the section's displacement ``N_t`` and its rotation
+    ``N_r`` (each 3 × 12, element frame), ``u = N_t·d``, ``θ = N_r·d`` for the element DOFs
+    ``d``: linear axial and torsion, and in each bending plane the shape functions of
+    :func:`element_matrices`, so that ``∫ρA·N_tᵀN_t + N_rᵀ·diag(ρI_p, ρI_y, ρI_z)·N_r dx``
+    (the bending rotations' terms where ``beam.rotary_inertia``) is the element's M."""
+    Nt = np.zeros((3, 12))
+    Nr = np.zeros((3, 12))
+    Nt[0, [0, 6]] = Nr[0, [3, 9]] = (1.0 - xi, xi)
+    for row, dofs, I, sign in ((1, _XY, beam.I_z, np.ones(4)), (2, _XZ, beam.I_y, _SIGN_XZ)):
+        Nv, Np = _bending_shapes(xi, L, beam.phi(I, L))
+        Nt[row, dofs] = Nv * sign
+        # θ_z = ψ of the x–y plane; θ_y = −ψ of the x–z plane
+        Nr[3 - row, dofs] = Np * sign if row == 1 else -Np * sign
+    return Nt, Nr
 
 
 def _shear_strain(L: float, phi: float) -> np.ndarray:

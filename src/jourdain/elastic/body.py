@@ -26,10 +26,12 @@ the discretized body (all orders in q_e, so energy is conserved exactly where th
 conservative), and every stage (reactions, linearization, simulation, FMU, reports) takes the
 body as it takes rigid ones. The invariants of the SID (m, m·c, J, C_t, C_r, M_e, ...) are the
 sums over these nodes (:func:`jourdain.elastic.modal.modal_data` of the lumped mass gives them;
-``tests/test_elastic_body.py`` checks that the projected M at q_e = 0 equals them). Left out:
-the nodes' rotary inertia (the sections' ρI, and with it the gyroscopic terms of a spinning
-shaft's own mass: a rotor's discs are rigid bodies at attachment frames); a body with many
-nodes costs in proportion to them, which the invariant form would not.
+``tests/test_elastic_body.py`` checks that the projected M at q_e = 0 equals them). Nodes may
+carry sections (rotary inertia, spinning with a rotor). With ``mass="consistent"`` (beams and
+rotors) the distributed mass sits instead at the elements' Gauss points, ``<name>_g<k>``, moved
+by the interpolated field: the consistent FE mass and its invariants exactly
+(:mod:`jourdain.elastic.quadrature`). A body costs in proportion to its nodes or points, which
+the invariant form's cost (∝ n_q²) would not.
 """
 
 from __future__ import annotations
@@ -42,6 +44,7 @@ import symengine as se
 
 from jourdain.elastic.beam import Beam, FEModel, assemble, frame_of_axis
 from jourdain.elastic.modal import ModalData
+from jourdain.elastic.quadrature import MassPoints, gauss_points, lumped_masses
 from jourdain.elastic.reduction import modal_truncation
 from jourdain.elastic.rotor import Bearing, Disc, rotor
 from jourdain.elastic.stiffening import foreshortening
@@ -74,32 +77,6 @@ def _linear(coefs: np.ndarray, q: Sequence[se.Symbol], const: float = 0.0,
     return se.Add(*terms) if terms else _ZERO
 
 
-def lumped_masses(fe: FEModel) -> np.ndarray:
-    """The nodes' masses by HRZ lumping (Hinton, Rock & Zienkiewicz 1976): each node gets the
-    share of its translational diagonal entries of M in the sum of all of them, times the
-    body's mass (Γ_tᵀ·M·Γ_t), so the lumped body keeps its mass exactly."""
-    diag = np.asarray(fe.M.diagonal() if hasattr(fe.M, "diagonal") else np.diag(fe.M))
-    per_node = np.zeros(len(fe.nodes))
-    total = np.zeros(3)
-    counts = np.zeros(3)
-    for i, (node, name) in enumerate(fe.dofs):
-        if name in ("ux", "uy", "uz"):
-            per_node[node] += diag[i]
-            total[("ux", "uy", "uz").index(name)] += diag[i]
-            counts[("ux", "uy", "uz").index(name)] += 1
-    ones = np.zeros(fe.n)
-    mass = []
-    for k, name in enumerate(("ux", "uy", "uz")):
-        if counts[k]:
-            ones[:] = [1.0 if d[1] == name else 0.0 for d in fe.dofs]
-            mass.append(float(ones @ np.asarray(fe.M @ ones)))
-    m = float(np.mean(mass)) if mass else 0.0
-    s = per_node.sum()
-    if not s > 0:
-        raise ModelError(f"{fe.name}: the mass matrix has no translational mass to lump")
-    return per_node * (m / s)
-
-
 @dataclass(frozen=True, eq=False)
 class ElasticBody(BodyGroup):
     """An elastic body (module docstring) hanging from ``parent`` by ``joint``.
@@ -120,15 +97,20 @@ class ElasticBody(BodyGroup):
     attach: tuple[tuple[str, int], ...] = ()
     node_inertia: np.ndarray | None = None
     spin: tuple[tuple[float, float, float], se.Basic] | None = None
+    points: MassPoints | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name.isidentifier():
             raise ModelError(f"elastic body name {self.name!r} must be an identifier")
         n = len(self.modal.nodes)
         m = np.asarray(self.node_mass, dtype=float)
-        if m.shape != (n,) or not np.all(np.isfinite(m)) or np.any(m < 0) or not m.sum() > 0:
+        if self.points is not None:
+            self.points.check(f'elastic body "{self.name}"', self.n_q)
+        distributed = 0.0 if self.points is None else float(np.sum(self.points.mass))
+        if (m.shape != (n,) or not np.all(np.isfinite(m)) or np.any(m < 0)
+                or not m.sum() + distributed > 0):
             raise ModelError(f'elastic body "{self.name}": node_mass must be {n} finite '
-                             "non-negative masses, not all zero")
+                             "non-negative masses, not all zero (without mass points)")
         for label, node in self.attach:
             if not (isinstance(label, str) and label.isidentifier()):
                 raise ModelError(f'elastic body "{self.name}": attachment label {label!r} must '
@@ -145,13 +127,15 @@ class ElasticBody(BodyGroup):
                 a = np.asarray(self.spin[0], dtype=float)
                 a = a / np.linalg.norm(a)
                 P = np.eye(3) - np.outer(a, a)
-                for k, Ik in enumerate(I_n):  # axisymmetric about the spin axis
+                sections = I_n if self.points is None else [*I_n, *self.points.inertia]
+            for k, Ik in enumerate(sections):  # axisymmetric about the spin axis
                     scale = max(float(np.abs(Ik).max()), 1e-300)
                     side = P @ Ik @ P
                     iso = np.trace(side) / 2 * P
                     if (np.abs(Ik @ a - (a @ Ik @ a) * a).max() > 1e-12 * scale
                             or np.abs(side - iso).max() > 1e-12 * scale):
-                        raise ModelError(f'elastic body "{self.name}": node {k}\'s inertia is '
+                        what = f"node {k}" if k < n else f"mass point {k - n}"
+                        raise ModelError(f'elastic body "{self.name}": {what}\'s inertia is '
                                          "not axisymmetric about the spin axis")
         if self.Psi is not None and np.shape(self.Psi) != (n, 3, self.n_q, self.n_q):
             raise ModelError(f'elastic body "{self.name}": Psi of shape {np.shape(self.Psi)}, '
@@ -161,8 +145,9 @@ class ElasticBody(BodyGroup):
     def _key(self) -> tuple:
         arrays = (self.modal.nodes, self.modal.Phi, self.modal.K_e, self.modal.D_e,
                   self.node_mass, self.Psi if self.Psi is not None else np.zeros(0),
-                  self.node_inertia if self.node_inertia is not None else np.zeros(0))
-        return (self.name, self.parent, self.joint, self.attach, self.spin,
+                  self.node_inertia if self.node_inertia is not None else np.zeros(0),
+                  *(self.points.arrays() if self.points is not None else ()))
+        return (self.name, self.parent, self.joint, self.attach, self.spin, self.points is None,
                 tuple(np.ascontiguousarray(a, dtype=float).tobytes() for a in arrays))
 
     def __eq__(self, other: object) -> bool:
@@ -170,6 +155,12 @@ class ElasticBody(BodyGroup):
 
     def __hash__(self) -> int:
         return hash(self._key())
+
+    @property
+    def total_mass(self) -> float:
+        """The body's mass: its nodes' and its mass points'."""
+        return float(np.sum(self.node_mass)) + (0.0 if self.points is None
+                                                else float(np.sum(self.points.mass)))
 
     @property
     def n_q(self) -> int:
@@ -208,19 +199,19 @@ class ElasticBody(BodyGroup):
                                General(f"{self.name}_mode{k + 1}", [Trans("x", qk)],
                                        coordinates=[qk]), mass=0, inertia=none))
         inertia = self.node_inertia
+        md = self.modal
         for node, m in enumerate(np.asarray(self.node_mass, dtype=float)):
             I_n = None if inertia is None or not np.any(inertia[node]) else inertia[node]
-            if m > 0 or I_n is not None:
-                steps: list[Rot | Trans] = [Trans(vector=self.node_position(node))]
-                if I_n is not None:  # the section turns with the node (and spins)
-                    steps += self._rotations(node)
-                    if self.spin is not None:
-                        steps.append(Rot(self.spin[0], self.spin[1]))
-                bodies.append(Body(f"{self.name}_n{node}", self.name,
-                                   General(f"{self.name}_node{node}", steps),
-                                   mass=_num(float(m)),
-                                   inertia=none if I_n is None else
-                                   [[_num(float(x)) for x in row] for row in I_n]))
+            quad = None if self.Psi is None else self.Psi[node]
+            bodies += self._carrier(f"n{node}", f"node{node}", md.nodes[node], md.Phi_t[node],
+                                    md.Phi_r[node], quad, float(m), I_n)
+        pts = self.points
+        for k in range(0 if pts is None else len(pts.mass)):
+            assert pts is not None
+            I_p = pts.inertia[k] if np.any(pts.inertia[k]) else None
+            quad = None if pts.Psi is None else pts.Psi[k]
+            bodies += self._carrier(f"g{k}", f"point{k}", pts.c[k], pts.Phi_t[k], pts.Phi_r[k],
+                                    quad, float(pts.mass[k]), I_p, section=True)
         for label, node in self.attach:
             frame: list[Rot | Trans] = [Trans(vector=self.node_position(node))]
             frame += self._rotations(node)
@@ -232,6 +223,26 @@ class ElasticBody(BodyGroup):
                                    -_linear(K[k], q) - _linear(D[k], qd))
                   for k, qk in enumerate(q)]
         return q, tuple(bodies), tuple(forces)
+
+    def _carrier(self, body: str, joint: str, c: np.ndarray, Pt: np.ndarray, Pr: np.ndarray,
+                 quad: np.ndarray | None, m: float, I_n: np.ndarray | None,
+                 section: bool = False) -> list[Body]:
+        """The body ``<name>_<body>`` of a node or mass point at ``c + Pt·q + ½qᵀ·quad·q``
+        with mass ``m`` and, where ``I_n`` is given, a section turned by ``Pr·q`` (and spun)."""
+        if not (m > 0 or I_n is not None):
+            return []
+        q = self.coordinates
+        where = tuple(_linear(Pt[i], q, float(c[i]), None if quad is None else quad[i])
+                      for i in range(3))
+        steps: list[Rot | Trans] = [Trans(vector=where)]
+        if I_n is not None:  # the section turns with the node (and spins)
+            steps += [Rot(axis, th) for axis, th in
+                      zip("xyz", (_linear(Pr[i], q) for i in range(3)), strict=True) if th != 0]
+            if self.spin is not None:
+                steps.append(Rot(self.spin[0], self.spin[1]))
+        return [Body(f"{self.name}_{body}", self.name, General(f"{self.name}_{joint}", steps),
+                     mass=_num(m), inertia=(0, 0, 0) if I_n is None else
+                     [[_num(float(x)) for x in row] for row in I_n], section=section)]
 
     def internal_joints(self) -> tuple[str, ...]:
         _, bodies, _ = self.expand()
@@ -261,7 +272,7 @@ class ElasticBody(BodyGroup):
     @classmethod
     def rotor(cls, name: str, parent: str, joint: Joint, shaft: Beam, n_modes: int, *,
               spin: object, discs: Sequence[Disc] = (), bearings: Sequence[Bearing] = (),
-              attach: Mapping[str, int] | None = None) -> ElasticBody:
+              attach: Mapping[str, int] | None = None, mass: str = "lumped") -> ElasticBody:
         """A flexible rotor: the ``shaft`` (along a body axis) with rigid ``discs`` and
         linear ``bearings`` (:mod:`jourdain.elastic.rotor`), its frame held by ``joint`` (not
         spinning), the shaft's material spinning by the angle ``spin`` (an expression such as
@@ -269,22 +280,28 @@ class ElasticBody(BodyGroup):
         bearings at rest (K_e, D_e with the bearings, cross-coupled terms kept). Each node
         carries its lumped mass (shaft ρA and discs) and a section that turns with the node's
         small rotation and spins: the lumped shaft inertia ρ·(I_p, I_y, I_z) per length and
-        the discs' (I_p, I_d, I_d), so the gyroscopic terms come from the method itself."""
+        the discs' (I_p, I_d, I_d), so the gyroscopic terms come from the method itself.
+        ``mass="consistent"``: the shaft's mass and sections at the elements' Gauss points
+        instead (:mod:`jourdain.elastic.quadrature`: the FE rotor's M and G exactly)."""
         return _rotor_body(cls, name, parent, joint, shaft, discs, bearings, n_modes, spin,
-                           attach)
+                           attach, _mass_kind(name, mass))
 
     @classmethod
     def beam(cls, name: str, parent: str, joint: Joint, beam: Beam, n_modes: int, *,
              clamped: Iterable[int] = (0,), keep: Sequence[str] | None = None,
              attach: Mapping[str, int] | None = None, stiffening: bool = True,
-             damping_ratio: float = 0.0) -> ElasticBody:
+             damping_ratio: float = 0.0, mass: str = "lumped") -> ElasticBody:
         """A beam body: ``beam`` meshed (:func:`jourdain.elastic.beam.assemble`), its
         ``n_modes`` lowest normal modes with the nodes ``clamped`` held in the reference frame
         (the cantilever's modes for the default, node 0 at ``beam.origin``), node masses ρA
         per length lumped at the nodes (:func:`lumped_masses`), modal damping ``damping_ratio``
         (D_e = 2ζ·diag ω), and the foreshortening of :mod:`~jourdain.elastic.stiffening` when
         ``stiffening``. ``keep`` (DOF names such as ``("uy", "rz")``) restricts the modes to
-        those DOFs, every other one held at every node: a beam bending in one plane only."""
+        those DOFs, every other one held at every node: a beam bending in one plane only.
+        ``mass="consistent"`` puts the mass and the sections' rotary inertia at the elements'
+        Gauss points (:mod:`jourdain.elastic.quadrature`): the FE beam's consistent mass,
+        exactly, for four bodies per element instead of one per node."""
+        consistent = _mass_kind(name, mass)
         fe = assemble(beam)
         clamped = [int(c) for c in clamped]
         fixed: list[int | tuple[int, str]] = list(clamped)
@@ -298,13 +315,24 @@ class ElasticBody(BodyGroup):
         if stiffening:
             R = frame_of_axis(beam.axis, beam.up)
             Psi = foreshortening(modal.nodes, R, modal.Phi_t, modal.Phi_r, clamped[0])
-        return cls(name, parent, joint, modal, lumped_masses(fe), Psi,
-                   tuple((str(k), int(v)) for k, v in (attach or {}).items()))
+        labels = tuple((str(k), int(v)) for k, v in (attach or {}).items())
+        if consistent:
+            return cls(name, parent, joint, modal, np.zeros(len(modal.nodes)), Psi, labels,
+                       points=gauss_points(beam, modal, clamped[0] if stiffening else None))
+        return cls(name, parent, joint, modal, lumped_masses(fe), Psi, labels)
+
+
+def _mass_kind(name: str, mass: object) -> bool:
+    """True for ``"consistent"``, False for ``"lumped"``; ModelError otherwise."""
+    if mass not in ("lumped", "consistent"):
+        raise ModelError(f'elastic body "{name}": mass must be "lumped" or "consistent", '
+                         f"got {mass!r}")
+    return mass == "consistent"
 
 
 def _rotor_body(cls: type[ElasticBody], name: str, parent: str, joint: Joint, shaft: Beam,
                 discs: Sequence[Disc], bearings: Sequence[Bearing], n_modes: int, spin: object,
-                attach: Mapping[str, int] | None) -> ElasticBody:
+                attach: Mapping[str, int] | None, consistent: bool) -> ElasticBody:
     """:meth:`ElasticBody.rotor`."""
     r = rotor(shaft, discs, bearings)
     R = frame_of_axis(shaft.axis, shaft.up)
@@ -322,8 +350,8 @@ def _rotor_body(cls: type[ElasticBody], name: str, parent: str, joint: Joint, sh
     Phi = modal.Phi
     modal = replace(modal, K_e=Phi.T @ r.K @ Phi, D_e=Phi.T @ r.C @ Phi,
                     G_e=Phi.T @ r.G @ Phi)
-    mass = lumped_masses(r.fe)
     n = len(fe.nodes)
+    mass = np.zeros(n) if consistent else lumped_masses(r.fe)
     inertia = np.zeros((n, 3, 3))
     share = np.zeros(n)
     le = shaft.length / int(shaft.n_elements)
@@ -331,7 +359,7 @@ def _rotor_body(cls: type[ElasticBody], name: str, parent: str, joint: Joint, sh
     share[1:] += le / 2
     Id = shaft.rho * np.array([shaft.polar, shaft.I_y if shaft.rotary_inertia else 0.0,
                                shaft.I_z if shaft.rotary_inertia else 0.0])
-    for node in range(n):
+    for node in range(0 if consistent else n):
         inertia[node] = share[node] * (R @ np.diag(Id) @ R.T)
     for d in discs:
         mass[d.node] += d.m
@@ -339,7 +367,8 @@ def _rotor_body(cls: type[ElasticBody], name: str, parent: str, joint: Joint, sh
     axis = tuple(float(x) for x in R[:, 0])
     return cls(name, parent, joint, modal, mass, None,
                tuple((str(a), int(v)) for a, v in (attach or {}).items()),
-               inertia, (axis, as_expr(spin, f'elastic body "{name}" spin')))  # type: ignore[arg-type]
+               inertia, (axis, as_expr(spin, f'elastic body "{name}" spin')),  # type: ignore[arg-type]
+               gauss_points(shaft, modal) if consistent else None)
 
 
 def _clamped_modes(name: str, fe: FEModel, n_modes: int, clamped: Sequence[object],

@@ -25,7 +25,7 @@ import numpy as np
 
 from jourdain.errors import ModelError
 
-__all__ = ["foreshortening"]
+__all__ = ["foreshortening", "foreshortening_at"]
 
 _GX, _GW = np.polynomial.legendre.leggauss(3)
 _XI = 0.5 * (_GX + 1.0)
@@ -46,6 +46,16 @@ def foreshortening(nodes: np.ndarray, R: np.ndarray, Phi_t: np.ndarray, Phi_r: n
     the modes' nodal translations and rotations in the body frame; ``reference`` the node that
     keeps its axial place (the clamped one)."""
     nodes = np.asarray(nodes, dtype=float)
+    return foreshortening_at(nodes, R, Phi_t, Phi_r, reference,
+                             [(min(k, len(nodes) - 2), 0.0 if k < len(nodes) - 1 else 1.0)
+                              for k in range(len(nodes))] if len(nodes) > 1 else [])
+
+
+def foreshortening_at(nodes: np.ndarray, R: np.ndarray, Phi_t: np.ndarray, Phi_r: np.ndarray,
+                      reference: int, points: list[tuple[int, float]]) -> np.ndarray:
+    """Ψ (P, 3, n_q, n_q) as :func:`foreshortening`, at the points ``(e, ξ)`` of the beam:
+    element ``e`` (between nodes e and e + 1) at ``ξ`` ∈ [0, 1] of its length."""
+    nodes = np.asarray(nodes, dtype=float)
     n, nq = len(nodes), Phi_t.shape[2]
     if Phi_r.shape != Phi_t.shape or Phi_t.shape[:2] != (n, 3):
         raise ModelError(f"foreshortening: mode arrays of shapes {Phi_t.shape}, {Phi_r.shape} "
@@ -57,19 +67,27 @@ def foreshortening(nodes: np.ndarray, R: np.ndarray, Phi_t: np.ndarray, Phi_r: n
     # the element frame's components: v along y with slope θ_z, w along z with slope −θ_y
     loc_t = np.einsum("ji,njk->nik", R, Phi_t)
     loc_r = np.einsum("ji,njk->nik", R, Phi_r)
-    P_el = np.zeros((max(n - 1, 0), nq, nq))
-    for e in range(n - 1):
+
+    def integral(e: int, a: float, b: float) -> np.ndarray:
+        """∫ (v'v'ᵀ + w'w'ᵀ) ds over ξ ∈ [a, b] of element e (3-point Gauss, exact)."""
         L = s[e + 1] - s[e]
         v = np.stack([loc_t[e, 1], loc_r[e, 2], loc_t[e + 1, 1], loc_r[e + 1, 2]])
         w = np.stack([loc_t[e, 2], -loc_r[e, 1], loc_t[e + 1, 2], -loc_r[e + 1, 1]])
-        for xi, wt in zip(_XI, _WXI, strict=True):
+        out = np.zeros((nq, nq))
+        for xi, wt in zip(a + (b - a) * _XI, (b - a) * _WXI, strict=True):
             d = _slope_rows(float(xi), L)
             dv, dw = d @ v, d @ w
-            P_el[e] += wt * L * (np.outer(dv, dv) + np.outer(dw, dw))
-    Psi = np.zeros((n, 3, nq, nq))
-    for k in range(n):
-        lo, hi = sorted((reference, k))
-        P = -P_el[lo:hi].sum(axis=0)
-        sign = 1.0 if k >= reference else -1.0
+            out += wt * L * (np.outer(dv, dv) + np.outer(dw, dw))
+        return out
+
+    whole = [integral(e, 0.0, 1.0) for e in range(n - 1)]
+    Psi = np.zeros((len(points), 3, nq, nq))
+    for k, (e, xi) in enumerate(points):
+        if e >= reference:  # from the reference node forward to the point
+            P = -(sum(whole[reference:e], np.zeros((nq, nq))) + integral(e, 0.0, xi))
+            sign = 1.0
+        else:  # back from the reference node to the point
+            P = -(sum(whole[e + 1:reference], np.zeros((nq, nq))) + integral(e, xi, 1.0))
+            sign = -1.0
         Psi[k] = sign * ex[:, None, None] * P[None, :, :]
     return Psi

@@ -42,6 +42,10 @@ class Body:
         the moment about the normal of the plane alone, for a body whose angular velocity
         stays about that axis (checked by the Newton–Euler stage): ``planar`` is then that
         axis.
+    ``section``: the body is a slice of a beam (an elastic body's mass point,
+    :mod:`jourdain.elastic.quadrature`), whose inertia is the section's ρ·(I_p, I_y, I_z) per
+    length, that of a one-dimensional continuum: positive semi-definite, but without the
+    rigid body's triangle inequality (a beam without rotary inertia keeps its torsional one).
     """
 
     name: str
@@ -51,9 +55,11 @@ class Body:
     com: Vec3
     inertia: Mat3
     planar: str | None = None
+    section: bool = False
 
     def __init__(self, name: str, parent: str, joint: Joint, mass: object = None,
-                 com: object = (0, 0, 0), inertia: object = None) -> None:
+                 com: object = (0, 0, 0), inertia: object = None, *,
+                 section: bool = False) -> None:
         if not isinstance(name, str) or not name.isidentifier():
             raise ModelError(f"body name {name!r} must be an identifier")
         if name == WORLD:
@@ -96,6 +102,7 @@ class Body:
         object.__setattr__(self, "com", c)
         object.__setattr__(self, "inertia", I)
         object.__setattr__(self, "planar", planar)
+        object.__setattr__(self, "section", bool(section))
         if not any(x.free_symbols for x in (m, *c, *(x for row in I for x in row))):
             # numbers only: checked now (with parameters: by the System, at their values)
             check_mass_data(self, {})
@@ -138,7 +145,8 @@ def mass_data_problem(body: Body, values: Mapping[str, float]) -> tuple[str, str
     if ev.min() < -1e-12 * scale:
         return "inertia", ("inertia tensor is not positive semi-definite (eigenvalues "
                            f"{np.array2string(ev, precision=4)})")
-    if ev[2] > ev[0] + ev[1] + TRIANGLE_TOL * ev[2] and body.planar is None:
+    if (ev[2] > ev[0] + ev[1] + TRIANGLE_TOL * ev[2] and body.planar is None
+            and not body.section):
         return "inertia", ("inertia tensor is not that of a rigid body: its largest principal "
                            f"moment {ev[2]:.6g} exceeds the sum of the other two "
                            f"({ev[0]:.6g} + {ev[1]:.6g}); each principal moment must be at most "

@@ -11,7 +11,9 @@
 The beam's data are numbers (the modes are computed from them once). Optional keys:
 ``clamped`` (nodes held by the frame, default ``[0]``), ``keep`` (the DOF names the modes use),
 ``attach`` (label -> node: the frames ``<name>_<label>`` other bodies and forces use),
-``stiffening`` (geometric stiffening, default true) and ``damping_ratio``. A rotor has
+``stiffening`` (geometric stiffening, default true), ``damping_ratio`` and ``mass``
+(``"lumped"`` at the nodes, the default, or ``"consistent"``: at the elements' Gauss points,
+the FE beam's consistent mass exactly, for four bodies per element). A rotor has
 ``spin`` (the shaft's angle, ``"Omega*t"``), ``discs`` (``{ node, m, Id, Ip }``) and
 ``bearings`` (``{ node, k_yy, k_zz, k_yz, k_zy, c_yy, ... }``) instead. jourdain.elastic
 (SciPy's sparse eigensolvers) is imported only for files that have such a body.
@@ -26,7 +28,7 @@ from ..toml_positions import Path
 from .values import _Values
 
 _ELASTIC_KEYS = {"beam", "modes", "clamped", "keep", "attach", "stiffening", "damping_ratio",
-                 "spin", "discs", "bearings"}
+                 "spin", "discs", "bearings", "mass"}
 _DISC_KEYS = {"node", "m", "Id", "Ip"}
 _BEARING_KEYS = {"node", "k_yy", "k_zz", "k_yz", "k_zy", "c_yy", "c_zz", "c_yz", "c_zy"}
 _BEAM_NUMBERS = ("length", "E", "rho", "A", "I_y", "I_z", "J", "G", "nu", "kappa", "I_p")
@@ -85,8 +87,11 @@ class _Elastic(_Values):
             self.name(label, (*p, "attach", label), "attachment")
         stiffening = self.flag(el.get("stiffening", True), (*p, "stiffening"))
         zeta = self.number(el.get("damping_ratio", 0.0), (*p, "damping_ratio"))
+        mass = self.string(el.get("mass", "lumped"), (*p, "mass"))
+        if mass not in ("lumped", "consistent"):
+            raise self.fail((*p, "mass"), f'expected "lumped" or "consistent", got {mass!r}')
         if "spin" in el:
-            return self.read_rotor(bname, el, parent, joint, kw, modes, attach)
+            return self.read_rotor(bname, el, parent, joint, kw, modes, attach, mass)
         for key in ("discs", "bearings"):
             if key in el:
                 raise self.fail((*p, key), f"{key} belong to a rotor: give its spin as well "
@@ -95,13 +100,13 @@ class _Elastic(_Values):
             beam = Beam(**kw)
             return ElasticBody.beam(bname, parent, joint, beam, modes, clamped=clamped,
                                     keep=keep, attach=attach, stiffening=stiffening,
-                                    damping_ratio=zeta)
+                                    damping_ratio=zeta, mass=mass)
         except ModelError as exc:
             where = bp if str(exc).startswith("Beam") else p
             raise self.fail(where, str(exc)) from None
 
     def read_rotor(self, bname: str, el: dict, parent: str, joint: Any, kw: dict[str, Any],
-                   modes: int, attach: dict[str, int]) -> Any:
+                   modes: int, attach: dict[str, int], mass: str) -> Any:
         """A flexible rotor (:meth:`jourdain.elastic.ElasticBody.rotor`): ``spin`` (the shaft's
         angle, an expression of parameters and t), ``discs`` and ``bearings`` (arrays of
         tables with numbers)."""
@@ -132,7 +137,7 @@ class _Elastic(_Values):
         try:
             return ElasticBody.rotor(bname, parent, joint, Beam(**kw), modes, spin=spin,
                                      discs=parts["discs"], bearings=parts["bearings"],
-                                     attach=attach)
+                                     attach=attach, mass=mass)
         except ModelError as exc:
             raise self.fail(p, str(exc)) from None
 

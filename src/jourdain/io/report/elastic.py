@@ -59,9 +59,9 @@ def elastic_html(run: Run) -> str:
     bodies = [g for g in groups if hasattr(g, "modal")]
     if not bodies:
         return ""
-    parts = ["<h3>Elastic bodies</h3><p>Floating frame of reference with the mass lumped at "
-             "the nodes (docs/elastic.md); the elastic coordinates are the amplitudes of the "
-             "basis below. Frequencies: the basis's own (K_e, M_e of the finite-element "
+    parts = ["<h3>Elastic bodies</h3><p>Floating frame of reference with the mass at the "
+             "nodes (lumped) or at the elements' Gauss points (consistent; docs/elastic.md); "
+             "the elastic coordinates are the amplitudes of the basis below. Frequencies: the basis's own (K_e, M_e of the finite-element "
              "model; for a rotor on its bearings, at rest).</p>"]
     for b in bodies:
         m = b.modal
@@ -69,7 +69,9 @@ def elastic_html(run: Run) -> str:
                  numstr(m.omega[k] / (2 * np.pi))) for k in range(b.n_q)]
         spin = "" if getattr(b, "spin", None) is None else f", spinning by {esc(str(b.spin[1]))}"
         parts.append(f"<h4>{esc(b.name)}</h4><p>{len(m.nodes)} nodes, mass "
-                     f"{numstr(float(np.sum(b.node_mass)))} kg, {b.n_q} elastic coordinates "
+                     f"{numstr(b.total_mass)} kg"
+                     f"{'' if b.points is None else f' ({len(b.points.mass)} mass points)'}"
+                     f", {b.n_q} elastic coordinates "
                      f"{esc(', '.join(str(c) for c in b.coordinates))} ({esc(m.method)}"
                      f"{'' if b.Psi is None else ', geometric stiffening'}{spin})</p>")
         parts.append(html_table(rows, ["mode", "kind", "ω / (rad/s)", "f / Hz"]))

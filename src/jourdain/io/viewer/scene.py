@@ -119,9 +119,13 @@ def _camera(motion: np.ndarray, points: np.ndarray, up: np.ndarray
     return center, extent, d, ground
 
 
-def _node_index(name: str) -> int:
-    """k of an elastic body's node body ``<body>_n<k>``."""
-    return int(name.rsplit("_n", 1)[1])
+def _line(group: Any) -> list[str]:
+    """The bodies of an elastic body's line, in order along it: its mass points
+    ``<body>_g<k>`` (consistent mass) or else its nodes ``<body>_n<k>``."""
+    points = getattr(group, "points", None)
+    if points is not None:
+        return [f"{group.name}_g{k}" for k in range(len(points.mass))]
+    return [f"{group.name}_n{k}" for k in range(len(getattr(group, "node_mass", ())))]
 
 
 def scene(results: Results, visuals: Any = None,
@@ -167,9 +171,8 @@ def scene(results: Results, visuals: Any = None,
     mmax = max((m for m, _, _, _ in raw), default=0.0)
 
     budget = [MAX_TRIANGLES]
-    # an elastic body's mass nodes: small beads on its line (viewer.js joins them)
-    beads = {f"{g.name}_n{k}" for g in getattr(system, "groups", ())
-             for k in range(len(getattr(g, "node_mass", ())))}
+    # an elastic body's mass nodes or points: small beads on its line (viewer.js joins them)
+    beads = {n for g in getattr(system, "groups", ()) for n in _line(g)}
     for i, (b, (m, com, sides, V)) in enumerate(zip(system.bodies, raw, strict=True)):
         if m <= 0:
             kind, size = "none", np.zeros(3)
@@ -214,8 +217,7 @@ def scene(results: Results, visuals: Any = None,
                         "point_b": _vec(c.point_b, values, f'closing joint "{c.name}" point_b'
                                         ).tolist()})
     names = {b.name for b in system.bodies}
-    elastic = [{"name": g.name, "nodes": [n for n in sorted(beads & names, key=_node_index)
-                                          if n.startswith(f"{g.name}_n")]}
+    elastic = [{"name": g.name, "nodes": [n for n in _line(g) if n in names]}
                for g in getattr(system, "groups", ())]
     poses = np.concatenate([r, quaternions(S)], axis=-1)  # (n, p, 7)
     return {"format": SCENE_FORMAT, "name": system.name, "n_frames": int(len(times)),
