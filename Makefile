@@ -51,12 +51,15 @@ browser:
 # (the compiled libraries go to a cache in the project, shared by the two runs and removed by
 # make clean, never to the user's ~/.cache/jourdain; compiled at -O1, JOURDAIN_OPTIMIZE=1: the
 # same numbers bit for bit as the default -O2, tests/test_native.py, in a quarter of the
-# compiler's time, which was most of the suite's)
+# compiler's time, which was most of the suite's). Each run in TEST_WORKERS processes
+# (pytest-xdist, whole files per process; the cache is safe for concurrent builds);
+# TEST_WORKERS=0 runs in one process.
+TEST_WORKERS ?= 2
 test: lint browser
 	PYTHONHASHSEED=0 OPENBLAS_NUM_THREADS=1 JOURDAIN_TEST_CACHE=$(CURDIR)/.jourdain-test-cache \
-	  JOURDAIN_OPTIMIZE=1 $(BIN)/python -m pytest -q
+	  JOURDAIN_OPTIMIZE=1 $(BIN)/python -m pytest -q -n $(TEST_WORKERS) --dist loadfile
 	PYTHONHASHSEED=12345 JOURDAIN_TEST_CACHE=$(CURDIR)/.jourdain-test-cache \
-	  JOURDAIN_OPTIMIZE=1 $(BIN)/python -m pytest -q
+	  JOURDAIN_OPTIMIZE=1 $(BIN)/python -m pytest -q -n $(TEST_WORKERS) --dist loadfile
 
 # the documentation site (mkdocs.yml): tutorials executed and every example run for the gallery
 # at each build, so a change of the code that breaks either fails here; compiled libraries in a

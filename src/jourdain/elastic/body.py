@@ -214,7 +214,7 @@ class ElasticBody(BodyGroup):
                                     quad, float(pts.mass[k]), I_p, section=True)
         for label, node in self.attach:
             frame: list[Rot | Trans] = [Trans(vector=self.node_position(node))]
-            frame += self._rotations(node)
+            frame += self._rotations(self.modal.Phi_r[node])
             bodies.append(Body(f"{self.name}_{label}", self.name,
                                General(f"{self.name}_{label}_node", frame), mass=0,
                                inertia=none))
@@ -236,8 +236,7 @@ class ElasticBody(BodyGroup):
                       for i in range(3))
         steps: list[Rot | Trans] = [Trans(vector=where)]
         if I_n is not None:  # the section turns with the node (and spins)
-            steps += [Rot(axis, th) for axis, th in
-                      zip("xyz", (_linear(Pr[i], q) for i in range(3)), strict=True) if th != 0]
+            steps += self._rotations(Pr)
             if self.spin is not None:
                 steps.append(Rot(self.spin[0], self.spin[1]))
         return [Body(f"{self.name}_{body}", self.name, General(f"{self.name}_{joint}", steps),
@@ -248,10 +247,11 @@ class ElasticBody(BodyGroup):
         _, bodies, _ = self.expand()
         return tuple(b.joint.name for b in bodies if b.name != self.name)
 
-    def _rotations(self, node: int) -> list[Rot | Trans]:
-        """The node's small rotation θ = Φ_r·q_e as elementary rotations about x, y, z."""
+    def _rotations(self, Pr: np.ndarray) -> list[Rot | Trans]:
+        """The small rotation θ = Pr·q_e of a node or point as elementary rotations about x,
+        y, z."""
         q = self.coordinates
-        theta = [_linear(self.modal.Phi_r[node][i], q) for i in range(3)]
+        theta = [_linear(Pr[i], q) for i in range(3)]
         return [Rot(axis, th) for axis, th in zip("xyz", theta, strict=True) if th != 0]
 
     @classmethod
