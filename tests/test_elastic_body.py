@@ -259,7 +259,8 @@ def test_hinge_reaction_is_the_momentum_balance() -> None:
     centre of mass's acceleration of the simulated motion (rtol 1e-12), by central differences
     of its interpolated positions with Richardson's step (h = 1e-4 and 5e-5 s; the plain
     differences converge like h²: 1.4e-4 at 3e-4 s, 1.6e-5 at 1e-4 s). The joints inside the
-    body have no reactions of their own."""
+    body have no reactions of their own. Along the motion, Results.g and Results.joint_wrenches
+    give the same numbers at the samples (jourdain.analysis.group_reactions)."""
     model = jd.load_model(Path(__file__).parent.parent / "examples" / "flexible_pendulum.toml")
     system = model.system
     r = system.simulate(t_span=(0, 0.6), y0=[0.8, 0, 0, 0], yd0=[0, 0, 0, 0], rtol=1e-12,
@@ -268,7 +269,8 @@ def test_hinge_reaction_is_the_momentum_balance() -> None:
     masses = {b.name: float(b.mass.subs(values)) for b in system.bodies
               if float(b.mass.subs(values)) > 0}
     total = sum(masses.values())
-    t0 = 0.3
+    k = int(np.argmin(np.abs(r.t - 0.3)))  # a sample of the run
+    t0 = float(r.t[k])
 
     def acc(h: float) -> np.ndarray:
         ts = np.array([t0 - h, t0, t0 + h])
@@ -286,6 +288,15 @@ def test_hinge_reaction_is_the_momentum_balance() -> None:
     S = np.array([[np.cos(phi), -np.sin(phi), 0], [np.sin(phi), np.cos(phi), 0], [0, 0, 1]])
     F = S @ np.array([g["arm.F_x"], g["arm.F_y"], g["arm.F_z"]])  # the joint frame turns
     assert np.abs(F - F_ref).max() <= 1e-6 * np.abs(F_ref).max()
+    assert np.abs(ev["joint_wrenches"]["arm"].force_inertial - F_ref).max() <= (
+        1e-6 * np.abs(F_ref).max())
+    # along the motion: the ordinary joints' g and wrenches at every sample
+    assert r.g_names == ev["g_names"] and r.g.shape == (len(r.t), len(ev["g_names"]))
+    scale = np.abs(ev["g"]).max()
+    assert np.abs(r.g[k] - ev["g"]).max() <= 1e3 * np.finfo(float).eps * scale
+    w = r.joint_wrenches
+    assert set(w) == {"arm", "tip_mass"}  # the hinge and the tip mass's joint
+    assert np.abs(w["arm"].force_inertial[k] - F_ref).max() <= 1e-6 * np.abs(F_ref).max()
 
 
 def test_body_from_an_imported_fe_model() -> None:

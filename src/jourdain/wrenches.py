@@ -80,10 +80,12 @@ class JointWrench:
 
 
 @lru_cache(maxsize=32)
-def _layout(system: System) -> tuple[tuple[Any, ...], list[Any], dict[str, SymMatrix]]:
-    """The joints' constrained directions, and per joint with directions its matrix
-    ``E_k`` (6 × n_k, the unit wrenches as columns) and its child's orientation ``S_k``."""
-    joints = joint_directions(system)
+def _layout(system: System, only: tuple[str, ...] | None = None
+            ) -> tuple[tuple[Any, ...], list[Any], dict[str, SymMatrix]]:
+    """The joints' constrained directions (of those in ``only`` where given), and per joint
+    with directions its matrix ``E_k`` (6 × n_k, the unit wrenches as columns) and its child's
+    orientation ``S_k``."""
+    joints = joint_directions(system, only)
     kin = kinematics(system)
     mats: dict[str, SymMatrix] = {}
     for k, jr in enumerate(joints):
@@ -95,8 +97,8 @@ def _layout(system: System) -> tuple[tuple[Any, ...], list[Any], dict[str, SymMa
 
 
 @lru_cache(maxsize=32)
-def _compiled(system: System) -> Any:
-    return lambdify(system, _layout(system)[2], lean=True)
+def _compiled(system: System, only: tuple[str, ...] | None = None) -> Any:
+    return lambdify(system, _layout(system, only)[2], lean=True)
 
 
 def _assemble(joints: Sequence[Any], g: np.ndarray, nums: Mapping[str, np.ndarray]
@@ -118,14 +120,16 @@ def _assemble(joints: Sequence[Any], g: np.ndarray, nums: Mapping[str, np.ndarra
 
 
 def joint_wrenches(system: System, g: Any, y: Any, yd: Any = None, t: float = 0.0,
-                   parameters: Mapping[str, float] | None = None) -> dict[str, JointWrench]:
-    """The wrench of every joint at one state from its reactions ``g`` (q,), in the order of
-    ``system.bodies``: ``{joint name: JointWrench}`` (see the module docstring).
+                   parameters: Mapping[str, float] | None = None,
+                   only: tuple[str, ...] | None = None) -> dict[str, JointWrench]:
+    """The wrench of every joint (of those in ``only``) at one state from its reactions ``g``
+    (q,), in the order of ``system.bodies``: ``{joint name: JointWrench}`` (see the module
+    docstring).
 
     The constrained directions and the orientations are evaluated once in floating point
     (no compilation); :meth:`System.evaluate` returns these as ``joint_wrenches``.
     """
-    joints, names, mats = _layout(system)
+    joints, names, mats = _layout(system, only)
     # the directions and orientations do not depend on the inputs: zeros stand for them (None
     # is refused for a model with inputs)
     args = state_vectors(system, y, np.zeros(system.f) if yd is None else yd, t, parameters,
@@ -147,13 +151,14 @@ def joint_wrenches(system: System, g: Any, y: Any, yd: Any = None, t: float = 0.
 
 
 def joint_wrenches_along(system: System, g: np.ndarray, t: np.ndarray, y: np.ndarray,
-                         yd: np.ndarray, parameters: np.ndarray) -> dict[str, JointWrench]:
+                         yd: np.ndarray, parameters: np.ndarray,
+                         only: tuple[str, ...] | None = None) -> dict[str, JointWrench]:
     """The wrenches along a motion: ``g`` (N, q), ``t`` (N,), ``y``, ``yd`` (N, f), the
-    parameter vector (compiled once per system; arrays (N, 3) in the result)."""
-    joints, names, _ = _layout(system)
+    parameter vector (compiled once per system and ``only``; arrays (N, 3) in the result)."""
+    joints, names, _ = _layout(system, only)
     if not names:
         return _assemble(joints, np.asarray(g, float), {})
-    out = _compiled(system).batch(y, yd, t, parameters, None)
+    out = _compiled(system, only).batch(y, yd, t, parameters, None)
     return _assemble(joints, np.asarray(g, float), out)
 
 

@@ -343,7 +343,9 @@ def evaluate_keys(system: System, y: Any, yd: Any, t: float, parameters: Any, in
     :func:`evaluate_reactions` raises, so that no reaction numbers appear for it.
     """
     if getattr(system, "groups", ()):
-        return _group_reactions(system, y, yd, t, parameters, inputs)
+        from .group_reactions import group_reactions
+
+        return group_reactions(system, y, yd, t, parameters, inputs)
     try:
         _reactions_function(system)
         out = evaluate_reactions(system, y, yd, t, parameters, inputs, eom=eom)
@@ -352,28 +354,6 @@ def evaluate_keys(system: System, y: Any, yd: Any, t: float, parameters: Any, in
 
     out["joint_wrenches"] = joint_wrenches(system, out["g"], y, yd, t, parameters)
     return out
-
-
-def _group_reactions(system: System, y: Any, yd: Any, t: float, parameters: Any,
-                     inputs: Any) -> dict[str, Any]:
-    """The reactions of a system with elastic bodies: those of its ordinary joints (not the
-    ones inside a body, which its elastic coordinates move), each from the sub-tree it carries
-    (:func:`joint_reactions`): ``g``, ``g_names``, ``g_undetermined`` (and ``reactions_note``).
-    Q̄ and N̂ are not formed (the bodies' inner joints are coupled)."""
-    inner = {j for g in system.groups for j in g.internal_joints()}
-    joints = [b.joint.name for b in system.bodies if b.joint.name not in inner]
-    note = ("the joints inside elastic bodies (" + ", ".join(g.name for g in system.groups)
-            + ") share the bodies' elastic coordinates and have no reactions of their own; "
-            "the other joints' reactions come from the sub-trees they carry")
-    try:
-        g = joint_reactions(system, joints, y, yd, t, parameters, inputs)
-    except JourdainError as exc:
-        return {"reactions_error": str(exc)}
-    names = list(g)
-    vals = np.array([g[n] for n in names], dtype=float)
-    return {"g": vals, "g_names": names,
-            "g_undetermined": [n for n, v in zip(names, vals, strict=True) if np.isnan(v)],
-            "reactions_note": note}
 
 
 def check_orthogonality(r: Reactions, samples: int = 3, seed: int = 7, fn: Any = None) -> float:

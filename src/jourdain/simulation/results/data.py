@@ -224,6 +224,11 @@ class TimeHistories:
 
             self._energies["g"], self._energies["g_names"] = closed_reactions_along(system, self)
             return
+        if system.groups:  # the ordinary joints' (jourdain.analysis.group_reactions)
+            from ...analysis.group_reactions import group_reactions_along
+
+            self._energies["g"], self._energies["g_names"] = group_reactions_along(system, self)
+            return
         from ...analysis.reactions import _reactions_function, reactions_along
 
         lay, fn = _reactions_function(system)
@@ -244,6 +249,12 @@ class TimeHistories:
 
             system = self._need_system("the joint wrenches")
             p = np.array([self.parameters[k] for k, _ in system.parameters])
+            if system.groups and not system.closing:
+                from ...analysis.group_reactions import group_wrenches_along
+
+                self._energies["joint_wrenches"] = group_wrenches_along(
+                    system, self.g, self.t, self.y, self.yd, p)
+                return self._energies["joint_wrenches"]
             tree = system.tree  # a closed system's tree joints come first in g
             q = len(self.g_names) - len(self._closing_g_names())
             self._energies["joint_wrenches"] = joint_wrenches_along(tree, self.g[:, :q], self.t,

@@ -102,8 +102,8 @@ def check_joints(system: System, joints: Sequence[JointReactions], samples: int 
             "the joints of an elastic body's nodes all move with its elastic coordinates, so "
             "the forces inside the body are no single joint's reaction (M, k, q, the "
             "linearization and the simulation hold the body in full; the other joints' "
-            "reactions, from the sub-trees they carry: System.evaluate, jd.joint_reactions, "
-            "jourdain reactions)")
+            "reactions, from the sub-trees they carry: System.evaluate, Results.g and "
+            "Results.joint_wrenches, jd.joint_reactions, jourdain reactions)")
     if total > system.f:
         # a joint that moves with coordinates it does not drive (gears, a screw turned by
         # another joint's angle) couples two joints: that coupling force is no joint's reaction

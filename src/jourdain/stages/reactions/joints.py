@@ -294,13 +294,17 @@ def _sample_values(exprs: list[se.Basic], coordinates: Sequence[se.Symbol],
 
 
 @lru_cache(maxsize=32)
-def joint_directions(system: System) -> tuple[JointReactions, ...]:
-    """The constrained directions of every joint, in body order, with the names and columns of
-    their components of g (no Q̄ yet: that needs the kinematics)."""
+def joint_directions(system: System, only: tuple[str, ...] | None = None
+                     ) -> tuple[JointReactions, ...]:
+    """The constrained directions of every joint (or of the joints named in ``only``), in body
+    order, with the names and columns of their components of g (no Q̄ yet: that needs the
+    kinematics)."""
     params = system.parameter_values
     joints: list[JointReactions] = []
     start = 0
     for body in system.bodies:
+        if only is not None and body.joint.name not in only:
+            continue
         dirs = constrained_directions(body.joint, system.coordinates, params)
         joints.append(JointReactions(
             body.joint, body.name, body.parent,
