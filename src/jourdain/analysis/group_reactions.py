@@ -19,6 +19,7 @@ import numpy as np
 
 from ..errors import JourdainError
 from ..wrenches import joint_wrenches, joint_wrenches_along
+from .reactions import joint_reactions
 
 if TYPE_CHECKING:
     from ..model.system import System
@@ -44,8 +45,6 @@ def group_reactions(system: System, y: Any, yd: Any, t: float, parameters: Any,
     """The reaction entries of :meth:`System.evaluate` for a system with elastic bodies:
     ``g``, ``g_names``, ``g_undetermined`` of the ordinary joints, their ``joint_wrenches``
     and ``reactions_note``; ``{"reactions_error": message}`` where they cannot be had."""
-    from .reactions import joint_reactions
-
     try:
         only = tuple(ordinary_joints(system))
         g = joint_reactions(system, list(only), y, yd, t, parameters, inputs)
@@ -63,8 +62,6 @@ def group_reactions_along(system: System, results: Any) -> tuple[np.ndarray, lis
     """``g`` (N, components) of the ordinary joints along a simulated motion and its column
     names: each sample's ÿ from the equations of motion and each joint's sub-tree residual
     (one compiled function, called per sample)."""
-    from .reactions import joint_reactions
-
     joints = ordinary_joints(system)
     rows: list[list[float]] = []
     names: list[str] = []

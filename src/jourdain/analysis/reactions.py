@@ -342,10 +342,6 @@ def evaluate_keys(system: System, y: Any, yd: Any, t: float, parameters: Any, in
     motion: then the only entry is ``reactions_error``, the message that
     :func:`evaluate_reactions` raises, so that no reaction numbers appear for it.
     """
-    if getattr(system, "groups", ()):
-        from .group_reactions import group_reactions
-
-        return group_reactions(system, y, yd, t, parameters, inputs)
     try:
         _reactions_function(system)
         out = evaluate_reactions(system, y, yd, t, parameters, inputs, eom=eom)

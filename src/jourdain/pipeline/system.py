@@ -198,6 +198,11 @@ class System(Model):
         out: dict[str, Any] = dict(evaluate_eom(self, y, yd, t=t, parameters=parameters,
                                                 inputs=inputs))
         eom: dict[str, np.ndarray] = dict(out)
+        if self.groups:  # elastic bodies: the ordinary joints' (jourdain.analysis.group_reactions)
+            from ..analysis.group_reactions import group_reactions
+
+            out.update(group_reactions(self, y, yd, t, parameters, inputs))
+            return out
         from ..analysis.reactions import evaluate_keys
 
         out.update(evaluate_keys(self, y, yd, t, parameters, inputs, eom=eom))
