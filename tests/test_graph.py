@@ -10,7 +10,7 @@ import sympy as sp
 
 import jourdain.graph.identity as identity
 from jourdain.errors import JourdainError
-from jourdain.graph import Graph, cse, evaluate_float, jet, jet_float
+from jourdain.graph import Graph, cse, evaluate_float, evaluate_float_many, jet, jet_float
 from jourdain.models import spatial_chain
 
 EPS = np.finfo(float).eps
@@ -117,3 +117,20 @@ def test_missing_value_and_non_real_results_name_the_cause():
     with pytest.raises(JourdainError, match="no real value"):
         evaluate_float([se.log(x)], {"x": -1.0})
     assert evaluate_float([se.exp(x)], {"x": 1.0}) == [math.e]
+
+
+def test_many_sets_in_one_walk_equal_one_set_at_a_time(rng):
+    """evaluate_float_many: the numbers of evaluate_float at each set, to the rounding of its
+    left-to-right sums (evaluate_float sums exactly: fsum); a value that is not real falls
+    back to evaluate_float, which names it."""
+    eom = spatial_chain(3).equations_of_motion()
+    exprs = [*eom.M.entries(), *eom.k.entries(), se.Max(eom.y[0], eom.y[1]), se.Abs(eom.y[2])]
+    names = sorted(Graph(exprs).symbol_names())
+    sets = [dict(zip(names, rng.uniform(-1, 1, len(names)), strict=True)) for _ in range(5)]
+    many = evaluate_float_many(exprs, sets)
+    one = np.array([evaluate_float(exprs, v) for v in sets])
+    assert many.shape == (5, len(exprs))
+    assert np.abs(many - one).max() <= 1e3 * EPS * np.abs(one).max()
+    x = se.Symbol("x")
+    with pytest.raises(JourdainError, match="no real value"):
+        evaluate_float_many([se.log(x)], [{"x": 1.0}, {"x": -1.0}])

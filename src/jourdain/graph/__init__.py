@@ -21,11 +21,18 @@ Floor: model → **graph tools** → stages → numeric. The package imports not
 from .elimination import CSE, count_nodes, cse, graph_ops, node_ops, tree_ops
 from .forward import Jet, as_basic, jet
 from .nodes import Graph, Merged, atom_key
-from .numbers import FloatJet, evaluate_arrays, evaluate_float, free_symbol_names, jet_float
+from .numbers import (
+    FloatJet,
+    evaluate_arrays,
+    evaluate_float,
+    evaluate_float_many,
+    free_symbol_names,
+    jet_float,
+)
 from .sums import shared_sums, term_keys
 
 __all__ = [
     "CSE", "FloatJet", "Graph", "Jet", "Merged", "as_basic", "atom_key", "count_nodes", "cse",
-    "evaluate_arrays", "evaluate_float", "free_symbol_names", "graph_ops", "jet", "jet_float", "node_ops",
+    "evaluate_arrays", "evaluate_float", "evaluate_float_many", "free_symbol_names", "graph_ops", "jet", "jet_float", "node_ops",
     "shared_sums", "term_keys", "tree_ops",
 ]

@@ -1,7 +1,8 @@
 """Numbers of shared expression graphs: evaluation and first derivatives in floating point.
 
 :func:`evaluate_float` gives the numbers of some expressions for numbers of their symbols, and
-:func:`jet_float` their values and Jacobian (forward mode with dense NumPy gradients), and
+:func:`jet_float` their values and Jacobian (forward mode with dense NumPy gradients),
+:func:`evaluate_float_many` their numbers at several sets of values in one walk, and
 :func:`evaluate_arrays` their values at many states at once (NumPy arrays), each visiting every
 distinct node of the :class:`~jourdain.graph.Graph` once. For one evaluation this
 is faster than compiling; for many, compile (:func:`jourdain.numeric.lambdify`).
@@ -89,6 +90,50 @@ def _float_values(g: Graph, values: Mapping[str, float]) -> dict[int, float]:
             v = float(g.node[k].func(*(se.RealDouble(x) for x in args)))
         num[k] = v
     return num
+
+
+def evaluate_float_many(exprs: Sequence[Expr], values: Sequence[Mapping[str, float]]
+                        ) -> np.ndarray:
+    """:func:`evaluate_float` at several sets of symbol values at once: an array (sets,
+    expressions). The graph is walked once with NumPy vectors of the sets' values (sums left to
+    right, not ``fsum``: rounding of the terms' size). Where a value is not finite, each set is
+    evaluated again by :func:`evaluate_float`, which names a value that is not real."""
+    g = graph_of(exprs)
+    n = len(values)
+    num: dict[int, Any] = {}
+    for ka, a in g.atoms.items():
+        if a.is_Symbol:
+            name = str(a)
+            if any(name not in v for v in values):
+                raise JourdainError(f'no value for the symbol "{name}"')
+            num[ka] = np.array([float(v[name]) for v in values])
+        else:
+            num[ka] = np.full(n, float(a))
+    kind, children = g.kind, g.children
+    with no_gc(), np.errstate(all="ignore"):
+        for k in g.order:
+            args = [num[c] for c in children[k]]
+            name = kind[k]
+            if name == "Add" or name == "Mul":
+                v = args[0]
+                for x in args[1:]:
+                    v = v + x if name == "Add" else v * x
+            elif name == "Pow":
+                base = g.atoms.get(children[k][0])
+                v = (np.exp(args[1]) if base is not None and base == se.E
+                     else np.power(args[0], args[1]))
+            elif name in ("Max", "Min"):
+                v = (np.maximum if name == "Max" else np.minimum).reduce(args)
+            elif name in _NUMPY:
+                v = _NUMPY[name](*args)
+            else:
+                v = np.array([float(g.node[k].func(*(se.RealDouble(float(x[i])) for x in args)))
+                              for i in range(n)])
+            num[k] = v
+        out = np.array([num[k] for k in g.roots]).reshape(len(g.roots), n).T
+    if not np.all(np.isfinite(out)):
+        return np.array([evaluate_float(exprs, v) for v in values], dtype=float)
+    return out
 
 
 def _sum(args: list[float]) -> float:

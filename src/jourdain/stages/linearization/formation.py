@@ -13,7 +13,7 @@ import numpy as np
 import symengine as se
 
 from ...errors import JourdainError, warn
-from ...graph import evaluate_float, free_symbol_names, jet
+from ...graph import evaluate_float_many, free_symbol_names, jet
 from ...symbolic import SymMatrix
 
 if TYPE_CHECKING:
@@ -183,8 +183,8 @@ def _time_dependence(system: System, matrices: dict[str, list[list[se.Basic]]]
         if "t" not in free_symbol_names(flat):
             continue
         for values in trials:
-            nums = np.array([evaluate_float(flat, {**values, "t": tv})
-                             for tv in (0.0, 0.37, 1.91, 4.3)])
+            nums = evaluate_float_many(flat, [{**values, "t": tv}
+                                              for tv in (0.0, 0.37, 1.91, 4.3)])
             scale = max(1.0, float(np.abs(nums).max()))
             if not np.all(np.isfinite(nums)) or np.ptp(nums, axis=0).max() > 1e-10 * scale:
                 out.append(name)
