@@ -48,6 +48,7 @@ if TYPE_CHECKING:  # the same names for type checkers and readers; at run time _
     )
     from .analysis.energy import Energy, energy
     from .analysis.floquet import floquet
+    from .analysis.mode_motion import mode_motion
     from .analysis.modes import modes
     from .analysis.numeric_linearization import NumericLinearization, linearize_numeric
     from .analysis.reactions import evaluate_reactions, joint_reactions
@@ -146,6 +147,7 @@ _WHERE: dict[str, tuple[str, ...]] = {
         "state_feedback", "to_control"),
     "analysis.energy": ("Energy", "energy"),
     "analysis.floquet": ("floquet",),
+    "analysis.mode_motion": ("mode_motion",),
     "analysis.modes": ("modes",),
     "analysis.numeric_linearization": ("NumericLinearization", "linearize_numeric"),
     "analysis.reactions": ("evaluate_reactions", "joint_reactions"),
@@ -233,7 +235,7 @@ __all__ = [
     # simulation (jourdain.simulation)
     "simulate", "Results", "Event", "IntegrationError",
     # analysis (jourdain.analysis, jourdain.equilibrium)
-    "state_space", "StateSpace", "modes", "Modes", "stability", "Stability",
+    "state_space", "StateSpace", "modes", "Modes", "mode_motion", "stability", "Stability",
     "frequency_response", "FrequencyResponse", "sweep", "Sweep", "stability_boundary",
     "floquet", "Floquet", "cyclic_coordinates", "energy", "Energy",
     "find_equilibrium", "find_equilibria", "Equilibrium", "NoEquilibrium",
