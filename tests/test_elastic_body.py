@@ -17,6 +17,7 @@ import scipy.optimize as so
 import symengine as se
 
 import jourdain as jd
+from jourdain.analysis.floquet import FLOQUET_RTOL
 from jourdain.elastic import Beam, assemble, modal_data
 from jourdain.elastic.body import ElasticBody, lumped_masses
 from jourdain.errors import ModelError
@@ -382,3 +383,20 @@ def test_closed_loop_through_an_elastic_body() -> None:
     scale = np.abs(np.asarray(r.kinetic_energy)).max() + np.abs(E_tot).max()
     assert np.abs(E_tot - E_tot[0]).max() <= 10 * rtol * scale
     assert np.abs(np.asarray(r.y)[:, 3:]).max() > 1e-6  # the coupler did bend
+
+
+def test_floquet_of_a_flexible_pendulum_is_its_eigenvalues() -> None:
+    """Floquet on the hanging flexible pendulum (time-invariant: any period T): the
+    multipliers from the integrated monodromy matrix equal e^{λT} of the linearization's
+    eigenvalues, to the integration's tolerance — the elastic coordinates' fast modes
+    (ωT up to 37 rad) included."""
+    model = jd.load_model(Path(__file__).parent.parent / "examples" / "flexible_pendulum.toml")
+    system = model.system
+    eq = jd.find_equilibrium(system, {"phi": -np.pi / 2})
+    lin = system.linearize(dict(zip(system.coordinate_names, eq.y, strict=True)))
+    T = 0.05
+    fl = jd.floquet(lin, T, cyclic=())
+    ref = np.exp(jd.modes(lin).eigenvalues * T)
+    worst = max(float(np.abs(fl.multipliers - mu).min()) for mu in ref)
+    assert len(fl.multipliers) == len(ref) == 8
+    assert worst <= 1e3 * FLOQUET_RTOL, worst

@@ -39,7 +39,7 @@ OUTCOME = {
     **dict.fromkeys(["kinematics", "evaluate_reactions", "joint_reactions", "joint_wrenches",
                      "linearize_numeric", "sweep", "stability_boundary", "floquet",
                      "cyclic_coordinates", "find_equilibrium", "find_equilibria",
-                     "state_feedback", "to_casadi"], "refused"),
+                     "state_feedback", "to_casadi", "mode_motion"], "refused"),
 }
 
 
@@ -72,6 +72,7 @@ def test_refused_functions_name_the_closing_joints(closed) -> None:  # noqa: ANN
         "state_feedback": lambda: jd.state_feedback(system, np.zeros((0, 2)),
                                                     {"theta1": 0.5}),
         "to_casadi": lambda: jd.to_casadi(system),
+        "mode_motion": lambda: jd.mode_motion(lin, 1),
     }
     assert set(calls) == {k for k, v in OUTCOME.items() if v == "refused"}
     for name, call in calls.items():

@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import EvaluationError
+from ..errors import EvaluationError, refuse_closed
 from ..graph import evaluate_float_many
 from ..simulation.results import Results
 from .modes import modes
@@ -38,17 +38,14 @@ def mode_motion(lin: Any, mode: int = 1, amplitude: float = 0.1, periods: float 
     unit), at the ``parameters`` (default: the model's). For a time-dependent (periodic)
     linearization the mode is that of the matrices at ``t0``.
 
-    Raises EvaluationError for a linearization of a closed system (its state is not the
-    system's coordinates), a mode number out of range, or arguments that are not positive
-    finite numbers.
+    Raises ClosedSystemError for the linearization of a closed system (its state is not the
+    system's coordinates) and EvaluationError for a mode number out of range or arguments that
+    are not positive finite numbers.
     """
     system = lin.system
-    names = tuple(system.coordinate_names)
+    refuse_closed(system, "mode_motion", "the state of a closed system's linearization is its "
+                  "independent coordinates, not the motion of all of them")
     ss = state_space(lin, t0, parameters, allow_time_variant=True)
-    if tuple(ss.coordinate_names) != names or getattr(system, "closing", None):
-        raise EvaluationError("mode_motion: give the linearization of a system without closing "
-                              "joints (the state of a closed system's linearization is not its "
-                              "coordinates)")
     for what, v in (("amplitude", amplitude), ("periods", periods)):
         if not (np.isfinite(v) and v > 0):
             raise EvaluationError(f"mode_motion: {what} must be a positive number, got {v!r}")
