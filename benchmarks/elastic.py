@@ -61,6 +61,10 @@ Measured 2026-11-26 (the full run, 4 min) on a 2-core x86-64 shared with other s
    the graph built for it). Model → first simulated step: 3.37 s, of which derivation and
    compilation of M, k, q 2.88 s (gcc 2.08 s for the recursion's library: the symbolic
    projection, derived first, has 31 750 graph nodes, over the 1 500 of symbolic code).
+   **2026-11-27**, after the check walks each matrix once for its 4 times
+   (``graph.evaluate_float_many``), best of 5, the code before and after run one after the
+   other on the same machine (load 1.1–1.8): **1.84 s** against 2.28 s before (linearize
+   1.56 against 1.95 s; a second run: 1.79 s): the 2 s target is met.
 2. Campbell, 200 speeds: ROSS 42.9 s (model 0.08 s; import 4.7 s and its first call's Numba
    compilation 10.3 s not counted) against jourdain's sweep 0.41 s (**105×**; compiled
    linearization 0.18 s, 242×); with the one-off costs (body + linearization 2.15 s) 16.8×.
