@@ -32,6 +32,8 @@ from jourdain.elastic.rotor import campbell, eigenvalues
 from jourdain.io.report.campbell import _frequencies
 from jourdain.model.expressions import t
 from jourdain.models.elastic import flexible_rotor, flexible_rotor_fe, rotor_parts, rotor_shaft
+from jourdain.study import loads_study, run_study
+from jourdain.study.linear import VERDICTS
 
 EXAMPLE = Path(__file__).parent.parent / "examples" / "flexible_rotor.toml"
 SPEEDS = np.array([0.0, 250.0, 500.0, 750.0, 1000.0])
@@ -151,3 +153,24 @@ def test_consistent_mass_with_every_mode_equals_ross() -> None:
         camp = _ross_rotor(rs, 6).run_campbell(SPEEDS, frequencies=6)
     theirs = np.sort(np.asarray(camp.wd), axis=1)
     assert np.abs(mine / theirs - 1).max() < 1e-6
+
+
+def test_a_parameter_study_over_speed(linearized) -> None:
+    """A study of the example over the spin speed (jourdain.study: the compiled
+    linearization, batched): its eigenvalues equal those of the linearization's state space
+    at each speed, to the eigenvalues' accuracy (eps·‖A‖ times the spread of the modes), and
+    its verdicts turn unstable past the boundary of test_stability_boundary_over_speed."""
+    spec = loads_study(f'[study]\nmodel = "{EXAMPLE}"\ndesign = "list"\n[vary.Omega]\n'
+                       'values = [0.0, 300.0, 600.0]\n[compute.linearize]\nabout = "spinning"\n')
+    ds = run_study(spec, workers=1)
+    assert (ds.error.values == "").all()
+    for k, om in enumerate(ds.Omega.values):
+        ss = jd.state_space(linearized, parameters={"Omega": float(om)})
+        ref = np.linalg.eigvals(ss.A)
+        w = np.abs(ref)
+        tol = 1e3 * np.finfo(float).eps * np.abs(ss.A).max() * w.max() / w.min()
+        lam = ds.eigenvalue_real.values[k] + 1j * ds.eigenvalue_imag.values[k]
+        assert len(lam) == len(ref)
+        assert max(float(np.abs(ref - z).min()) for z in lam) <= tol
+    assert [VERDICTS[int(v)] for v in ds.verdict.values] == ["asymptotically stable"] * 2 + [
+        "unstable"]
