@@ -48,11 +48,17 @@ def test_internal_damping_threshold_in_the_report(tmp_path: Path) -> None:
 
 def test_elastic_parts_of_the_report_and_the_view(tmp_path: Path) -> None:
     """The flexible pendulum's report lists its basis's frequencies and draws the mode
-    shapes; the 3-D view joins the beam's nine mass nodes, in order, by its line."""
+    shapes, links 3-D views of its lowest modes; the 3-D view joins the beam's nine mass
+    nodes, in order, by its line."""
     model = jd.load_model(EXAMPLES / "flexible_pendulum.toml")
     write_report(model, tmp_path, t_end=0.2)
     page = (tmp_path / "report.html").read_text(encoding="utf-8")
     assert "Elastic bodies" in page and "mode shapes of arm" in page
+    # the lowest modes about the nominal "hanging" animated in 3-D views of their own
+    for k in (1, 2, 3):
+        assert f"href='mode-hanging-{k}.html'" in page
+        view_page = (tmp_path / f"mode-hanging-{k}.html").read_text(encoding="utf-8")
+        assert "jourdain-view/1" in view_page
     eb = model.system.groups[0]
     assert f"{eb.modal.omega[0]:.6g}" in page or f"{eb.modal.omega[0]:.5g}" in page
     r = model.system.simulate(t_span=(0, 0.1), y0=[0.5, 0, 0, 0], yd0=[0, 0, 0, 0])

@@ -9,6 +9,8 @@ from typing import Any
 
 import numpy as np
 
+from ...analysis.mode_motion import mode_motion
+from ..viewer import view
 from .figures import plot_axes, svg
 from .html import esc, html_table, numstr
 from .state import Run
@@ -80,3 +82,53 @@ def elastic_html(run: Run) -> str:
             parts.append(run.figures.add(mode_shape_plot, s, shapes, labels,
                                          f"mode shapes of {b.name}"))
     return "".join(parts)
+
+
+#: oscillating modes of a model with elastic bodies animated in 3-D views of their own
+MODE_VIEWS = 3
+
+
+def mode_amplitude(system: Any, shape: np.ndarray) -> float:
+    """The amplitude for :func:`jourdain.analysis.mode_motion.mode_motion` of the mode
+    ``shape`` (complex, f): the elastic bodies' nodes move by at most 5 % of the largest body's
+    extent, the other coordinates by at most 0.1 (rad or m)."""
+    names = list(system.coordinate_names)
+    shape = np.asarray(shape)
+    move, extent = 0.0, 0.0
+    elastic: set[int] = set()
+    for g in getattr(system, "groups", ()):
+        if not hasattr(g, "modal"):
+            continue
+        idx = [names.index(str(c)) for c in g.coordinates]
+        elastic.update(idx)
+        # a gyroscopic mode's complex shape: each node's largest excursion, |Φ_t·s|
+        u = np.einsum("nik,k->ni", np.asarray(g.modal.Phi_t, float), shape[idx])
+        move = max(move, float(np.abs(u).max(initial=0.0)))
+        nodes = np.asarray(g.modal.nodes, float)
+        extent = max(extent, float(np.ptp(nodes, axis=0).max()) if len(nodes) > 1 else 0.0)
+    rigid = [abs(shape[i]) for i in range(len(names)) if i not in elastic]
+    bounds = [0.1 / max(rigid)] if rigid and max(rigid) > 0 else []
+    if move > 0 and extent > 0:
+        bounds.append(0.05 * extent / move)
+    return min(bounds, default=0.1)
+
+
+def mode_views(run: Run, nominal: str, lin: Any, modes: Any) -> str:
+    """``mode-<nominal>-<k>.html``: the model's lowest oscillating modes about ``nominal``
+    animated in the 3-D view (:func:`jourdain.mode_motion`), for models with elastic bodies;
+    a line linking them ("" otherwise)."""
+    system = run.model.system
+    if not getattr(system, "groups", ()):
+        return ""
+    osc = modes.oscillating()[:MODE_VIEWS]
+    links = []
+    for k, i in enumerate(osc, start=1):
+        amp = mode_amplitude(system, modes.shapes[:, i])
+        v = view(mode_motion(lin, k, amplitude=amp, parameters=run.params))
+        path = v.save(run.out / f"mode-{nominal}-{k}.html")
+        run.info.files.append(path)
+        links.append(f"<a href='{esc(path.name)}'>mode {k}, "
+                     f"{modes.damped_frequencies[i] / (2 * np.pi):.4g} Hz</a>")
+    return ("<p>The lowest modes, animated in the 3-D view (nodes moved by up to 5 % of the "
+            "body's length, other coordinates by up to 0.1): " + ", ".join(links)
+            + ".</p>") if links else ""

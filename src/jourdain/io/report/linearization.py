@@ -12,6 +12,7 @@ from ...errors import JourdainError
 from ...workflow import has_capability
 from .. import capabilities
 from .campbell import campbell_section
+from .elastic import mode_views
 from .figures import Figures, eigen_plot, multiplier_plot
 from .html import SYM, esc, headline_lin, html_table, mathml, matrix_table, note, numstr, snap
 from .state import Run
@@ -93,6 +94,11 @@ def linearization_section(run: Run) -> str:
                 s.append(html_table(rows, ["Re λ / (1/s)", "Im λ / (rad/s)", "f<sub>n</sub> / Hz",
                                        "ζ"]))
                 s.append(run.figures.add(eigen_plot, lams, f"eigenvalues about {nominal.name}"))
+                if res["time_invariant"]:  # elastic bodies: the lowest modes in 3-D
+                    try:
+                        s.append(mode_views(run, nominal.name, res["linearization"], m))
+                    except JourdainError as exc:
+                        s.append(note(f"the modes' 3-D views not available: {exc}"))
             if res.get("cyclic"):
                 s.append(f"<p>{esc(capabilities.cyclic_text(res['cyclic']))}.</p>")
             fl = res.get("floquet")
