@@ -44,8 +44,8 @@ import symengine as se
 
 from jourdain.elastic.beam import Beam, FEModel, assemble, frame_of_axis
 from jourdain.elastic.modal import ModalData
-from jourdain.elastic.quadrature import MassPoints, gauss_points, lumped_masses
-from jourdain.elastic.reduction import modal_truncation
+from jourdain.elastic.quadrature import MassPoints, gauss_points, lumped_masses, mass_kind
+from jourdain.elastic.reduction import clamped_basis, modal_damping, modal_truncation
 from jourdain.elastic.rotor import Bearing, Disc, rotor
 from jourdain.elastic.stiffening import foreshortening
 from jourdain.errors import ModelError
@@ -163,6 +163,29 @@ class ElasticBody(BodyGroup):
                                                 else float(np.sum(self.points.mass)))
 
     @property
+    def elastic_mass(self) -> np.ndarray:
+        """The body's own ``M_e``: Σ m·Φ_tᵀΦ_t + Φ_rᵀ·I·Φ_r over its nodes and mass points
+        (the FE's Φᵀ·M·Φ for the consistent mass; the lumped masses' otherwise)."""
+        md = self.modal
+        sets = [(md.Phi_t, md.Phi_r, self.node_mass, self.node_inertia)]
+        if self.points is not None:
+            sets.append((self.points.Phi_t, self.points.Phi_r, self.points.mass,
+                         self.points.inertia))
+        out = np.zeros((self.n_q, self.n_q))
+        for Pt, Pr, m, inertia in sets:
+            out += np.einsum("n,nik,nil->kl", np.asarray(m, float), Pt, Pt)
+            if inertia is not None:
+                out += np.einsum("nik,nij,njl->kl", Pr, np.asarray(inertia, float), Pr)
+        return 0.5 * (out + out.T)
+
+    def damped(self, zeta: float) -> ElasticBody:
+        """This body with every mode of its own (``K_e``, :attr:`elastic_mass`) damped by the
+        ratio ``zeta`` (:func:`jourdain.elastic.reduction.modal_damping`; itself for 0)."""
+        if not zeta:
+            return self
+        return replace(self, modal=modal_damping(self.modal, float(zeta), self.elastic_mass))
+
+    @property
     def n_q(self) -> int:
         return self.modal.n_q
 
@@ -258,16 +281,20 @@ class ElasticBody(BodyGroup):
     def from_fe(cls, name: str, parent: str, joint: Joint, fe: FEModel, n_modes: int, *,
                 clamped: Iterable[int | tuple[int, str]] = (0,),
                 attach: Mapping[str, int] | None = None,
-                damping_ratio: float = 0.0) -> ElasticBody:
+                damping_ratio: float = 0.0, reduction: str = "normal") -> ElasticBody:
         """An elastic body from any finite-element model (:func:`jourdain.elastic.fe_model`:
         M and K as arrays, SciPy sparse matrices or MatrixMarket files, with node
         coordinates): its ``n_modes`` lowest normal modes with the ``clamped`` nodes (or
         ``(node, dof)`` pairs) held by the frame, the mass lumped at the nodes by HRZ
-        (:func:`lumped_masses`). No geometric stiffening (it needs a beam's axis)."""
+        (:func:`lumped_masses`); ``reduction="craig_bampton"`` as for :meth:`beam`. No
+        geometric stiffening (it needs a beam's axis)."""
         clamped = list(clamped)
-        modal = _clamped_modes(name, fe, n_modes, clamped, clamped, damping_ratio)
+        nodes = [c[0] if isinstance(c, tuple) else c for c in clamped]
+        modal = clamped_basis(name, fe, n_modes, nodes, clamped, reduction,  # type: ignore[arg-type]
+                              [int(v) for v in (attach or {}).values()])
         return cls(name, parent, joint, modal, lumped_masses(fe), None,
-                   tuple((str(k), int(v)) for k, v in (attach or {}).items()))
+                   tuple((str(k), int(v)) for k, v in (attach or {}).items())
+                   ).damped(damping_ratio)
 
     @classmethod
     def rotor(cls, name: str, parent: str, joint: Joint, shaft: Beam, n_modes: int, *,
@@ -284,24 +311,28 @@ class ElasticBody(BodyGroup):
         ``mass="consistent"``: the shaft's mass and sections at the elements' Gauss points
         instead (:mod:`jourdain.elastic.quadrature`: the FE rotor's M and G exactly)."""
         return _rotor_body(cls, name, parent, joint, shaft, discs, bearings, n_modes, spin,
-                           attach, _mass_kind(name, mass))
+                           attach, mass_kind(name, mass))
 
     @classmethod
     def beam(cls, name: str, parent: str, joint: Joint, beam: Beam, n_modes: int, *,
              clamped: Iterable[int] = (0,), keep: Sequence[str] | None = None,
              attach: Mapping[str, int] | None = None, stiffening: bool = True,
-             damping_ratio: float = 0.0, mass: str = "lumped") -> ElasticBody:
+             damping_ratio: float = 0.0, mass: str = "lumped",
+             reduction: str = "normal") -> ElasticBody:
         """A beam body: ``beam`` meshed (:func:`jourdain.elastic.beam.assemble`), its
         ``n_modes`` lowest normal modes with the nodes ``clamped`` held in the reference frame
         (the cantilever's modes for the default, node 0 at ``beam.origin``), node masses ρA
         per length lumped at the nodes (:func:`lumped_masses`), modal damping ``damping_ratio``
-        (D_e = 2ζ·diag ω), and the foreshortening of :mod:`~jourdain.elastic.stiffening` when
+        (every mode of the basis damped by ζ), and the foreshortening of :mod:`~jourdain.elastic.stiffening` when
         ``stiffening``. ``keep`` (DOF names such as ``("uy", "rz")``) restricts the modes to
         those DOFs, every other one held at every node: a beam bending in one plane only.
         ``mass="consistent"`` puts the mass and the sections' rotary inertia at the elements'
         Gauss points (:mod:`jourdain.elastic.quadrature`): the FE beam's consistent mass,
-        exactly, for four bodies per element instead of one per node."""
-        consistent = _mass_kind(name, mass)
+        exactly, for four bodies per element instead of one per node.
+        ``reduction="craig_bampton"``: the basis is Craig–Bampton's, constraint modes at the
+        ``attach`` nodes (the DOFs kept there) and ``n_modes`` fixed-interface modes, so that
+        static loads at the attachments are exact."""
+        consistent = mass_kind(name, mass)
         fe = assemble(beam)
         clamped = [int(c) for c in clamped]
         fixed: list[int | tuple[int, str]] = list(clamped)
@@ -310,24 +341,19 @@ class ElasticBody(BodyGroup):
             if bad:
                 raise ModelError(f'elastic body "{name}": unknown DOF names {bad} in keep')
             fixed += [d for d in fe.dofs if d[1] not in keep and d[0] not in clamped]
-        modal = _clamped_modes(name, fe, n_modes, clamped, fixed, damping_ratio)
+        modal = clamped_basis(name, fe, n_modes, clamped, fixed, reduction,
+                              [int(v) for v in (attach or {}).values()])
         Psi = None
         if stiffening:
             R = frame_of_axis(beam.axis, beam.up)
             Psi = foreshortening(modal.nodes, R, modal.Phi_t, modal.Phi_r, clamped[0])
         labels = tuple((str(k), int(v)) for k, v in (attach or {}).items())
         if consistent:
-            return cls(name, parent, joint, modal, np.zeros(len(modal.nodes)), Psi, labels,
+            body = cls(name, parent, joint, modal, np.zeros(len(modal.nodes)), Psi, labels,
                        points=gauss_points(beam, modal, clamped[0] if stiffening else None))
-        return cls(name, parent, joint, modal, lumped_masses(fe), Psi, labels)
-
-
-def _mass_kind(name: str, mass: object) -> bool:
-    """True for ``"consistent"``, False for ``"lumped"``; ModelError otherwise."""
-    if mass not in ("lumped", "consistent"):
-        raise ModelError(f'elastic body "{name}": mass must be "lumped" or "consistent", '
-                         f"got {mass!r}")
-    return mass == "consistent"
+        else:
+            body = cls(name, parent, joint, modal, lumped_masses(fe), Psi, labels)
+        return body.damped(damping_ratio)
 
 
 def _rotor_body(cls: type[ElasticBody], name: str, parent: str, joint: Joint, shaft: Beam,
@@ -369,20 +395,3 @@ def _rotor_body(cls: type[ElasticBody], name: str, parent: str, joint: Joint, sh
                tuple((str(a), int(v)) for a, v in (attach or {}).items()),
                inertia, (axis, as_expr(spin, f'elastic body "{name}" spin')),  # type: ignore[arg-type]
                gauss_points(shaft, modal) if consistent else None)
-
-
-def _clamped_modes(name: str, fe: FEModel, n_modes: int, clamped: Sequence[object],
-                   fixed: Sequence[int | tuple[int, str]], damping_ratio: float) -> ModalData:
-    """The ``n_modes`` lowest normal modes with ``fixed`` held (the ``clamped`` nodes, which
-    the reference frame holds, among them), with modal damping ``damping_ratio``."""
-    if not clamped:
-        raise ModelError(f'elastic body "{name}": give the clamped nodes (the reference frame '
-                         "holds them); free-free bodies are not built here")
-    modal = modal_truncation(fe, n_modes, fixed=fixed)
-    return _with_damping(modal, float(damping_ratio)) if damping_ratio else modal
-
-
-def _with_damping(modal: ModalData, zeta: float) -> ModalData:
-    if not (np.isfinite(zeta) and zeta >= 0):
-        raise ModelError(f"damping_ratio must be a finite number ≥ 0, got {zeta!r}")
-    return replace(modal, D_e=2.0 * zeta * np.diag(modal.omega) @ modal.M_e)

@@ -34,7 +34,7 @@ from jourdain.elastic.modal import ModalData
 from jourdain.elastic.stiffening import foreshortening_at
 from jourdain.errors import ModelError
 
-__all__ = ["MassPoints", "gauss_points", "lumped_masses"]
+__all__ = ["MassPoints", "gauss_points", "lumped_masses", "mass_kind"]
 
 _GX, _GW = np.polynomial.legendre.leggauss(4)
 _XI = 0.5 * (_GX + 1.0)
@@ -137,3 +137,11 @@ def gauss_points(beam: Beam, modal: ModalData, stiffening_from: int | None = Non
     shape = (n_el * 4, 3, n_q)
     return MassPoints(np.array(c), np.array(Pt).reshape(shape), np.array(Pr).reshape(shape),
                       np.array(mass), np.array(inertia), Psi)
+
+
+def mass_kind(name: str, mass: object) -> bool:
+    """True for ``"consistent"``, False for ``"lumped"``; ModelError otherwise."""
+    if mass not in ("lumped", "consistent"):
+        raise ModelError(f'elastic body "{name}": mass must be "lumped" or "consistent", '
+                         f"got {mass!r}")
+    return mass == "consistent"

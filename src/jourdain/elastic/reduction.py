@@ -27,6 +27,7 @@ sparse LU and shift-invert Lanczos (``scipy.sparse.linalg.eigsh``).
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -39,7 +40,7 @@ from jourdain.elastic.modal import ModalData, modal_data, rigid_fields
 from jourdain.errors import ModelError
 
 __all__ = ["dof_indices", "constrain", "normal_modes", "modal_truncation", "craig_bampton",
-           "free_modes"]
+           "free_modes", "clamped_basis", "modal_damping"]
 
 DofSpec = int | tuple[int, str]
 
@@ -222,3 +223,45 @@ def free_modes(fe: FEModel, n_modes: int, correction: Iterable[DofSpec] = (),
         kinds = ["ritz"] * basis.shape[1]  # modes and corrections mixed by the Ritz step
     return modal_data(fe, _expand(fe, keep, basis), "free modes + static correction"
                       if cols else "free modes", tuple(kinds))
+
+
+def clamped_basis(name: str, fe: FEModel, n_modes: int, clamped: Sequence[int],
+                  fixed: Sequence[DofSpec], reduction: str = "normal",
+                  interface: Sequence[int] = ()) -> ModalData:
+    """The basis of an elastic body whose reference frame holds the ``clamped`` nodes, the
+    DOFs ``fixed`` (those nodes' among them) held: its ``n_modes`` lowest normal modes
+    (``reduction="normal"``), or Craig–Bampton's constraint modes at the DOFs of the
+    ``interface`` nodes that are not fixed, with ``n_modes`` fixed-interface modes
+    (``"craig_bampton"``: a static load at an interface node is then represented exactly).
+    ModelError names the body."""
+    if not clamped:
+        raise ModelError(f'elastic body "{name}": give the clamped nodes (the reference frame '
+                         "holds them); free-free bodies are not built here")
+    if reduction == "normal":
+        modal = modal_truncation(fe, n_modes, fixed=fixed)
+    elif reduction == "craig_bampton":
+        held = set(dof_indices(fe, fixed))
+        dofs = [d for d in fe.dofs if d[0] in set(interface) and fe.index(*d) not in held]
+        if not dofs:
+            raise ModelError(f'elastic body "{name}": Craig–Bampton needs interface nodes '
+                             "(attach) with DOFs that are not held")
+        modal = craig_bampton(fe, dofs, n_modes, fixed=fixed)
+    else:
+        raise ModelError(f'elastic body "{name}": reduction must be "normal" or '
+                         f'"craig_bampton", got {reduction!r}')
+    return modal
+
+
+def modal_damping(modal: ModalData, zeta: float, M_e: np.ndarray | None = None) -> ModalData:
+    """``modal`` with the damping ``D_e`` that gives every mode of ``(K_e, M_e)`` the damping
+    ratio ``zeta``: ``D_e = M_e·V·diag(2ζω)·Vᵀ·M_e`` with ``K_e·V = M_e·V·diag(ω²)``,
+    ``Vᵀ·M_e·V = E`` (``2ζ·diag(ω)`` for mass-normal modes). ``M_e``: the elastic mass the
+    body has (lumped masses: not the FE's; default ``modal.M_e``)."""
+    if not (np.isfinite(zeta) and zeta >= 0):
+        raise ModelError(f"damping_ratio must be a finite number ≥ 0, got {zeta!r}")
+    Me = modal.M_e if M_e is None else np.asarray(M_e, dtype=float)
+    Ke = 0.5 * (modal.K_e + modal.K_e.T)
+    lam, V = sla.eigh(Ke, 0.5 * (Me + Me.T))
+    w = np.sqrt(np.clip(lam, 0.0, None))
+    MV = Me @ V
+    return replace(modal, D_e=MV @ np.diag(2.0 * zeta * w) @ MV.T)

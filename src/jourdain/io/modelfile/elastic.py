@@ -13,7 +13,9 @@ The beam's data are numbers (the modes are computed from them once). Optional ke
 ``attach`` (label -> node: the frames ``<name>_<label>`` other bodies and forces use),
 ``stiffening`` (geometric stiffening, default true), ``damping_ratio`` and ``mass``
 (``"lumped"`` at the nodes, the default, or ``"consistent"``: at the elements' Gauss points,
-the FE beam's consistent mass exactly, for four bodies per element). A rotor has
+the FE beam's consistent mass exactly, for four bodies per element) and ``reduction``
+(``"normal"`` modes, the default, or ``"craig_bampton"``: constraint modes at the ``attach``
+nodes and ``modes`` fixed-interface modes). A rotor has
 ``spin`` (the shaft's angle, ``"Omega*t"``), ``discs`` (``{ node, m, Id, Ip }``) and
 ``bearings`` (``{ node, k_yy, k_zz, k_yz, k_zy, c_yy, ... }``) instead. jourdain.elastic
 (SciPy's sparse eigensolvers) is imported only for files that have such a body.
@@ -28,7 +30,7 @@ from ..toml_positions import Path
 from .values import _Values
 
 _ELASTIC_KEYS = {"beam", "modes", "clamped", "keep", "attach", "stiffening", "damping_ratio",
-                 "spin", "discs", "bearings", "mass"}
+                 "spin", "discs", "bearings", "mass", "reduction"}
 _DISC_KEYS = {"node", "m", "Id", "Ip"}
 _BEARING_KEYS = {"node", "k_yy", "k_zz", "k_yz", "k_zy", "c_yy", "c_zz", "c_yz", "c_zy"}
 _BEAM_NUMBERS = ("length", "E", "rho", "A", "I_y", "I_z", "J", "G", "nu", "kappa", "I_p")
@@ -90,7 +92,14 @@ class _Elastic(_Values):
         mass = self.string(el.get("mass", "lumped"), (*p, "mass"))
         if mass not in ("lumped", "consistent"):
             raise self.fail((*p, "mass"), f'expected "lumped" or "consistent", got {mass!r}')
+        reduction = self.string(el.get("reduction", "normal"), (*p, "reduction"))
+        if reduction not in ("normal", "craig_bampton"):
+            raise self.fail((*p, "reduction"), 'expected "normal" or "craig_bampton", got '
+                            f"{reduction!r}")
         if "spin" in el:
+            if "reduction" in el:
+                raise self.fail((*p, "reduction"), "a rotor (with spin) takes no reduction: its "
+                                "modes are the bending modes on its bearings")
             return self.read_rotor(bname, el, parent, joint, kw, modes, attach, mass)
         for key in ("discs", "bearings"):
             if key in el:
@@ -100,7 +109,7 @@ class _Elastic(_Values):
             beam = Beam(**kw)
             return ElasticBody.beam(bname, parent, joint, beam, modes, clamped=clamped,
                                     keep=keep, attach=attach, stiffening=stiffening,
-                                    damping_ratio=zeta, mass=mass)
+                                    damping_ratio=zeta, mass=mass, reduction=reduction)
         except ModelError as exc:
             where = bp if str(exc).startswith("Beam") else p
             raise self.fail(where, str(exc)) from None
