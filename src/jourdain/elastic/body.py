@@ -290,7 +290,7 @@ class ElasticBody(BodyGroup):
         geometric stiffening (it needs a beam's axis)."""
         clamped = list(clamped)
         nodes = [c[0] if isinstance(c, tuple) else c for c in clamped]
-        modal = clamped_basis(name, fe, n_modes, nodes, clamped, reduction,  # type: ignore[arg-type]
+        modal = clamped_basis(name, fe, n_modes, nodes, clamped, reduction,
                               [int(v) for v in (attach or {}).values()])
         return cls(name, parent, joint, modal, lumped_masses(fe), None,
                    tuple((str(k), int(v)) for k, v in (attach or {}).items())
