@@ -178,6 +178,7 @@ def test_every_public_function_handles_or_refuses_a_general_system() -> None:
         "find_equilibria": lambda: jd.find_equilibria(s, [y0]),
         "state_feedback": lambda: jd.state_feedback(s, np.zeros((0, 2)), {"zc": -0.3}),
         "to_casadi": lambda: jd.to_casadi(s),
+        "mode_motion": lambda: jd.mode_motion(lin, 1),
     }
     handled = {"sweep", "stability_boundary"}
     assert set(refused) | handled == {k for k, v in OUTCOME.items() if v == "refused"}
