@@ -209,6 +209,12 @@ def test_bad_elastic_body_input_is_named() -> None:
     with pytest.raises(ModelError, match="mass points' Phi_t must be finite, of shape"):
         ElasticBody("b", "world", jd.Fixed("wall"), eb.modal, np.zeros(5),
                     points=replace(pts, Phi_t=pts.Phi_t[:, :, :1]))
+    # sections without spin are taken; with spin each must be axisymmetric about its axis
+    ElasticBody("b", "world", jd.Fixed("wall"), eb.modal, eb.node_mass,
+                node_inertia=np.zeros((5, 3, 3)))
+    with pytest.raises(ModelError, match="mass point 0's inertia is not axisymmetric"):
+        ElasticBody("b", "world", jd.Fixed("wall"), eb.modal, np.zeros(5), points=pts,
+                    spin=((0.0, 1.0, 0.0), se.Symbol("t")))
 
 
 def test_model_file_elastic_body_equals_the_python_one() -> None:

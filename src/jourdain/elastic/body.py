@@ -118,25 +118,28 @@ class ElasticBody(BodyGroup):
             if not 0 <= int(node) < n:
                 raise ModelError(f'elastic body "{self.name}": attachment "{label}" at node '
                                  f"{node}, but the body has nodes 0 … {n - 1}")
+        sections: list[tuple[str, np.ndarray]] = []
         if self.node_inertia is not None:
             I_n = np.asarray(self.node_inertia, dtype=float)
             if I_n.shape != (n, 3, 3) or not np.all(np.isfinite(I_n)):
                 raise ModelError(f'elastic body "{self.name}": node_inertia must be {n} finite '
                                  "3×3 tensors")
-            if self.spin is not None:
-                a = np.asarray(self.spin[0], dtype=float)
-                a = a / np.linalg.norm(a)
-                P = np.eye(3) - np.outer(a, a)
-                sections = I_n if self.points is None else [*I_n, *self.points.inertia]
-            for k, Ik in enumerate(sections):  # axisymmetric about the spin axis
-                    scale = max(float(np.abs(Ik).max()), 1e-300)
-                    side = P @ Ik @ P
-                    iso = np.trace(side) / 2 * P
-                    if (np.abs(Ik @ a - (a @ Ik @ a) * a).max() > 1e-12 * scale
-                            or np.abs(side - iso).max() > 1e-12 * scale):
-                        what = f"node {k}" if k < n else f"mass point {k - n}"
-                        raise ModelError(f'elastic body "{self.name}": {what}\'s inertia is '
-                                         "not axisymmetric about the spin axis")
+            sections += [(f"node {k}", Ik) for k, Ik in enumerate(I_n)]
+        if self.points is not None:
+            sections += [(f"mass point {k}", np.asarray(Ik, dtype=float))
+                         for k, Ik in enumerate(self.points.inertia)]
+        if self.spin is not None:
+            a = np.asarray(self.spin[0], dtype=float)
+            a = a / np.linalg.norm(a)
+            P = np.eye(3) - np.outer(a, a)
+            for what, Ik in sections:  # axisymmetric about the spin axis
+                scale = max(float(np.abs(Ik).max()), 1e-300)
+                side = P @ Ik @ P
+                iso = np.trace(side) / 2 * P
+                if (np.abs(Ik @ a - (a @ Ik @ a) * a).max() > 1e-12 * scale
+                        or np.abs(side - iso).max() > 1e-12 * scale):
+                    raise ModelError(f'elastic body "{self.name}": {what}\'s inertia is not '
+                                     "axisymmetric about the spin axis")
         if self.Psi is not None and np.shape(self.Psi) != (n, 3, self.n_q, self.n_q):
             raise ModelError(f'elastic body "{self.name}": Psi of shape {np.shape(self.Psi)}, '
                              f"expected {(n, 3, self.n_q, self.n_q)}")
@@ -195,10 +198,13 @@ class ElasticBody(BodyGroup):
 
     def node_position(self, node: int) -> tuple[se.Basic, se.Basic, se.Basic]:
         """The node's position in the body frame as expressions of q_e."""
+        return self._position(self.modal.nodes[node], self.modal.Phi_t[node],
+                              None if self.Psi is None else self.Psi[node])
+
+    def _position(self, c: np.ndarray, Pt: np.ndarray, quad: np.ndarray | None
+                  ) -> tuple[se.Basic, se.Basic, se.Basic]:
+        """``c + Pt·q_e + ½·q_eᵀ·quad·q_e`` (body frame) as expressions."""
         q = self.coordinates
-        Pt = self.modal.Phi_t[node]
-        quad = None if self.Psi is None else self.Psi[node]
-        c = self.modal.nodes[node]
         return tuple(_linear(Pt[i], q, float(c[i]), None if quad is None else quad[i])
                      for i in range(3))
 
@@ -254,10 +260,7 @@ class ElasticBody(BodyGroup):
         with mass ``m`` and, where ``I_n`` is given, a section turned by ``Pr·q`` (and spun)."""
         if not (m > 0 or I_n is not None):
             return []
-        q = self.coordinates
-        where = tuple(_linear(Pt[i], q, float(c[i]), None if quad is None else quad[i])
-                      for i in range(3))
-        steps: list[Rot | Trans] = [Trans(vector=where)]
+        steps: list[Rot | Trans] = [Trans(vector=self._position(c, Pt, quad))]
         if I_n is not None:  # the section turns with the node (and spins)
             steps += self._rotations(Pr)
             if self.spin is not None:
