@@ -19,7 +19,7 @@ import numpy as np
 
 from ..errors import JourdainError
 from ..wrenches import joint_wrenches, joint_wrenches_along
-from .reactions import joint_reactions
+from .reactions import _joint_function, _refuse_friction, joint_components, joint_reactions
 
 if TYPE_CHECKING:
     from ..model.system import System
@@ -61,17 +61,19 @@ def group_reactions(system: System, y: Any, yd: Any, t: float, parameters: Any,
 def group_reactions_along(system: System, results: Any) -> tuple[np.ndarray, list[str]]:
     """``g`` (N, components) of the ordinary joints along a simulated motion and its column
     names: each sample's ÿ from the equations of motion and each joint's sub-tree residual
-    (one compiled function, called per sample)."""
-    joints = ordinary_joints(system)
-    rows: list[list[float]] = []
-    names: list[str] = []
-    U = results.u if results.u.shape[1] else None
-    for k in range(len(results.t)):
-        g = joint_reactions(system, joints, results.y[k], results.yd[k], float(results.t[k]),
-                            results.parameters, None if U is None else U[k])
-        names = list(g)
-        rows.append([g[n] for n in names])
-    return np.array(rows, dtype=float).reshape(len(results.t), len(names)), names
+    (the compiled function of :func:`jourdain.analysis.reactions.joint_reactions`, one batch
+    over the samples)."""
+    _refuse_friction(system)
+    info, fn = _joint_function(system, tuple(ordinary_joints(system)))
+    p = np.array([results.parameters[k] for k, _ in system.parameters])
+    batch = fn.batch(results.y, results.yd, results.t, p,
+                     results.u if results.u.shape[1] else None)
+    names = [f"{name}.{sfx}" for name, suffixes in info for sfx in suffixes]
+    g = np.empty((len(results.t), len(names)))
+    for k, tk in enumerate(results.t):
+        row = joint_components(info, {n: v[k] for n, v in batch.items()}, f"at t = {tk:.9g}")
+        g[k] = [row[n] for n in names]
+    return g, names
 
 
 def group_wrenches_along(system: System, g: np.ndarray, t: np.ndarray, y: np.ndarray,

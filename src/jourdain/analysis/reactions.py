@@ -304,13 +304,19 @@ def joint_reactions(system: System, joints: str | Sequence[str], y: Any, yd: Any
             raise ModelError(f'unknown joint "{name}"; joints are: {", ".join(by_joint)}')
     args = state_vectors(system, y, yd, t, parameters, inputs)
     info, fn = _joint_function(system, tuple(joints))
-    out_ = fn(*args)
-    require_finite("at this state", **{k: np.asarray(v, float) for k, v in out_.items()})
+    return joint_components(info, fn(*args))
+
+
+def joint_components(info: list, out_: Mapping[str, np.ndarray], where: str = "at this state"
+                     ) -> dict[str, float]:
+    """The reaction components of :func:`joint_reactions` from the numbers of
+    :func:`_joint_function` at one state (``info`` and the compiled function's output; a
+    batch's one row), ``where`` naming the state in the errors."""
+    require_finite(where, **{k: np.asarray(v, float) for k, v in out_.items()})
     try:
         ydd = np.linalg.solve(np.atleast_2d(out_["M"]), (out_["q"] - out_["k"]).reshape(-1))
     except np.linalg.LinAlgError:
-
-        raise SingularMassMatrix("the mass matrix M is singular at this state") from None
+        raise SingularMassMatrix(f"the mass matrix M is singular {where}") from None
     out: dict[str, float] = {}
     for k, (name, suffixes) in enumerate(info):
         if not suffixes:

@@ -326,8 +326,8 @@ class ElasticBody(BodyGroup):
         ``n_modes`` lowest normal modes with the nodes ``clamped`` held in the reference frame
         (the cantilever's modes for the default, node 0 at ``beam.origin``), node masses ρA
         per length lumped at the nodes (:func:`lumped_masses`), modal damping ``damping_ratio``
-        (every mode of the basis damped by ζ), and the foreshortening of :mod:`~jourdain.elastic.stiffening` when
-        ``stiffening``. ``keep`` (DOF names such as ``("uy", "rz")``) restricts the modes to
+        (every mode of the body as built damped by ζ: :meth:`damped`), and the foreshortening
+        of :mod:`~jourdain.elastic.stiffening` when ``stiffening``. ``keep`` (DOF names such as ``("uy", "rz")``) restricts the modes to
         those DOFs, every other one held at every node: a beam bending in one plane only.
         ``mass="consistent"`` puts the mass and the sections' rotary inertia at the elements'
         Gauss points (:mod:`jourdain.elastic.quadrature`): the FE beam's consistent mass,

@@ -240,8 +240,8 @@ def clamped_basis(name: str, fe: FEModel, n_modes: int, clamped: Sequence[int],
     if reduction == "normal":
         modal = modal_truncation(fe, n_modes, fixed=fixed)
     elif reduction == "craig_bampton":
-        held = set(dof_indices(fe, fixed))
-        dofs = [d for d in fe.dofs if d[0] in set(interface) and fe.index(*d) not in held]
+        held, nodes = set(dof_indices(fe, fixed)), set(interface)
+        dofs = [d for i, d in enumerate(fe.dofs) if d[0] in nodes and i not in held]
         if not dofs:
             raise ModelError(f'elastic body "{name}": Craig–Bampton needs interface nodes '
                              "(attach) with DOFs that are not held")

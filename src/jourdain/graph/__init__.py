@@ -33,6 +33,7 @@ from .sums import shared_sums, term_keys
 
 __all__ = [
     "CSE", "FloatJet", "Graph", "Jet", "Merged", "as_basic", "atom_key", "count_nodes", "cse",
-    "evaluate_arrays", "evaluate_float", "evaluate_float_many", "free_symbol_names", "graph_ops", "jet", "jet_float", "node_ops",
+    "evaluate_arrays", "evaluate_float", "evaluate_float_many", "free_symbol_names",
+    "graph_ops", "jet", "jet_float", "node_ops",
     "shared_sums", "term_keys", "tree_ops",
 ]

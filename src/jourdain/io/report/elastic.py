@@ -63,8 +63,9 @@ def elastic_html(run: Run) -> str:
         return ""
     parts = ["<h3>Elastic bodies</h3><p>Floating frame of reference with the mass at the "
              "nodes (lumped) or at the elements' Gauss points (consistent; docs/elastic.md); "
-             "the elastic coordinates are the amplitudes of the basis below. Frequencies: the basis's own (K_e, M_e of the finite-element "
-             "model; for a rotor on its bearings, at rest).</p>"]
+             "the elastic coordinates are the amplitudes of the basis below. Frequencies: the "
+             "basis's own (K_e, M_e of the finite-element model; for a rotor on its bearings, "
+             "at rest).</p>"]
     for b in bodies:
         m = b.modal
         rows = [(str(k + 1), esc(m.kinds[k] if k < len(m.kinds) else ""), numstr(m.omega[k]),
