@@ -22,5 +22,6 @@ from jourdain.elastic.reduction import (
 from jourdain.elastic.sid import read_sid, sid_data, sid_text, write_sid
 
 __all__ = ["ElasticBody", "lumped_masses", "MassPoints", "gauss_points", "DOF_NAMES", "Beam",
-           "FEModel", "assemble", "element_matrices", "ModalData", "modal_data", "constrain", "craig_bampton", "free_modes", "modal_truncation",
-           "normal_modes", "fe_model", "read_sid", "write_sid", "sid_text", "sid_data"]
+           "FEModel", "assemble", "element_matrices", "ModalData", "modal_data", "constrain",
+           "craig_bampton", "free_modes", "modal_truncation", "normal_modes", "fe_model",
+           "read_sid", "write_sid", "sid_text", "sid_data"]

@@ -162,8 +162,7 @@ class ElasticBody(BodyGroup):
     @property
     def total_mass(self) -> float:
         """The body's mass: its nodes' and its mass points'."""
-        return float(np.sum(self.node_mass)) + (0.0 if self.points is None
-                                                else float(np.sum(self.points.mass)))
+        return float(np.sum(self.node_mass) + (self.points.mass.sum() if self.points else 0.0))
 
     @property
     def elastic_mass(self) -> np.ndarray:
@@ -327,8 +326,9 @@ class ElasticBody(BodyGroup):
         (the cantilever's modes for the default, node 0 at ``beam.origin``), node masses ρA
         per length lumped at the nodes (:func:`lumped_masses`), modal damping ``damping_ratio``
         (every mode of the body as built damped by ζ: :meth:`damped`), and the foreshortening
-        of :mod:`~jourdain.elastic.stiffening` when ``stiffening``. ``keep`` (DOF names such as ``("uy", "rz")``) restricts the modes to
-        those DOFs, every other one held at every node: a beam bending in one plane only.
+        of :mod:`~jourdain.elastic.stiffening` when ``stiffening``. ``keep`` (DOF names such as
+        ``("uy", "rz")``) restricts the modes to those DOFs, every other one held at every
+        node: a beam bending in one plane only.
         ``mass="consistent"`` puts the mass and the sections' rotary inertia at the elements'
         Gauss points (:mod:`jourdain.elastic.quadrature`): the FE beam's consistent mass,
         exactly, for four bodies per element instead of one per node.

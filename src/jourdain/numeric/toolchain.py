@@ -27,8 +27,8 @@ ms; probably its AVX code beside the model's SSE code). ``JOURDAIN_NATIVE=0`` co
 architecture's baseline instead (valgrind, for one, does not know AVX-512). FMUs are not built
 here and stay portable (:mod:`jourdain.io.fmu.binary`).
 
-``JOURDAIN_OPTIMIZE=0``/``1``: ``-O0``/``-O1`` for ``-O2``/``-O3``, compiled in a tenth/quarter of the
-time, slower code, the same numbers bit for bit (no flag reorders arithmetic; test_native.py).
+``JOURDAIN_OPTIMIZE=0``/``1``: ``-O0``/``-O1`` for ``-O2``/``-O3``, compiled in a tenth/quarter
+of the time, slower code, the same numbers bit for bit (no flag reorders arithmetic).
 
 Loading a library runs its code, so a library is loaded only from a directory that belongs to
 the user and that no one else may write to, and only if the file itself belongs to the user and
