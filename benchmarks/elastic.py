@@ -70,6 +70,11 @@ Measured 2026-11-26 (the full run, 4 min) on a 2-core x86-64 shared with other s
    linearization 0.18 s, 242×); with the one-off costs (body + linearization 2.15 s) 16.8×.
    Six lowest frequencies within 2.4e-4 (four lowest) and 4.3e-3 (5th and 6th, at 1000 rad/s)
    of ROSS's: the lumped masses.
+   **2026-11-27**, the whole benchmark in one run (load ≈ 1): ROSS 6.31 s (its Numba code
+   now from its on-disk cache; first call 5.35 s, import 4.61 s, not counted) against 0.366 s
+   (**17.2×**; compiled 0.177 s, 35.6×; with the one-off costs 3.3×): the ≥ 10× target holds,
+   by less than the 105× above, whose ROSS time (42.9 s) was the outlier. Part 1 in the same
+   run: 1.83 s (trials 1.83, 1.91, 1.96).
 3. Spin-up, 20 elements, 5 modes: the beam's stiff modes hold DOP853 at ~15 000 evaluations
    whatever the tolerance; jourdain's loop costs 5.7 µs per evaluation, of which M, k, q are
    5.6 µs (the recursion over 21 nodal bodies), SciPy's 26 µs (DOP853) and 50 µs (Radau, with
