@@ -24,6 +24,7 @@ from ..symbolic import SymMatrix
 from .cachefile import dump_pickle, keep_sealed, load_pickle
 from .ccode import HEADER, argument_names, function_source
 from .integrator_ldl import ldl_source  # the solve written out per f (H1)
+from .planar_recursion import planar_units
 from .recursive import LDL_SOLVE, recursive_units
 from .toolchain import (
     CompilerError,
@@ -267,6 +268,17 @@ def dynamics_function(system: System) -> CompiledFunction:
     return _recursive(system, full=False, accel=True)
 
 
+@lru_cache(maxsize=32)
+def planar_function(system: System) -> CompiledFunction:
+    """Compiled ``M, k, q`` and the integrator's ``jd_accel`` of a planar system by the
+    recursion in planar vectors (:mod:`jourdain.numeric.planar_recursion`; the caller checks
+    :func:`~jourdain.numeric.planar_recursion.is_planar`), memoized per system."""
+    _refuse_closed(system)
+    f = system.f
+    local, engine, _ = planar_units(system, _accel_source(f))
+    return _load(system, ("M", "k", "q"), ((f, f), (f, 1), (f, 1)), (local, engine))
+
+
 def _accel_source(f: int) -> str:
     """The integrator's ``jd_accel`` by LDLᵀ of M for ``f`` coordinates ("" above ACCEL_MAX_F:
     its work arrays live on the stack)."""
@@ -304,6 +316,7 @@ def clear_cache(disk: bool = False) -> None:
     _eom_function.cache_clear()
     mkq_function.cache_clear()
     dynamics_function.cache_clear()
+    planar_function.cache_clear()
     if disk:
         d = cache_dir()
         if d.is_dir():
