@@ -150,7 +150,13 @@ def test_mkq_function_equals_full_function(rng):
 
 
 def test_integrator_code_is_the_recursion_for_spatial_models(rng):
-    system = models.spatial_chain(4)
+    """A spatial chain the cost model gives the spatial recursion: the integrator's M, k, q
+    are the full function's, bit for bit (the same engine; the articulated bodies only for
+    ÿ)."""
+    from jourdain.numeric import evaluation_path
+
+    system = models.spatial_chain(10)
+    assert evaluation_path(system).path == "spatial"
     full, mkq = _eom_function(system), mkq_function(system)
     pv = np.array(list(system.parameter_values.values()))
     y, yd = rng.uniform(-2, 2, system.f), rng.uniform(-2, 2, system.f)

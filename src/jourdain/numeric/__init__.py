@@ -6,7 +6,8 @@
 cached on disk by content hash (:func:`cache_dir`, safe to delete; :mod:`.toolchain`). Parameter
 values are arguments, so changing them never recompiles. Many states evaluate in one call with
 :meth:`CompiledFunction.batch` (the loop runs in C). :func:`mkq_function` adds ``jd_accel``
-(``ÿ = M⁻¹(q − k)`` by an LDLᵀ factorization) for the integrator of :mod:`jourdain.simulation.simulate`.
+(``ÿ = M⁻¹(q − k)``) for the integrator of :mod:`jourdain.simulation.simulate`, by the path that
+:func:`evaluation_path` predicts cheapest (:mod:`.cost`).
 :func:`evaluate` gives the numbers of the Newton–Euler equations and the equations of motion at
 one state. Compiled functions are memoized per (immutable, content-compared) system;
 :func:`clear_cache` empties that memo (and, with ``disk=True``, the on-disk cache). Without a C
@@ -17,25 +18,25 @@ compiler, evaluation falls back to SymEngine's ``Lambdify`` (:class:`Interpreted
 from .compiled import (
     ACCEL_MAX_F,
     ACCEL_TEMPLATE,
-    SYMBOLIC_MAX_F,
-    SYMBOLIC_NODES,
     arguments,
     build_eom_soon,
     clear_cache,
     dynamics_function,
     lambdify,
     mkq_function,
+    planar_function,
 )
 from .compiled import (
     _eom_function as _eom_function,
 )
+from .cost import SYMBOLIC_MAX_F, PathChoice, evaluation_path
 from .functions import CompiledFunction, InterpretedFunction
 from .state import _vector as _vector
 from .state import evaluate, parameter_vector, state_vectors, time_value
 from .toolchain import CompilerError, cache_dir
 
-__all__ = ["ACCEL_MAX_F", "ACCEL_TEMPLATE", "SYMBOLIC_MAX_F", "SYMBOLIC_NODES", "time_value",
-           "CompiledFunction", "CompilerError", "InterpretedFunction", "arguments",
+__all__ = ["ACCEL_MAX_F", "ACCEL_TEMPLATE", "SYMBOLIC_MAX_F", "time_value",
+           "CompiledFunction", "CompilerError", "InterpretedFunction", "PathChoice", "arguments",
            "build_eom_soon", "cache_dir",
-           "clear_cache", "dynamics_function", "evaluate", "lambdify", "mkq_function",
-           "parameter_vector", "state_vectors"]
+           "clear_cache", "dynamics_function", "evaluate", "lambdify", "evaluation_path",
+           "mkq_function", "parameter_vector", "planar_function", "state_vectors"]

@@ -23,6 +23,7 @@ from ..stages.reactions import joint_directions, reactions
 from ..symbolic import SymMatrix
 from .cachefile import dump_pickle, keep_sealed, load_pickle
 from .ccode import HEADER, argument_names, function_source
+from .cost import evaluation_path
 from .integrator_ldl import ldl_source  # the solve written out per f (H1)
 from .planar_recursion import planar_units
 from .recursive import LDL_SOLVE, recursive_units
@@ -131,11 +132,13 @@ def _jit(system: System, names: tuple[str, ...], shapes: tuple[tuple[int, int], 
 
 
 def _load(system: System, names: tuple[str, ...], shapes: tuple[tuple[int, int], ...],
-          source: str | tuple[str, ...], n_bodies: int = 0) -> CompiledFunction:
-    """Build (or load from the cache) the library of ``jd_fn`` and ``jd_fn_batch``."""
+          source: str | tuple[str, ...], n_bodies: int = 0,
+          unit_flags: tuple[tuple[str, ...], ...] | None = None) -> CompiledFunction:
+    """Build (or load from the cache) the library of ``jd_fn`` and ``jd_fn_batch``
+    (``unit_flags``: compiler flags per unit of ``source``)."""
     units = (source,) if isinstance(source, str) else source
-    key = content_key(_GENERATOR_VERSION, *units)
-    lib = build(key, source)
+    key = content_key(_GENERATOR_VERSION, *units, *(" ".join(f) for f in unit_flags or ()))
+    lib = build(key, source, unit_flags=unit_flags)
     vp = ctypes.c_void_p
     lib.jd_fn.restype = None
     lib.jd_fn.argtypes = [vp, vp, ctypes.c_double, vp, vp, vp]
@@ -188,7 +191,7 @@ def _recursive(system: System, full: bool, extra_source: str = "",
         return lambdify(system, mats, extra_source)
     units = recursive_units(system, full, directions, extra_source,
                             _accel_source(f) if accel else None)
-    return _load(system, names, shapes, units, n_bodies=p)
+    return _load(system, names, shapes, units, n_bodies=p, unit_flags=((), ("-O3",)))
 
 
 def _refuse_closed(system: System) -> None:
@@ -222,27 +225,27 @@ def build_eom_soon(system: System) -> None:
 
 #: largest f for which the integrator's jd_accel is compiled (its work arrays live on the stack)
 ACCEL_MAX_F = 128
-#: The integrator's M, k, q are the straight-line code of the symbolic projection when its
-#: expression graph has at most SYMBOLIC_NODES distinct nodes (f ≤ SYMBOLIC_MAX_F): small and
-#: planar models, where that code is up to 10× faster per evaluation than the general recursion
-#: (4-link pendulum on a cart, 80 nodes: 55 ns against 700 ns; 12 links, 433 nodes: 230 ns
-#: against 2.3 µs). Above it the recursion is faster (7-joint arm, 2 800 nodes: 1.3 µs against
-#: 0.84 µs) and compiles in a fraction of the time.
-SYMBOLIC_NODES = 1500
-SYMBOLIC_MAX_F = 24
 
 
 @lru_cache(maxsize=32)
 def mkq_function(system: System) -> CompiledFunction:
     """Compiled ``M, k, q`` of the equations of motion for the integrator (memoized per system),
-    with ``jd_accel`` (ÿ = M⁻¹(q − k)) when f ≤ ACCEL_MAX_F: the symbolic projection's code
-    with LDLᵀ for small graphs (:data:`SYMBOLIC_NODES`), else the recursion (its
-    articulated-body ÿ where every coordinate belongs to one joint)."""
-    if system.f <= SYMBOLIC_MAX_F:
-        eom = projection(newton_euler(kinematics(system)))
-        exprs = [*eom.M.entries(), *eom.k.entries(), *eom.q.entries()]
-        if count_nodes(exprs, SYMBOLIC_NODES) <= SYMBOLIC_NODES:
-            return symbolic_mkq(system, eom)
+    with ``jd_accel`` (ÿ = M⁻¹(q − k)) when f ≤ ACCEL_MAX_F or every coordinate belongs to one
+    joint: by the path of least predicted cost per right-hand side
+    (:func:`jourdain.numeric.cost.evaluation_path`): the symbolic projection's straight-line
+    code with LDLᵀ (:func:`symbolic_mkq`), the recursion in planar vectors
+    (:func:`planar_function`) or in spatial vectors (:func:`dynamics_function`), each with its
+    articulated-body ÿ where every coordinate belongs to one joint."""
+    _refuse_closed(system)
+    try:
+        compiler()
+    except CompilerError:  # evaluated without C: the recursion's fallback
+        return dynamics_function(system)
+    choice = evaluation_path(system)
+    if choice.path == "symbolic" and choice.eom is not None:
+        return symbolic_mkq(system, choice.eom)
+    if choice.path == "planar":
+        return planar_function(system)
     return dynamics_function(system)
 
 
@@ -276,7 +279,8 @@ def planar_function(system: System) -> CompiledFunction:
     _refuse_closed(system)
     f = system.f
     local, engine, _ = planar_units(system, _accel_source(f))
-    return _load(system, ("M", "k", "q"), ((f, f), (f, 1), (f, 1)), (local, engine))
+    return _load(system, ("M", "k", "q"), ((f, f), (f, 1), (f, 1)), (local, engine),
+                 unit_flags=((), ("-O3",)))
 
 
 def _accel_source(f: int) -> str:
@@ -317,6 +321,7 @@ def clear_cache(disk: bool = False) -> None:
     mkq_function.cache_clear()
     dynamics_function.cache_clear()
     planar_function.cache_clear()
+    evaluation_path.cache_clear()
     if disk:
         d = cache_dir()
         if d.is_dir():

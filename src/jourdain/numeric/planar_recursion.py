@@ -40,7 +40,7 @@ if TYPE_CHECKING:
 PLANE_BODY = 17
 PLANE_COLUMN = 3
 #: bodies above which the planar engine's work (on the stack) is not used
-PLANE_MAX_BODIES = 512
+PLANE_MAX_BODIES = 256
 
 
 def _zero(x: se.Basic) -> bool:

@@ -38,11 +38,13 @@ typedef struct {
     double Ic[13 * JD_P], Bc[6 * JD_P], Wc[6 * JD_P];
     double c[3 * JD_P], qc[6 * JD_P];
 #if JD_ABA
-    double Ib[13 * JD_P], Bb[6 * JD_P], Wb[6 * JD_P];  /* each body's own, before the sums */
+    double Wb[6 * JD_P];  /* each body's own q_e wrench (own_only: Ic and Bc stay each body's own) */
 #endif
 } jd_work;
 
-static void jd_recursion(const double *L, const double *yd, jd_work *W) {
+/* own_only (the articulated bodies): Ic and Bc stay each body's own and only Wc is summed
+   (for the power ẏᵀq), with the own Wc kept in Wb */
+static void jd_recursion(const double *L, const double *yd, jd_work *W, int own_only) {
     static const double I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, Z[3] = {0, 0, 0};
     for (int i = 0; i < JD_P; ++i) {
         const double *b = L + i * JD_BODY;
@@ -133,8 +135,16 @@ static void jd_recursion(const double *L, const double *yd, jd_work *W) {
         Ic[12] = m;
     }
 #if JD_ABA
-    for (int a = 0; a < 13 * JD_P; ++a) W->Ib[a] = W->Ic[a];
-    for (int a = 0; a < 6 * JD_P; ++a) { W->Bb[a] = W->Bc[a]; W->Wb[a] = W->Wc[a]; }
+    if (own_only) {
+        for (int a = 0; a < 6 * JD_P; ++a) W->Wb[a] = W->Wc[a];
+        for (int i = JD_P - 1; i >= 0; --i) {
+            int lam = jd_parent[i];
+            if (lam >= 0) for (int a = 0; a < 6; ++a) W->Wc[6 * lam + a] += W->Wc[6 * i + a];
+        }
+        return;
+    }
+#else
+    (void)own_only;
 #endif
     /* composite bodies: sums over each sub-tree, children before parents */
     for (int i = JD_P - 1; i >= 0; --i) {
@@ -259,7 +269,7 @@ void jd_fn(const double *y, const double *yd, double t, const double *p, const d
     if (!W) { for (long a = 0; a < JD_SIZE; ++a) out[a] = NAN; return; }
 #endif
     jd_local(y, yd, t, p, u, L);
-    jd_recursion(L, yd, W);
+    jd_recursion(L, yd, W, 0);
 #if JD_FULL
     jd_newton_euler(L, W, out);
     double *M = out + 36L * JD_P * JD_P + 6L * JD_P * JD_F + 12L * JD_P;
@@ -358,7 +368,7 @@ typedef struct { double IA[36 * JD_P], pA[6 * JD_P], U[36 * JD_P], Dinv[36 * JD_
 static int jd_aba(const jd_work *W, jd_aba_work *A, double *ydd, double *wrench) {
     double scale = 0.0;
     for (int i = 0; i < JD_P; ++i) {
-        const double *Ib = W->Ib + 13 * i, *h = Ib + 9;
+        const double *Ib = W->Ic + 13 * i, *h = Ib + 9;
         double *IA = A->IA + 36 * i;
         /* [[Ī, h̃], [−h̃, m E]]: twist (w, u) -> wrench (moment, force) */
         double H[9] = {0, -h[2], h[1], h[2], 0, -h[0], -h[1], h[0], 0};
@@ -369,7 +379,7 @@ static int jd_aba(const jd_work *W, jd_aba_work *A, double *ydd, double *wrench)
                 IA[6 * (3 + r) + c] = -H[3 * r + c];
                 IA[6 * (3 + r) + 3 + c] = r == c ? Ib[12] : 0.0;
             }
-        for (int a = 0; a < 6; ++a) A->pA[6 * i + a] = W->Bb[6 * i + a] - W->Wb[6 * i + a];
+        for (int a = 0; a < 6; ++a) A->pA[6 * i + a] = W->Bc[6 * i + a] - W->Wb[6 * i + a];
         scale = fmax(scale, fmax(Ib[12], fmax(Ib[0], fmax(Ib[4], Ib[8]))));
     }
     for (int i = JD_P - 1; i >= 0; --i) {
@@ -377,6 +387,27 @@ static int jd_aba(const jd_work *W, jd_aba_work *A, double *ydd, double *wrench)
         const double *S = W->V + 6 * c0;  /* column k at S + 6k */
         double *IA = A->IA + 36 * i, *pA = A->pA + 6 * i, *U = A->U + 36 * i;
         double *Dinv = A->Dinv + 36 * i, *u = A->u + 6 * i, D[36];
+        if (n == 1) {  /* one column: D a number, the updates symmetric */
+            for (int r = 0; r < 6; ++r) U[r] = jd_dot6(IA + 6 * r, S);
+            const double d = jd_dot6(S, U);
+            if (!(d > 1e-13 * scale)) return 1;
+            Dinv[0] = 1.0 / d;
+            u[0] = jd_dot6(S, pA);
+            if (lam < 0) continue;
+            double *IAp = A->IA + 36 * lam, *pAp = A->pA + 6 * lam;
+            const double g = Dinv[0] * u[0];
+            for (int r = 0; r < 6; ++r) {
+                pAp[r] += pA[r] - U[r] * g;
+                const double e = Dinv[0] * U[r];
+                IAp[7 * r] += IA[7 * r] - e * U[r];
+                for (int c = r + 1; c < 6; ++c) {
+                    const double v = IA[6 * r + c] - e * U[c];
+                    IAp[6 * r + c] += v;
+                    IAp[6 * c + r] += v;
+                }
+            }
+            continue;
+        }
         for (int k = 0; k < n; ++k)
             for (int r = 0; r < 6; ++r) {
                 double t = 0.0;
@@ -412,6 +443,12 @@ static int jd_aba(const jd_work *W, jd_aba_work *A, double *ydd, double *wrench)
         const double *u = A->u + 6 * i;
         double *X = A->X + 6 * i, r[6];
         for (int a = 0; a < 6; ++a) X[a] = lam < 0 ? 0.0 : A->X[6 * lam + a];
+        if (n == 1 && !wrench) {
+            const double a1 = -Dinv[0] * (jd_dot6(U, X) + u[0]);
+            ydd[jd_col_coord[c0]] = a1;
+            for (int a = 0; a < 6; ++a) X[a] += S[a] * a1;
+            continue;
+        }
         for (int k = 0; k < n; ++k) r[k] = jd_dot6(U + 6 * k, X) + u[k];
         for (int k = 0; k < n; ++k) {
             double t = 0.0;
@@ -457,7 +494,7 @@ static jd_work *jd_at_state(const double *y, const double *yd, double t, const d
     jd_work *W = (jd_work *)malloc(sizeof(jd_work) + extra);
     if (!W) return NULL;
     jd_local(y, yd, t, p, u, L);
-    jd_recursion(L, yd, W);
+    jd_recursion(L, yd, W, JD_ABA);
     return W;
 }
 

@@ -102,7 +102,7 @@ class Kinematics:
 #: systems with at least this many coordinates get the shared kinematics by default: below,
 #: the body-by-body sums read like a textbook's (a double pendulum's M), are the shortest
 #: code for planar chains, and are what the integrator compiles up to
-#: ``jourdain.numeric.compiled.SYMBOLIC_MAX_F`` = 24 coordinates
+#: ``jourdain.numeric.cost.SYMBOLIC_MAX_F`` = 24 coordinates
 SHARED_FROM_F = 25
 
 
