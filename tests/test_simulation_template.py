@@ -193,6 +193,8 @@ def test_threads_share_a_template(cart):
     ({"t_eval": [0.2, float("nan")]}, EvaluationError, r"t_eval\[1\] = nan"),
     ({"t_eval": [float("nan")]}, EvaluationError, r"t_eval\[0\] = nan"),
     ({"t_eval": [0.3, 0.2]}, EvaluationError, "t_eval must be sorted"),
+    ({"t_eval": [0.0, 1e300, 0.5]}, EvaluationError, "t_eval must be sorted"),
+    ({"t_eval": [0.0, float("inf"), 0.5]}, EvaluationError, r"t_eval\[1\] = inf"),
     ({"t_eval": [0.6]}, EvaluationError, "t_eval must lie within t_span"),
     ({"t_eval": []}, EvaluationError, "t_eval holds 0 times"),
     ({"parameters": {"nope": 1.0}}, EvaluationError, "unknown parameter"),

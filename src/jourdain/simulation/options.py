@@ -201,18 +201,20 @@ def check_t_eval(t_eval: Any, t0: float, t1: float, f: int, n_inputs: int = 0,
                  name: str = "t_eval") -> np.ndarray:
     """Output times: finite, sorted, within ``[t0, t1]``, at most :func:`max_samples`."""
     try:
-        te = np.ascontiguousarray(t_eval, dtype=float).reshape(-1)
+        te = np.ascontiguousarray(t_eval, dtype=float)
+        if te.ndim != 1:
+            te = te.reshape(-1)
     except (TypeError, ValueError):
         raise EvaluationError(f"{name} must be a sequence of numbers, got "
                               f"{_shown(t_eval)}") from None
-    top = max_samples(f, n_inputs)
     # the common cases in a few operations (the checks below cost 6 µs on a call of 20):
-    # comparisons with NaN are false, so a NaN fails them and the checks below name it
-    if te.size == 1:
-        if t0 <= te[0] <= t1:
-            return te
-    elif 1 < te.size <= top and t0 <= te[0] and te[-1] <= t1 and math.isfinite(te.dot(te)) \
-            and not (te[1:] < te[:-1]).any():
+    # comparisons with NaN are false, so a NaN fails them and the checks below name it; one
+    # time is always within the bound on samples (MIN_SAMPLES and more)
+    if te.size == 1 and t0 <= te[0] <= t1:
+        return te
+    top = max_samples(f, n_inputs)
+    if 1 < te.size <= top and t0 <= te[0] and te[-1] <= t1 and not (te[1:] < te[:-1]).any() \
+            and math.isfinite(te.dot(te)):  # sorted: all within ±MAX_TIME, x·x cannot overflow
         return te
     if te.size == 0 or te.size > top:
         raise EvaluationError(f"{name} holds {te.size} times: from 1 to {top} are allowed")
