@@ -20,12 +20,22 @@ Columns:
 Below the table, in this process (the model compiled and memoized, as in a user's loop):
 
 * ``simulate() overhead``: the median time of ``system.simulate((0, 1e-9), y0, ẏ0)`` (one
-  step, a dozen right-hand sides) of the 4-link pendulum on a cart: what a call costs outside
-  the C step loop (the target: 20 µs);
-* ``step loop``: a 10 s run of the same model (DOP853, the default tolerances): its C time per
-  right-hand side evaluation against the compiled M, k, q per state (``fn.batch`` on 10 000
-  states, best of 5): the loop's share beyond M, k, q (it includes the LDLᵀ solve of each
-  right-hand side and the step's vector arithmetic; the target: 30 % of a right-hand side).
+  step, a dozen right-hand sides) of the 4-link pendulum on a cart, of the same call with
+  ``t_eval=[1e-9]``, and of calls with a new parameter value each (a sweep, which the memo of
+  run templates never serves), in µs per call, next to the figures before the memo
+  (:data:`BEFORE_US`): what a call costs outside the C step loop (the target: 20 µs);
+* ``step loop``: a 10 s run of the same model (DOP853, the default tolerances): its time per
+  right-hand side evaluation against one ``jd_accel`` call timed alone in C (the model's
+  ÿ = M⁻¹(q − k) with its LDLᵀ solve, :data:`ACCEL_LOOP` calling it on 10 000 states, best of
+  5): the loop's share of a right-hand side (its step arithmetic, error control and output;
+  the target: 30 %), and, as before, against the compiled M, k, q per state (``fn.batch``).
+
+Measured 2026-11-27 (issue 35's memo of run templates; the same 2-core machine, medians of
+3000 calls, the old and the new tree run one after the other in quiet minutes: other work
+doubled some runs): the plain call 71-72 → 18.6-19.0 µs, with t_eval 80-81 → 19.2-19.9 µs, a
+new parameter value each call 75 → 55 µs; the step loop 0.174 µs per right-hand side (8 894
+in a 10 s run of 1.55 ms, best of 20) against jd_accel's 0.095 µs alone: the loop 80 % of a
+right-hand side (target 30 %: not met; M, k, q alone 0.055-0.069 µs).
 
     .venv/bin/python benchmarks/setup.py                   # f = 2 … 32, 5 trials (minutes)
     .venv/bin/python benchmarks/setup.py --quick           # f = 2 and 5, 2 trials
@@ -195,25 +205,92 @@ def starts(kind: str, n: int, trials: int, mujoco: bool) -> dict:
     return row
 
 
+#: simulate()'s cost per call before issue 35's memo of run templates (commit d91a913, this
+#: function, 2-core AMD EPYC): the plain call and the one with t_eval (µs)
+BEFORE_US = {"plain": 72.0, "t_eval": 81.0}
+
+#: a C loop that calls the model's ``jd_accel`` (ÿ = M⁻¹(q − k) and the power ẏᵀq: the
+#: model's part of a right-hand side) on ``m`` states through a function pointer, as the
+#: integrator does, ``reps`` times
+ACCEL_LOOP = r"""
+typedef int (*jd_accel_fn)(const double *y, const double *yd, double t, const double *p,
+                           const double *u, double *ydd, double *power);
+double jd_accel_loop(void *fn, const double *Y, const double *YD, long m, long f,
+                     const double *p, const double *u, long reps, double *ydd) {
+    jd_accel_fn accel = (jd_accel_fn)fn;
+    double power = 0.0, sum = 0.0;
+    for (long r = 0; r < reps; ++r)
+        for (long i = 0; i < m; ++i) {
+            accel(Y + i * f, YD + i * f, 0.0, p, u, ydd, &power);
+            sum += ydd[0] + power;
+        }
+    return sum;
+}
+"""
+
+
+def accel_seconds(fn, f: int, p, u, m: int = 10000, reps: int = 5) -> float:
+    """One ``jd_accel`` call of the compiled ``fn`` (:func:`jourdain.numeric.mkq_function`)
+    timed alone in C (:data:`ACCEL_LOOP`: one ctypes call per ``m`` states, best of
+    ``reps``), at random states."""
+    import ctypes
+
+    import numpy as np
+
+    from jourdain.numeric import toolchain
+
+    lib = toolchain.build(toolchain.content_key("bench-accel-loop", ACCEL_LOOP), ACCEL_LOOP)
+    loop = lib.jd_accel_loop
+    vp, lg = ctypes.c_void_p, ctypes.c_long
+    loop.restype = ctypes.c_double
+    loop.argtypes = [vp, vp, vp, lg, lg, vp, vp, lg, vp]
+    rng = np.random.default_rng(0)
+    Y, YD = rng.uniform(-1, 1, (m, f)), rng.uniform(-1, 1, (m, f))
+    pv, uv = np.ascontiguousarray(p, dtype=float), np.ascontiguousarray(u, dtype=float)
+    ydd = np.empty(f)
+    best = np.inf
+    for _ in range(reps):
+        t0 = time.perf_counter()
+        loop(fn.accel_address, Y.ctypes.data, YD.ctypes.data, m, f, pv.ctypes.data,
+             uv.ctypes.data, 1, ydd.ctypes.data)
+        best = min(best, time.perf_counter() - t0)
+    return best / m
+
+
+def per_call_us(call, calls: int, rounds: int = 10) -> float:
+    """The median time of ``call()`` over ``calls`` calls made in ``rounds`` rounds (µs)."""
+    times = []
+    for _ in range(rounds):
+        for _ in range(max(calls // rounds, 1)):
+            t0 = time.perf_counter()
+            call()
+            times.append(time.perf_counter() - t0)
+    return 1e6 * statistics.median(times)
+
+
 def overhead(repeat: int = 300) -> dict:
-    """simulate()'s cost outside the C loop, and the step loop's share beyond M, k, q, for the
-    4-link pendulum on a cart (this process; compiled once, memoized)."""
+    """simulate()'s cost outside the C loop, and the step loop's share beyond a right-hand
+    side, for the 4-link pendulum on a cart (this process; compiled once, memoized): the
+    median per call of ``simulate((0, 1e-9), y0, ẏ0)``, with ``t_eval=[1e-9]``, and with a new
+    parameter value each call (a sweep: the memo of run templates never serves it); a 10 s
+    run's time per right-hand side against M, k, q per state (``fn.batch``) and against one
+    ``jd_accel`` call timed alone in C (:func:`accel_seconds`)."""
     import numpy as np
 
     from jourdain.models import n_link_pendulum_on_cart
-    from jourdain.numeric import mkq_function
+    from jourdain.numeric import mkq_function, parameter_vector
 
     system = n_link_pendulum_on_cart(4)
     f = system.f
     y0, yd0 = np.full(f, 0.1), np.zeros(f)
     u = {"F": 0.0}
-    system.simulate((0.0, 1e-9), y0, yd0, inputs=u)
-    times, nfev = [], 0
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        r = system.simulate((0.0, 1e-9), y0, yd0, inputs=u)
-        times.append(time.perf_counter() - t0)
-        nfev = r.nfev
+    short = system.simulate((0.0, 1e-9), y0, yd0, inputs=u)
+    g = iter(9.81 + 1e-6 * np.arange(1, 10 * repeat + 2))
+    plain = per_call_us(lambda: system.simulate((0.0, 1e-9), y0, yd0, inputs=u), repeat)
+    t_eval = per_call_us(lambda: system.simulate((0.0, 1e-9), y0, yd0, inputs=u,
+                                                 t_eval=[1e-9]), repeat)
+    sweep = per_call_us(lambda: system.simulate((0.0, 1e-9), y0, yd0, inputs=u,
+                                                parameters={"g": next(g)}), repeat)
     long = min((system.simulate((0.0, 10.0), y0, yd0, inputs=u) for _ in range(3)),
                key=lambda r: r.wall_time)
     fn = mkq_function(system)
@@ -226,10 +303,13 @@ def overhead(repeat: int = 300) -> dict:
         fn.batch(Y, YD, 0.0, None, np.zeros((m, 1)))
         best = min(best, time.perf_counter() - t0)
     mkq_s = best / m
+    accel_s = accel_seconds(fn, f, parameter_vector(system, None), [0.0])
     per_eval = long.wall_time / long.nfev
-    return {"simulate_us": 1e6 * statistics.median(times), "short_nfev": nfev,
-            "run_s": long.wall_time, "run_nfev": long.nfev, "per_eval_us": 1e6 * per_eval,
-            "mkq_us": 1e6 * mkq_s, "loop_share_pct": 100.0 * (per_eval - mkq_s) / mkq_s}
+    return {"simulate_us": plain, "simulate_t_eval_us": t_eval, "simulate_sweep_us": sweep,
+            "short_nfev": short.nfev, "run_s": long.wall_time, "run_nfev": long.nfev,
+            "per_eval_us": 1e6 * per_eval, "mkq_us": 1e6 * mkq_s,
+            "loop_share_pct": 100.0 * (per_eval - mkq_s) / mkq_s, "accel_us": 1e6 * accel_s,
+            "accel_share_pct": 100.0 * (per_eval - accel_s) / accel_s}
 
 
 def _mark(value: float, target: float) -> str:
@@ -253,15 +333,20 @@ def table(rows: list[dict], over: dict | None) -> str:
     if not all(r["bit_identical"] for r in rows):
         out.append("WARNING: a warm start's motion differs from a cold start's")
     if over is not None:
-        out.append(f"simulate() per call (one step, {over['short_nfev']} right-hand sides): "
-                   f"{over['simulate_us']:.1f} µs (target {TARGET_OVERHEAD_US:.0f} µs: "
-                   f"{_mark(over['simulate_us'], TARGET_OVERHEAD_US)})")
+        worst = max(over["simulate_us"], over["simulate_t_eval_us"])
+        out.append(f"simulate() per call (one step, {over['short_nfev']} right-hand sides, "
+                   f"median): {BEFORE_US['plain']:.0f} → {over['simulate_us']:.1f} µs, with "
+                   f"t_eval {BEFORE_US['t_eval']:.0f} → {over['simulate_t_eval_us']:.1f} µs "
+                   f"(before: commit d91a913; target {TARGET_OVERHEAD_US:.0f} µs: "
+                   f"{_mark(worst, TARGET_OVERHEAD_US)}"
+                   f"); a new parameter value each call {over['simulate_sweep_us']:.1f} µs")
         out.append(f"step loop, n = 4, 10 s: {over['run_nfev']} right-hand sides in "
                    f"{1e3 * over['run_s']:.2f} ms, {over['per_eval_us']:.3f} µs each against "
-                   f"M, k, q {over['mkq_us']:.3f} µs: the loop and the solve "
-                   f"{over['loop_share_pct']:.0f} % of M, k, q (target "
+                   f"one jd_accel alone {over['accel_us']:.3f} µs: the loop "
+                   f"{over['accel_share_pct']:.0f} % of a right-hand side (target "
                    f"{TARGET_LOOP_SHARE:.0f} %: "
-                   f"{_mark(over['loop_share_pct'], TARGET_LOOP_SHARE)})")
+                   f"{_mark(over['accel_share_pct'], TARGET_LOOP_SHARE)}); against M, k, q "
+                   f"per state {over['mkq_us']:.3f} µs: {over['loop_share_pct']:.0f} %")
     return "\n".join(out)
 
 

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import ctypes
 import signal
+import struct
 import sys
 import threading
 import time
@@ -75,43 +76,88 @@ def _error(code: int, setup: _Setup, fail: np.ndarray) -> JourdainError:
     return IntegrationError(f"integrator failed with code {code}")
 
 
+#: the loop's counters in the state buffer (C longs): cnt (nfev, nstep, naccept, nreject,
+#: have_k0), i_eval, n_out, n_ev; read and written with struct (one call, no array made; an
+#: ndarray has the buffer protocol, which its stubs do not tell struct)
+_LONG, _COUNTERS = struct.Struct("l"), struct.Struct("8l")
+
+
+class _Sigint:
+    """Ctrl-C during a run (installed from the main thread only): the first sets a flag that is
+    looked at between calls of the C loop, so it never lands in the middle of bookkeeping; a
+    second raises at once. :meth:`restore` puts the previous handler back."""
+
+    __slots__ = ("interrupted", "old")
+
+    def __init__(self) -> None:
+        self.interrupted = False
+        self.old: Any = None
+        if threading.current_thread() is threading.main_thread():
+            try:
+                self.old = signal.signal(signal.SIGINT, self.handle)
+            except ValueError:  # not the main interpreter
+                pass
+
+    def handle(self, signum: int, frame: Any) -> None:
+        if self.interrupted:
+            raise KeyboardInterrupt
+        self.interrupted = True
+
+    def restore(self) -> None:
+        if self.old is not None:
+            signal.signal(signal.SIGINT, self.old)
+
+
+def _chunk(out: np.ndarray, o: int, cap: int, n: int, f: int, m: int
+           ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The ``m`` samples that a call wrote to ``out`` from ``o`` on (``cap`` times, ``cap``
+    states, ``cap`` derivatives of the state): views of t and x, a copy of ÿ only (half the
+    memory)."""
+    e = o + cap * (1 + n)
+    return (out[o:o + m], out[o + cap:o + cap + m * n].reshape(m, n),
+            out[e:e + m * n].reshape(m, n)[:, f:2 * f].copy())
+
+
 def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray | None,
            progress: bool | Callable[[float, float], None], output: str | None) -> dict:
     lib = integrator_library()
     system = setup.system
-    f = system.f
-    n = 2 * f + 1
+    n = x0.size
+    f = (n - 1) // 2
     nev = len(setup.events)
     ev_cap = 100000 if nev else 1  # crossings recorded (the message says if more were dropped)
-    # the loop's state and counters in one buffer of doubles and one of C longs, their
-    # addresses computed from two (a run's set-up is counted in microseconds)
-    dbl = np.zeros(4 + 3 * n + 1 + max(nev, 1))
-    # st (t, h, last trial rejected, last error), x, k0 (the derivative at x), fail, g_old
-    st, x, fail = dbl[0:4], dbl[4:4 + n], dbl[4 + 2 * n:5 + 3 * n]
-    st[0] = t0
-    x[:] = x0
-    ints = np.zeros(8 + ev_cap, dtype=np.int_)
-    # cnt (5), i_eval, n_out, n_ev, ev_i (ev_cap)
-    cnt, n_out, n_ev, ev_i = ints[0:5], ints[6:7], ints[7:8], ints[8:]
-    a_dbl, a_int, di = address(dbl) or 0, address(ints) or 0, ints.itemsize
-    p_st, p_x, p_k0, p_fail, p_g = (a_dbl + 8 * o for o in (0, 4, 4 + n, 4 + 2 * n, 5 + 3 * n))
-    p_cnt, p_ieval, p_nout, p_nev, p_evi = (a_int + di * o for o in (0, 5, 6, 7, 8))
-    ev_t = np.empty(ev_cap)
-    ev_x = np.empty((ev_cap, n))
-    p_evt, p_evx = address(ev_t), address(ev_x)
-    if te is not None:
-        cap = te.size
-        out = np.empty(cap * (1 + 2 * n))
-        out_t, out_x = out[:cap], out[cap:cap * (1 + n)].reshape(cap, n)
-        out_dx = out[cap * (1 + n):].reshape(cap, n)
-        a_out = address(out) or 0
-        p_te: int | None = address(te)
-        n_te = te.size
-    chunks_t: list[np.ndarray] = []
-    chunks_x: list[np.ndarray] = []
-    chunks_dx: list[np.ndarray] = []
-    if te is None:
-        cap, p_te, n_te = 1024, None, 0
+    cap = 1024 if te is None else te.size  # output samples per call
+    # One buffer of doubles (a run's set-up is counted in microseconds: each array and each
+    # address costs about half of one), its addresses computed from the first: the loop's
+    # state, zeroed (st: t, h, last trial rejected, last error; x; k0, the derivative at x;
+    # fail; g_old), its counters as C longs (cnt (5), i_eval, n_out, n_ev) and, without
+    # events, the record of one crossing (ev_i, ev_t, ev_x) that the loop never writes; then
+    # the output (cap times, states and their derivatives) of the first call, or with t_eval
+    # of all calls. With events their record of ev_cap crossings has arrays of its own.
+    o_fail, o_g = 4 + 2 * n, 5 + 3 * n
+    o_int = o_g + max(nev, 1)
+    o_ev = o_int + 9
+    o_out = o_ev if nev else o_ev + 1 + n
+    buf = np.empty(o_out + cap * (1 + 2 * n))
+    buf[:o_out] = 0.0
+    buf[0] = t0
+    buf[4:4 + n] = x0
+    a = address(buf) or 0
+    p_st, p_x, p_k0, p_g, p_fail = a, a + 32, a + 8 * (4 + n), a + 8 * o_g, a + 8 * o_fail
+    p_cnt, di = a + 8 * o_int, _LONG.size
+    if nev:
+        ev_t, ev_x = np.empty(ev_cap), np.empty((ev_cap, n))
+        ev_i = np.empty(ev_cap, dtype=np.int_)
+        p_evt, p_evx, p_evi = address(ev_t), address(ev_x), address(ev_i)
+    else:
+        p_evi, p_evt = p_cnt + 8 * di, a + 8 * o_ev
+        p_evx = p_evt + 8
+    p_te, n_te = (None, 0) if te is None else (address(te), te.size)
+    out, o, a_out = buf, o_out, a + 8 * o_out
+    # without t_eval, each call's accepted steps: (t, x, ÿ); ``pending`` the output buffer of
+    # a call not yet kept (a Ctrl-C may come right after the call returns)
+    chunks: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+    pending = None
     writer = (_Writer(output, system)
               if output and str(output).lower().endswith(OUTPUT_SUFFIXES) else None)
     status = "finished"
@@ -119,123 +165,121 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
     exception: BaseException | None = None
     error: JourdainError | None = None
     written = 0
-    id_chunk = kept = 0
-
-    def _keep_chunk() -> None:
-        nonlocal kept
-        chunks_t.append(out_t[:n_out[0]])
-        chunks_x.append(out_x[:n_out[0]])
-        chunks_dx.append(out_dx[:n_out[0], f:2 * f].copy())  # ÿ only: half the memory
-        kept = id_chunk
     max_steps = steps_per_call(f)
-    t_last_report = time.perf_counter()
-    # Ctrl-C sets a flag that is looked at between calls of the C loop, so it never lands in
-    # the middle of bookkeeping; a second Ctrl-C raises at once. Without Python input functions
-    # the handler is installed after the first call, and only when the run goes on: no Python
-    # runs during that call, so Python's own handler does the same (KeyboardInterrupt as the
-    # call returns, its chunk kept below), and a run done in one call (most runs of ordinary
-    # length) saves the two signal() calls. An input function is Python called from the loop,
-    # where Python's handler would raise: then the handler comes first.
-    interrupted = [False]
-    old_handler = None
-    handler_due = threading.current_thread() is threading.main_thread()
-
-    def on_sigint(signum: int, frame: Any) -> None:
-        if interrupted[0]:
-            raise KeyboardInterrupt
-        interrupted[0] = True
-
-    def install() -> None:
-        nonlocal handler_due, old_handler
-        handler_due = False
-        try:
-            old_handler = signal.signal(signal.SIGINT, on_sigint)
-        except ValueError:  # not the main interpreter
-            old_handler = None
-
-    problem = ctypes.byref(setup.problem)
-    stiffness = StiffnessCheck(lib, setup, setup.problem.method)
+    t_last_report = time.perf_counter() if progress is True else 0.0
+    # Ctrl-C: without Python input functions the handler is installed after the first call,
+    # and only when the run goes on: no Python runs during that call, so Python's own handler
+    # does the same (KeyboardInterrupt as the call returns, its chunk kept below), and a run
+    # done in one call (most runs of ordinary length) saves the two signal() calls. An input
+    # function is Python called from the loop, where Python's handler would raise: then the
+    # handler comes first.
+    sigint: _Sigint | None = None
+    stiffness: StiffnessCheck | None = None  # judged from the second call on
+    problem = setup.problem_ref
     try:
-        if handler_due and setup.callables:
-            install()
+        if setup.callables:
+            sigint = _Sigint()
         while True:
             if te is None:
-                out = np.empty(cap * (1 + 2 * n))
-                out_t, out_x = out[:cap], out[cap:cap * (1 + n)].reshape(cap, n)
-                out_dx = out[cap * (1 + n):].reshape(cap, n)
-                a_out = address(out) or 0
-                n_out[0] = 0
-            id_chunk += 1
+                if chunks:  # the first call's output is in buf; each later one's in its own
+                    out, o = np.empty(cap * (1 + 2 * n)), 0
+                    a_out = address(out) or 0
+                    _LONG.pack_into(buf, 8 * o_int + 6 * di, 0)  # type: ignore[arg-type]
+                pending = out
             code = lib.jd_integrate(
-                problem, t1, p_st, p_x, p_k0, p_g, p_cnt, p_te, n_te, p_ieval, a_out,
-                a_out + 8 * cap, a_out + 8 * cap * (1 + n), cap, p_nout, p_evt, p_evx, p_evi,
-                ev_cap, p_nev, max_steps, p_fail)
+                problem, t1, p_st, p_x, p_k0, p_g, p_cnt, p_te, n_te, p_cnt + 5 * di, a_out,
+                a_out + 8 * cap, a_out + 8 * cap * (1 + n), cap, p_cnt + 6 * di, p_evt, p_evx,
+                p_evi, ev_cap, p_cnt + 7 * di, max_steps, p_fail)
+            cnt = _COUNTERS.unpack_from(buf, 8 * o_int)  # type: ignore[arg-type]
             if te is None:
-                _keep_chunk()
+                chunks.append(_chunk(out, o, cap, n, f, cnt[6]))
+                pending = None
                 if writer:
-                    writer.append(chunks_t[-1], chunks_x[-1])
+                    writer.append(chunks[-1][0], chunks[-1][1])
             elif writer:
-                writer.append(out_t[written:n_out[0]], out_x[written:n_out[0]])
-                written = int(n_out[0])
+                m = cnt[6]
+                ts, xs, _ = _chunk(out, o, cap, n, f, m)
+                writer.append(ts[written:], xs[written:])
+                written = m
             if code < 0:
                 if code == _ECALLBACK and isinstance(setup.callback_error, KeyboardInterrupt):
                     raise setup.callback_error
-                err = _error(code, setup, fail)
+                err = _error(code, setup, buf[o_fail:o_fail + n + 1])
                 if code == _ECALLBACK:
                     status, message, exception = "interrupted", str(err), setup.callback_error
                     break
                 status, message, error = "failed", str(err), err
                 break
             if code == _EVENT:
-                k = int(ev_i[n_ev[0] - 1])
+                k = int(ev_i[cnt[7] - 1])
                 status = "event"
-                message = f"terminal event {setup.events[k].label!r} at t = {st[0]:.9g}"
+                message = f"terminal event {setup.events[k].label!r} at t = {buf[0]:.9g}"
                 break
             if code == _DONE:
                 break
-            stiffness.after_call(float(st[0]), float(st[1]), x.copy(), int(cnt[2]))
-            if handler_due:
-                install()
-            if interrupted[0]:
+            if stiffness is None:
+                stiffness = StiffnessCheck(lib, setup, setup.problem.method)
+            stiffness.after_call(float(buf[0]), float(buf[1]), buf[4:4 + n].copy(),
+                                 cnt[2])
+            if sigint is None:
+                sigint = _Sigint()
+            if sigint.interrupted:
                 raise KeyboardInterrupt
-            now = time.perf_counter()
             if callable(progress):
-                progress(float(st[0]), t1)
-            elif progress and now - t_last_report > 0.5:
-                t_last_report = now
-                print(f"\rsimulating {system.name}: t = {st[0]:.4g} of {t1:.4g} "
-                      f"({100 * (st[0] - t0) / (t1 - t0):.0f} %)", end="", file=sys.stderr)
+                progress(float(buf[0]), t1)
+            elif progress:
+                now = time.perf_counter()
+                if now - t_last_report > 0.5:
+                    t_last_report = now
+                    print(f"\rsimulating {system.name}: t = {buf[0]:.4g} of {t1:.4g} "
+                          f"({100 * (buf[0] - t0) / (t1 - t0):.0f} %)", end="", file=sys.stderr)
     except KeyboardInterrupt as exc:
-        if te is None and kept < id_chunk:  # Ctrl-C came right after a call returned
-            _keep_chunk()
+        if pending is not None:  # Ctrl-C came right after a call returned
+            m = _COUNTERS.unpack_from(buf, 8 * o_int)[6]  # type: ignore[arg-type]
+            chunks.append(_chunk(pending, o, cap, n, f, m))
         status = "interrupted"
         message = "interrupted by the user (Ctrl-C); the motion up to there is kept"
         exception = exc
     finally:
-        if old_handler is not None:
-            signal.signal(signal.SIGINT, old_handler)
+        if sigint is not None:
+            sigint.restore()
         if writer:
             writer.handle.close()
     if progress is True:
         print(file=sys.stderr)
+    cnt = _COUNTERS.unpack_from(buf, 8 * o_int)  # type: ignore[arg-type]
+    dx_out: np.ndarray | None
     if te is not None:
-        t_out, x_out = out_t[:n_out[0]], out_x[:n_out[0]]
-        dx_out = out_dx[:n_out[0], f:2 * f]
-    elif chunks_t and sum(len(c) for c in chunks_t):
-        t_out, x_out = np.concatenate(chunks_t), np.concatenate(chunks_x)
-        dx_out = np.concatenate(chunks_dx)
+        m = cnt[6]
+        e = o + cap * (1 + n)
+        t_out, x_out = out[o:o + m], out[o + cap:o + cap + m * n].reshape(m, n)
+        dx_out = out[e:e + m * n].reshape(m, n)[:, f:2 * f]
+    elif len(chunks) == 1 and len(chunks[0][0]):  # a run done in one call: t copied off
+        t_out, x_out, dx_out = chunks[0][0].copy(), chunks[0][1], chunks[0][2]
+    elif sum(len(c[0]) for c in chunks):
+        t_out = np.concatenate([c[0] for c in chunks])
+        x_out = np.concatenate([c[1] for c in chunks])
+        dx_out = np.concatenate([c[2] for c in chunks])
     else:  # failed or interrupted at the start: the initial state only
         t_out, x_out, dx_out = np.array([t0]), x0[None, :].copy(), None
     if isinstance(exception, KeyboardInterrupt):
         message = (f"interrupted by the user (Ctrl-C) at t = {t_out[-1]:.9g}; the motion up "
                    "to there is kept")
-    m = int(n_ev[0])
-    if nev and m == ev_cap:
-        message += f"; only the first {ev_cap} event crossings were recorded"
+    nfev, nstep, naccept, nreject = cnt[:4]
+    if nev:
+        m = cnt[7]
+        if m == ev_cap:
+            message += f"; only the first {ev_cap} event crossings were recorded"
+        events = (ev_t[:m].copy(), ev_x[:m].copy(), ev_i[:m].copy())
+    else:
+        events = _NO_EVENTS
     return {"t": t_out, "x": x_out, "ydd": dx_out, "status": status, "message": message,
-            "exception": exception, "error": error, "nfev": int(cnt[0]), "nstep": int(cnt[1]),
-            "naccept": int(cnt[2]), "nreject": int(cnt[3]),
-            "events": (ev_t[:m].copy(), ev_x[:m].copy(), ev_i[:m].copy())}
+            "exception": exception, "error": error, "nfev": nfev, "nstep": nstep,
+            "naccept": naccept, "nreject": nreject, "events": events}
+
+
+#: a run's crossings where it has no events (read only: nothing is appended to them)
+_NO_EVENTS = (np.empty(0), np.empty((0, 0)), np.empty(0, dtype=np.int_))
 
 
 def _run_scipy(setup: _Setup, method: str, t0: float, t1: float, x0: np.ndarray,

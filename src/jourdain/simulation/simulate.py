@@ -29,9 +29,11 @@ computed: the results say ``interrupted`` and why.
 Place in the method: the time integration of the equations of motion (``docs/method.md``,
 "Numbers, simulation, files").
 This module is the entry point; the options and their checks are in :mod:`.options`, what the
-compiled loop integrates (events, inputs, the C structure and library) in :mod:`.problem`, one
-run (C loop in chunks or SciPy, and the errors of a run) in :mod:`.runs`; the names that other
-modules import from here stay importable from here.
+compiled loop integrates (events, inputs, the C structure and library) in :mod:`.problem`, the
+problem prepared once per system and options (memoized: a repeated call costs microseconds
+outside its C loop) in :mod:`.template`, one run (C loop in chunks or SciPy, and the errors of
+a run) in :mod:`.runs`; the names that other modules import from here stay importable from
+here.
 """
 
 from __future__ import annotations
@@ -44,7 +46,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import EvaluationError
-from ..numeric import CompiledFunction, _vector, mkq_function, parameter_vector
+from ..numeric import CompiledFunction, _vector
 from .options import (  # noqa: F401 - the import paths of the options stay those of this module
     ATOL_MAX,
     C_METHODS,
@@ -71,6 +73,7 @@ from .options import (  # noqa: F401 - the import paths of the options stay thos
     check_t_end,
     check_t_eval,
     check_t_span,
+    checked_options,
     max_samples,
     steps_per_call,
 )
@@ -82,6 +85,7 @@ from .problem import (  # noqa: F401 - re-exported: the ensemble driver builds o
 )
 from .results import Results
 from .runs import IntegrationError, _run_c, _run_scipy
+from .template import RunTemplate, run_template
 
 if TYPE_CHECKING:
     from ..model.system import System
@@ -168,19 +172,16 @@ def simulate(system: System, t_span: tuple[float, float], y0: Any, yd0: Any,
                                max_step=max_step, events=tuple(events), first_step=first_step,
                                progress=progress, output=output,
                                raise_on_interrupt=raise_on_interrupt, **closed_options)
-    _tree_takes_no(system, closed_options)
+    if closed_options:
+        _tree_takes_no(system, closed_options)
     if getattr(system, "frictions", ()):  # friction forces fed back from the reactions
         from ..analysis.friction import friction_inputs  # with the analysis (issue 35)
 
         system, inputs = friction_inputs(system, inputs, parameters)
     f = system.f
     t0, t1 = check_t_span(t_span)
-    yv = _initial(y0, f, "y0", system, "")
-    ydv = _initial(yd0, f, "yd0", system, "_d")
-    method = check_method(method)
-    rtol = check_rtol(rtol)
-    a = check_atol(atol, 2 * f)
-    atol_x = np.concatenate([a, [a.min()]])
+    x0 = _initial_state(y0, yd0, f, system)
+    method, rtol, atol_x = checked_options(method, rtol, atol, 2 * f)
     max_step = check_max_step(max_step, t0, t1)
     if first_step is not None:
         first_step = _real(first_step, "first_step")
@@ -190,11 +191,10 @@ def simulate(system: System, t_span: tuple[float, float], y0: Any, yd0: Any,
     if output is not None and not str(output).lower().endswith(OUTPUT_SUFFIXES):
         raise EvaluationError(f"output = {_shown(str(output))}: a results file ends in "
                               f"{', '.join(OUTPUT_SUFFIXES)}")
-    p = parameter_vector(system, parameters)
-    mkq = mkq_function(system)
-    setup = _Setup(system, mkq, p, inputs, events, C_METHODS.get(method, 1), rtol, atol_x,
-                   max_step, first_step or 0.0)
-    x0 = np.concatenate([yv, ydv, [0.0]])
+    # the problem and the results' constant fields, memoized per system and options
+    template = run_template(system, parameters, inputs, events, method, rtol, atol_x,
+                            max_step, first_step or 0.0)
+    setup = template.setup
     integrator_library()  # built or loaded once per process, outside the timed run
     wall = time.perf_counter()
     if method in C_METHODS:
@@ -202,7 +202,7 @@ def simulate(system: System, t_span: tuple[float, float], y0: Any, yd0: Any,
     else:
         run = _run_scipy(setup, method, t0, t1, x0, te, rtol, atol_x, max_step, first_step)
     run["wall_time"] = time.perf_counter() - wall
-    res = _results(setup, run, method, rtol, a, p)
+    res = _results(template, run)
     if output is not None:
         res.save(output)
     if run.get("error") is not None:
@@ -231,41 +231,54 @@ def _tree_takes_no(system: System, options: Mapping[str, Any]) -> None:
                               f"systems; {system.name!r} has no closing joints")
 
 
-def _initial(x: Any, f: int, what: str, system: System, suffix: str) -> np.ndarray:
-    """An initial vector of ``f`` finite numbers; the names of the coordinates are formed only
-    for the message of a bad one."""
-    if isinstance(x, np.ndarray) and x.dtype == np.float64 and x.size == f:
-        v = x.reshape(-1)
-        if np.isfinite(v).all():
-            return v
-    return _vector(x, f, what, [f"{n}{suffix}" for n in system.coordinate_names])
+#: the work W at the start of a run (the state's last entry); the dtype of native doubles (a
+#: singleton: compared by identity, where ``==`` converts its operand first)
+_W0, _F8 = np.zeros(1), np.dtype(np.float64)
 
 
-def _results(setup: _Setup, run: dict, method: str, rtol: float, atol: np.ndarray,
-             p: np.ndarray) -> Results:
-    system = setup.system
-    f = system.f
+def _initial_state(y0: Any, yd0: Any, f: int, system: System) -> np.ndarray:
+    """The initial state ``[y0, ẏ0, W = 0]`` from ``f`` finite numbers each. Vectors of f
+    doubles are taken as they are when the sum of their entries is finite (NaN or inf wherever
+    an entry is; summed as Python floats, which overflow to inf without NumPy's warning); any
+    other argument, and a sum that overflows, go the long way, which forms the names of the
+    coordinates for the message of a bad entry."""
+    if (type(y0) is np.ndarray and type(yd0) is np.ndarray and y0.dtype is _F8
+            and yd0.dtype is _F8 and y0.shape == yd0.shape == (f,)):
+        x0 = np.concatenate((y0, yd0, _W0))
+        if math.isfinite(sum(x0.tolist())):
+            return x0
+    names = system.coordinate_names
+    return np.concatenate((_vector(y0, f, "y0", names),
+                           _vector(yd0, f, "yd0", [f"{n}_d" for n in names]), _W0))
+
+
+def _results(template: RunTemplate, run: dict) -> Results:
+    setup = template.setup
+    f = len(template.coordinate_names)
     t, x = run["t"], run["x"]
-    U = setup.inputs_at(t, x) if len(t) else np.zeros((0, len(system.inputs)))
+    U = template.inputs_at(t, x) if len(t) else np.zeros((0, len(template.input_names)))
     ydd = run.get("ydd")
     if ydd is not None and len(ydd) == len(t):  # from the C loop (NaN where M was singular)
         ydd = np.ascontiguousarray(ydd)
     else:
-        ydd = accelerations(setup.mkq, x[:, :f], x[:, f:2 * f], t, p, U)
-    ev_t, ev_x, ev_i = run["events"]
-    events: dict[str, list[tuple[float, np.ndarray, np.ndarray]]] = {
-        ev.label: [] for ev in setup.events}
-    for tt, xx, k in zip(ev_t, ev_x, ev_i, strict=True):
-        events[setup.events[int(k)].label].append((float(tt), xx[:f].copy(), xx[f:2 * f].copy()))
-    return Results(
-        system=system, t=t, y=x[:, :f].copy(), yd=x[:, f:2 * f].copy(), ydd=ydd, u=U,
-        W=x[:, 2 * f].copy(), parameters=dict(zip((k for k, _ in system.parameters), p.tolist(),
-                                                  strict=True)),
-        method=method, rtol=rtol, atol=atol, status=run["status"], message=run["message"],
-        nfev=run["nfev"], nsteps=run["nstep"], n_accepted=run["naccept"],
-        n_rejected=run["nreject"], wall_time=run["wall_time"],
-        events={k: _event_arrays(v, f) for k, v in events.items()},
-        exception=run["exception"])
+        ydd = accelerations(setup.mkq, x[:, :f], x[:, f:2 * f], t, setup.p, U)
+    events: dict[str, dict[str, np.ndarray]] = {}
+    if setup.events:
+        found: dict[str, list[tuple[float, np.ndarray, np.ndarray]]] = {
+            ev.label: [] for ev in setup.events}
+        for tt, xx, k in zip(*run["events"], strict=True):
+            found[setup.events[int(k)].label].append((float(tt), xx[:f].copy(),
+                                                      xx[f:2 * f].copy()))
+        events = {k: _event_arrays(v, f) for k, v in found.items()}
+    # positional: binding two dozen keywords took 0.7 µs of a call's 20
+    return Results(  # system, t, y, yd, ydd, u, W, parameters, method, rtol, atol, status,
+        # message, nfev, nsteps, n_accepted, n_rejected, wall_time, events, exception,
+        # coordinate_names, input_names, units, energies, name
+        setup.system, t, x[:, :f].copy(), x[:, f:2 * f].copy(), ydd, U, x[:, 2 * f].copy(),
+        dict(template.parameters), template.method, template.rtol, template.atol.copy(),
+        run["status"], run["message"], run["nfev"], run["nstep"], run["naccept"],
+        run["nreject"], run["wall_time"], events, run["exception"], template.coordinate_names,
+        template.input_names, template.units, None, template.name)
 
 
 def _event_arrays(items: list, f: int) -> dict[str, np.ndarray]:
