@@ -121,10 +121,11 @@ def loop_library() -> ctypes.CDLL:
     return lib
 
 
-def functions(system, max_nodes: int) -> tuple[dict, dict, int]:  # noqa: ANN001
+def functions(system, max_nodes: int) -> tuple[dict, dict, tuple[int, int]]:  # noqa: ANN001
     """The compiled function of every path ``system`` can take, their build seconds, and the
-    nodes of the symbolic graph (up to ``max_nodes`` + 1; 0 where not derived)."""
-    from jourdain.graph import count_nodes
+    nodes of the symbolic graph (up to ``max_nodes`` + 1; 0 where not derived) and its calls
+    of the C library (:func:`jourdain.graph.count_graph`)."""
+    from jourdain.graph import count_graph
     from jourdain.numeric.compiled import dynamics_function, planar_function, symbolic_mkq
     from jourdain.numeric.cost import SYMBOLIC_MAX_F
     from jourdain.numeric.planar_recursion import is_planar
@@ -132,12 +133,12 @@ def functions(system, max_nodes: int) -> tuple[dict, dict, int]:  # noqa: ANN001
     from jourdain.stages.newton_euler import newton_euler
     from jourdain.stages.projection import projection
 
-    fns, secs, nodes = {}, {}, 0
+    fns, secs, nodes = {}, {}, (0, 0)
     if system.f <= SYMBOLIC_MAX_F:
         t0 = time.perf_counter()
         eom = projection(newton_euler(kinematics(system)))
-        nodes = count_nodes([*eom.M.entries(), *eom.k.entries(), *eom.q.entries()], max_nodes)
-        if nodes <= max_nodes:
+        nodes = count_graph([*eom.M.entries(), *eom.k.entries(), *eom.q.entries()], max_nodes)
+        if nodes[0] <= max_nodes:
             fns["symbolic"] = symbolic_mkq(system, eom)
             secs["symbolic"] = time.perf_counter() - t0
     if is_planar(system):
@@ -214,7 +215,7 @@ def measure(name: str, make, lib: ctypes.CDLL, n_states: int, rounds: int,  # no
     scale = max(float(np.abs(ref).max()), 1.0)  # relative to the largest entry, or absolute
     M = fns["spatial"].batch(Y[:500], YD[:500], 0.0, p, None)["M"]
     row = {"model": name, **{k: int(v) for k, v in choice.features.items()},
-           "sym_nodes": nodes,
+           "sym_nodes": nodes[0], "sym_calls": nodes[1],
            "us": us, "build_s": secs, "chosen": choice.path,
            "predicted_us": {k: v / 1e3 for k, v in choice.cost.items()},
            "agreement": max(float(np.abs(o - ref).max()) / scale for o in out.values()),
@@ -240,7 +241,7 @@ def fit(rows: list[dict]) -> dict[str, dict[str, float]]:
 
     terms = {"planar": ("base", "body", "column", "local", "solve"),
              "spatial": ("base", "body", "column", "local", "solve"),
-             "symbolic": ("base", "node", "solve")}
+             "symbolic": ("base", "node", "call", "entry", "solve")}
     out = {}
     for path, names in terms.items():
         A, b = [], []
@@ -249,7 +250,8 @@ def fit(rows: list[dict]) -> dict[str, dict[str, float]]:
                 continue
             feat = {"base": 1.0, "body": r["bodies"], "column": r["columns"],
                     "local": r["local"], "solve": r["shared"] * r["f"] ** 3 if path != "symbolic"
-                    else r["f"] ** 3, "node": r["sym_nodes"]}
+                    else r["f"] ** 3, "node": r["sym_nodes"], "call": r["sym_calls"],
+                    "entry": r["f"] ** 2}
             t = r["us"][path] * 1e3
             A.append([feat[n] / t for n in names])
             b.append(1.0)

@@ -116,42 +116,26 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+# the planar chains: jourdain's model and the link data the peers' models are built from
+from jourdain.models.planar import (  # noqa: E402
+    GRAVITY,
+    LINK_I_AXIAL,
+    LINK_LENGTH,
+    LINK_MASS,
+)
+from jourdain.models.planar import planar_chain as chain_system  # noqa: E402
+
 LEVELS = (1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8)
 #: refinement stops below this error (every level is then reached)
 STOP_ERROR = 1e-9
 REF_TOL = 1e-13
-#: link data of the planar chains
-LINK_MASS, LINK_LENGTH, LINK_I_AXIAL, GRAVITY = 1.0, 1.0, 1e-3, 9.81
+
 MUJOCO_CHUNK = 10_000
 BENCH_EXTRA = "pip install 'jourdain[bench]'"
 MODELS = ("chain4", "chain12", "chain32", "arm", "fourbar")
 
 
 # --------------------------------------------------------------------------------------- models
-
-def chain_system(n: int):  # noqa: ANN201 - a jourdain System
-    """jourdain's planar n-link pendulum (relative joint angles q0 … q(n−1), every number a
-    parameter: m{i}, l{i}, J{i} (inertia across the link), Ja{i} (along it), g)."""
-    import symengine as se
-
-    from jourdain.model import Body, Gravity, Revolute
-    from jourdain.pipeline import System
-
-    qs = [se.Symbol(f"q{i}") for i in range(n)]
-    g = se.Symbol("g")
-    params: dict[str, float] = {"g": GRAVITY}
-    bodies = []
-    for i in range(n):
-        m, L, J, Ja = (se.Symbol(f"{k}{i}") for k in ("m", "l", "J", "Ja"))
-        pos = (0, 0, 0) if i == 0 else (se.Symbol(f"l{i - 1}"), 0, 0)
-        bodies.append(Body(f"link{i}", "world" if i == 0 else f"link{i - 1}",
-                           Revolute(f"joint{i}", qs[i], "z", position=pos), mass=m,
-                           com=(L / 2, 0, 0), inertia=(Ja, J, J)))
-        params.update({f"m{i}": LINK_MASS, f"l{i}": LINK_LENGTH, f"Ja{i}": LINK_I_AXIAL,
-                       f"J{i}": LINK_MASS * LINK_LENGTH ** 2 / 12})
-    return System(qs, bodies, [Gravity((0, -g, 0))], parameters=params,
-                  name=f"planar {n}-link pendulum")
-
 
 def _chain_links(n: int) -> list[dict]:
     """The chain in the form of :func:`jourdain.models.spatial_chain_data` (for the peers)."""

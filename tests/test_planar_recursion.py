@@ -158,12 +158,14 @@ def test_symbolic_projection_derived_only_where_it_can_win(monkeypatch):
         return real(*args)
 
     monkeypatch.setattr(cost, "projection", spy)
-    costly = {**cost.COST_NS, "symbolic": {"node": 0.3, "solve": 1e9, "base": 10.0}}
+    costly = {**cost.COST_NS, "symbolic": {"node": 0.3, "call": 4.0, "entry": 0.5,
+                                           "solve": 1e9, "base": 10.0}}
     monkeypatch.setattr(cost, "COST_NS", costly)
     evaluation_path.cache_clear()
     choice = evaluation_path(system)
     assert choice.path == "planar" and not calls and "nodes" not in choice.features
-    cheap = {**cost.COST_NS, "symbolic": {"node": 1e-6, "solve": 0.0, "base": 0.0}}
+    cheap = {**cost.COST_NS, "symbolic": {"node": 1e-6, "call": 0.0, "entry": 0.0,
+                                          "solve": 0.0, "base": 0.0}}
     monkeypatch.setattr(cost, "COST_NS", cheap)
     evaluation_path.cache_clear()
     choice = evaluation_path(system)

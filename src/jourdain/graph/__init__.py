@@ -18,7 +18,7 @@ Floor: model → **graph tools** → stages → numeric. The package imports not
 :mod:`jourdain.errors`; the stages, the numeric layer, the analyses and the export build on it.
 """
 
-from .elimination import CSE, count_nodes, cse, graph_ops, node_ops, tree_ops
+from .elimination import CSE, count_graph, count_nodes, cse, graph_ops, node_ops, tree_ops
 from .forward import Jet, as_basic, jet
 from .nodes import Graph, Merged, atom_key
 from .numbers import (
@@ -32,7 +32,7 @@ from .numbers import (
 from .sums import shared_sums, term_keys
 
 __all__ = [
-    "CSE", "FloatJet", "Graph", "Jet", "Merged", "as_basic", "atom_key", "count_nodes", "cse",
+    "CSE", "FloatJet", "Graph", "Jet", "Merged", "as_basic", "atom_key", "count_graph", "count_nodes", "cse",
     "evaluate_arrays", "evaluate_float", "evaluate_float_many", "free_symbol_names",
     "graph_ops", "jet", "jet_float", "node_ops",
     "shared_sums", "term_keys", "tree_ops",

@@ -70,8 +70,16 @@ def cse(exprs: Sequence[Expr], prefix: str = "x") -> CSE:
 def count_nodes(exprs: Sequence[Expr], cap: int) -> int:
     """Number of distinct non-atomic nodes of the expressions' graph (by identity), counted up
     to ``cap + 1``: a cheap test of whether a graph is small, whatever its full size."""
+    return count_graph(exprs, cap)[0]
+
+
+def count_graph(exprs: Sequence[Expr], cap: int) -> tuple[int, int]:
+    """:func:`count_nodes`, and among those nodes the function calls whose argument is not a
+    bare symbol (``sin(q0 + q1)``: a call of the C library each; the sines and cosines of
+    argument symbols are computed together, vectorized, :mod:`jourdain.numeric.ccode`)."""
     ids = NodeIds()
     seen: set[int] = set()
+    calls = 0
     stack = [e for e in exprs if not _is_atom(e)]
     while stack and len(seen) <= cap:
         e = stack.pop()
@@ -79,8 +87,10 @@ def count_nodes(exprs: Sequence[Expr], cap: int) -> int:
         if k in seen:
             continue
         seen.add(k)
+        if isinstance(e, se.Function) and not all(isinstance(a, se.Symbol) for a in e.args):
+            calls += 1
         stack.extend(a for a in e.args if not _is_atom(a))
-    return len(seen)
+    return len(seen), calls
 
 
 def node_ops(n: Expr) -> int:

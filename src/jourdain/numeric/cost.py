@@ -11,7 +11,7 @@ Three paths compute the integrator's ÿ = M⁻¹(q − k) (``jd_accel``):
 Both recursions take the articulated-body ÿ where every coordinate belongs to one joint, else
 LDLᵀ of their M. Their cost per right-hand side is predicted from the model's structure alone
 (bodies, Jacobian columns, the operations of the per-joint expressions, f); the symbolic
-path's from the nodes of its expression graph and f. The symbolic projection is derived only
+path's from the nodes and the C library's calls of its expression graph, and f. The symbolic projection is derived only
 where a lower bound of its cost (the LDLᵀ solve and one operation per entry of M, k, q) beats
 the best recursion, and its graph is counted only up to the size at which it would lose
 (never deriving what the chosen path does not need). Past :data:`SYMBOLIC_MAX_NODES` it is not
@@ -33,7 +33,7 @@ from functools import lru_cache
 from types import MappingProxyType
 from typing import TYPE_CHECKING
 
-from ..graph import count_nodes
+from ..graph import count_graph, count_nodes
 from ..stages.kinematics import kinematics
 from ..stages.newton_euler import newton_euler
 from ..stages.projection import projection
@@ -47,13 +47,15 @@ if TYPE_CHECKING:
 #: ns per right-hand side (AMD EPYC, gcc -O2; ``benchmarks/paths.py --fit``, 2026-11-27):
 #: per body, per Jacobian column, per node of the per-joint expressions, per f³ of an LDLᵀ
 #: solve (the recursions where coordinates are shared), and a constant; the symbolic path per
-#: node of its graph and per f³ of its solve
+#: node of its graph, per call of the C library in it (a sine of a sum of angles), per f² (the
+#: entries of M and their solve) and per f³
 COST_NS: Mapping[str, Mapping[str, float]] = MappingProxyType({
-    "planar": MappingProxyType({"body": 40.0, "column": 10.0, "local": 0.3, "solve": 0.1,
-                                "base": 20.0}),
-    "spatial": MappingProxyType({"body": 170.0, "column": 40.0, "local": 0.3, "solve": 0.1,
-                                 "base": 40.0}),
-    "symbolic": MappingProxyType({"node": 0.3, "solve": 0.1, "base": 10.0}),
+    "planar": MappingProxyType({"body": 25.5, "column": 0.0, "local": 7.7, "solve": 0.26,
+                                "base": 0.9}),
+    "spatial": MappingProxyType({"body": 83.0, "column": 67.0, "local": 0.97, "solve": 0.13,
+                                 "base": 36.0}),
+    "symbolic": MappingProxyType({"node": 0.30, "call": 3.5, "entry": 0.0, "solve": 0.00066,
+                                  "base": 7.3}),
 })
 #: the symbolic path is not taken above this many nodes of its graph (compile time)
 SYMBOLIC_MAX_NODES = 8000
@@ -68,8 +70,8 @@ class PathChoice:
     ``path``: ``"symbolic"``, ``"planar"`` or ``"spatial"``; ``cost``: the predicted ns per
     right-hand side of every path considered (the symbolic one only where derived);
     ``features``: what the prediction read (``f``, ``bodies``, ``columns``, ``local`` nodes,
-    ``shared`` coordinates (1 or 0), ``planar`` (1 or 0), ``nodes`` of the symbolic graph,
-    counted up to where it loses); ``eom``: the symbolic projection where it was derived."""
+    ``shared`` coordinates (1 or 0), ``planar`` (1 or 0), ``nodes`` and library ``calls`` of
+    the symbolic graph, counted up to where it loses); ``eom``: the symbolic projection where it was derived."""
 
     path: str
     cost: Mapping[str, float]
@@ -95,10 +97,12 @@ def recursion_cost(kind: str, feats: Mapping[str, int]) -> float:
             + c["local"] * feats["local"] + c["solve"] * feats["shared"] * feats["f"] ** 3)
 
 
-def symbolic_cost(nodes: int, f: int) -> float:
-    """Predicted ns per right-hand side of the symbolic path with ``nodes`` graph nodes."""
+def symbolic_cost(nodes: int, calls: int, f: int) -> float:
+    """Predicted ns per right-hand side of the symbolic path whose graph has ``nodes`` nodes,
+    ``calls`` of them calls of the C library (:func:`jourdain.graph.count_graph`)."""
     c = COST_NS["symbolic"]
-    return c["base"] + c["node"] * nodes + c["solve"] * f ** 3
+    return (c["base"] + c["node"] * nodes + c["call"] * calls + c["entry"] * f * f
+            + c["solve"] * f ** 3)
 
 
 @lru_cache(maxsize=32)
@@ -113,16 +117,16 @@ def evaluation_path(system: System) -> PathChoice:
     f = system.f
     entries = f * (f + 1) // 2 + 2 * f
     eom = None
-    if f <= SYMBOLIC_MAX_F and symbolic_cost(entries, f) < best:
+    if f <= SYMBOLIC_MAX_F and symbolic_cost(entries, 0, f) < best:
         eom = projection(newton_euler(kinematics(system)))
         exprs = [*eom.M.entries(), *eom.k.entries(), *eom.q.entries()]
         # the graph is counted only as far as the symbolic path could still win
-        cap = min(SYMBOLIC_MAX_NODES,
-                  int((best - symbolic_cost(0, f)) / COST_NS["symbolic"]["node"]) + 1)
-        nodes = count_nodes(exprs, cap)
-        feats["nodes"] = nodes
-        if nodes <= SYMBOLIC_MAX_NODES:
-            cost["symbolic"] = symbolic_cost(nodes, f)
+        node = max(COST_NS["symbolic"]["node"], 1e-9)
+        cap = min(SYMBOLIC_MAX_NODES, int((best - symbolic_cost(0, 0, f)) / node) + 1)
+        nodes, calls = count_graph(exprs, cap)
+        feats["nodes"], feats["calls"] = nodes, calls
+        if nodes <= cap:
+            cost["symbolic"] = symbolic_cost(nodes, calls, f)
     path = min(cost, key=lambda k: (cost[k], k))
     return PathChoice(path, MappingProxyType(cost), MappingProxyType(feats),
                       eom if path == "symbolic" else None)

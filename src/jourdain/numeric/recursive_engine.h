@@ -425,15 +425,22 @@ static int jd_aba(const jd_work *W, jd_aba_work *A, double *ydd, double *wrench)
             Du[k] = 0.0;
             for (int l = 0; l < n; ++l) Du[k] += Dinv[k * n + l] * u[l];
         }
+        double E[36];  /* E = D⁻¹ Uᵀ (n × 6): the update is then U E, symmetric */
+        for (int k = 0; k < n; ++k)
+            for (int c = 0; c < 6; ++c) {
+                double t = 0.0;
+                for (int l = 0; l < n; ++l) t += Dinv[k * n + l] * U[6 * l + c];
+                E[6 * k + c] = t;
+            }
         for (int r = 0; r < 6; ++r) {
             double t = pA[r];
             for (int k = 0; k < n; ++k) t -= U[6 * k + r] * Du[k];
             pAp[r] += t;
-            for (int c = 0; c < 6; ++c) {
+            for (int c = r; c < 6; ++c) {
                 double s = IA[6 * r + c];
-                for (int k = 0; k < n; ++k)
-                    for (int l = 0; l < n; ++l) s -= U[6 * k + r] * Dinv[k * n + l] * U[6 * l + c];
+                for (int k = 0; k < n; ++k) s -= U[6 * k + r] * E[6 * k + c];
                 IAp[6 * r + c] += s;
+                if (c > r) IAp[6 * c + r] += s;
             }
         }
     }
