@@ -17,7 +17,7 @@ import pytest
 import jourdain as jd
 from jourdain import models
 from jourdain.numeric import cost, evaluation_path, lambdify, mkq_function, planar_function
-from jourdain.numeric.planar_recursion import is_planar
+from jourdain.numeric.planar_recursion import is_planar, plane_normal
 from tests.tolerance import assert_close_eval, eval_tol, ydd_of, ydd_tol
 
 
@@ -53,12 +53,33 @@ def planar_mechanism() -> jd.System:
                      name="planar mechanism")
 
 
+def pendulum_in_plane(axis: str) -> jd.System:
+    """A three-link pendulum with hinges about ``axis`` (x or y) and a slider in that plane on
+    its second link, gravity across the axis: a planar mechanism in the y-z or z-x plane."""
+    a, b, s, c = jd.symbols("a b s c")
+    other = {"x": ((0, 0.5, 0.1), (0, 0.6, 0.8)), "y": ((0.1, 0, 0.5), (0.8, 0, 0.6))}[axis]
+    bodies = [
+        jd.Body("l1", "world", jd.Revolute("j1", a, axis), mass=1.0, com=other[0],
+                inertia=jd.box(1.0, 0.1, 0.2, 0.3)),
+        jd.Body("l2", "l1", jd.Revolute("j2", b, axis, position=other[0]), mass=0.8,
+                com=other[0], inertia=jd.box(0.8, 0.3, 0.1, 0.2)),
+        jd.Body("sl", "l2", jd.Prismatic("j3", s, other[1], position=other[0]), mass=0.3,
+                com=(0, 0, 0), inertia=jd.box(0.3, 0.05, 0.05, 0.05)),
+        jd.Body("l3", "sl", jd.Revolute("j4", c, axis), mass=0.5, com=other[0],
+                inertia=jd.box(0.5, 0.2, 0.1, 0.1)),
+    ]
+    return jd.System([a, b, s, c], bodies, [jd.Gravity((0, 0, -9.81))],
+                     name=f"pendulum about {axis}")
+
+
 CASES = {
     "chain 5 (articulated bodies)": lambda: models.planar_chain(5),
     "tree 9 with sliders": lambda: models.planar_tree(9, seed=2, prismatic=0.4),
     "cart pendulum 3 (shared coordinates)": lambda: models.n_link_pendulum_on_cart(3),
     "double pendulum": models.double_pendulum,
     "mechanism": planar_mechanism,
+    "pendulum in the y-z plane": lambda: pendulum_in_plane("x"),
+    "pendulum in the z-x plane": lambda: pendulum_in_plane("y"),
 }
 
 
@@ -101,19 +122,27 @@ def test_planar_recursion_equals_symbolic_projection(make, rng):
 
 
 def test_planar_is_structural():
-    """Only joints whose local expressions keep the x-y plane by literal zeros are planar:
-    spatial models, a hinge about x, a slider along z and a plane of other normal are not
-    (they get the spatial recursion, never a wrong number)."""
-    x, z, th = jd.symbols("x z th")
-    hinge_x = jd.System([th], [jd.Body("b", "world", jd.Revolute("j", th, "x"), mass=1.0,
-                                       inertia=jd.box(1, 0.1, 0.2, 0.3))])
-    slider_z = jd.System([z], [jd.Body("b", "world", jd.Prismatic("j", z, "z"), mass=1.0,
-                                       inertia=jd.point_mass())])
-    plane_x = jd.System([x, z, th], [jd.Body("b", "world", jd.Planar("j", (x, z, th), "x"),
-                                             mass=1.0, inertia=jd.box(1, 0.1, 0.2, 0.3))])
-    for system in (models.spatial_chain(3), models.heavy_top(), hinge_x, slider_z, plane_x):
+    """Only joints whose local expressions keep one plane of the inertial frame by literal
+    zeros are planar (z first): spatial models, hinges about two axes, a slider across the
+    hinges' plane are not (they get the spatial recursion, never a wrong number)."""
+    x, z, th, ph = jd.symbols("x z th ph")
+    box = jd.box(1, 0.1, 0.2, 0.3)
+    two_axes = jd.System([th, ph], [
+        jd.Body("b", "world", jd.Revolute("j", th, "z"), mass=1.0, inertia=box),
+        jd.Body("c", "b", jd.Revolute("k", ph, "x", position=(0.3, 0, 0)), mass=1.0,
+                inertia=box)])
+    across = jd.System([th, z], [
+        jd.Body("b", "world", jd.Revolute("j", th, "z"), mass=1.0, inertia=box),
+        jd.Body("c", "b", jd.Prismatic("k", z, "z"), mass=1.0, inertia=box)])
+    tilted = jd.System([th], [jd.Body("b", "world", jd.Revolute("j", th, (0, 0.6, 0.8)),
+                                      mass=1.0, inertia=box)])
+    for system in (models.spatial_chain(3), models.heavy_top(), two_axes, across, tilted):
         assert not is_planar(system), system.name
         assert evaluation_path(system).path != "planar"
+    plane_x = jd.System([x, z, th], [jd.Body("b", "world", jd.Planar("j", (x, z, th), "x"),
+                                             mass=1.0, inertia=box)])
+    assert plane_normal(plane_x) == 0 and plane_normal(pendulum_in_plane("y")) == 1
+    assert plane_normal(models.planar_chain(3)) == 2
 
 
 def test_simulation_by_planar_articulated_bodies_conserves_energy():

@@ -1,6 +1,7 @@
 
 /* The recursion of recursive_engine.h for planar systems (numeric/planar_recursion.py): every
-   body turns about the inertial z axis and moves in planes z = const. Twists (w, ux, uy): the
+   body turns about the inertial z axis and moves in planes z = const (for another plane, its
+   axes in cyclic order play x, y and z). Twists (w, ux, uy): the
    angular velocity about z and the velocity of the body point at the inertial origin; wrenches
    (mz, Fx, Fy): the moment about the origin's z axis and the in-plane force; the power of a
    wrench on a twist is w·mz + ux·Fx + uy·Fy. The components across the plane are carried by
