@@ -93,6 +93,11 @@ margins are at 1e-2: chain32 1.7× (MuJoCo's RK4 in 100 steps of 20 ms, 3.2 ms a
 ms), the arm and the four-bar 2.1×. There a call's fixed cost weighs: ``simulate()`` over
 1e-9 s (one step) takes 0.09 ms for chain4, 0.13 ms for the arm, 0.22 ms for chain32, and
 0.6 ms for the closed four-bar, of its 1.44 ms at 1e-2.
+
+Again on 2026-11-27 for the chains (``--models chain4 chain12 chain32 --rounds 3``), after
+issue 35's evaluation path by cost (chain12 and chain32 now on the recursion in planar vectors)
+and ``simulate()``'s 19 µs per call: MuJoCo / jourdain 20–140 (chain4), 10–49 (chain12),
+6.0–44 (chain32) across 1e-2 … 1e-8; Exudyn / jourdain 11–55, 18–51, 31–87.
 """
 
 from __future__ import annotations
