@@ -33,7 +33,7 @@ import symengine as se
 
 from ..stages.kinematics import JointMotion, joint_motions
 from .ccode import HEADER, argument_names, function_source
-from .recursive import _disjoint, c_table, layout
+from .recursive import _disjoint, c_table, column_tables, layout
 
 if TYPE_CHECKING:
     from ..model.system import System
@@ -106,11 +106,7 @@ def planar_units(system: System, accel_template: str) -> tuple[str, str, bool]:
     names = argument_names(system.y, system.yd, system.t, system.parameter_symbols,
                            system.inputs)
     local = function_source("jd_local", exprs, names)
-    col_start = [0]
-    col_coord: list[int] = []
-    for c in lay.columns:
-        col_coord.extend(c)
-        col_start.append(col_start[-1] + len(c))
+    col_start, col_coord = column_tables(lay.columns)
     aba = _disjoint(lay.columns)
     head = (f"#define JD_P {p}\n#define JD_F {f}\n#define JD_NC {max(len(col_coord), 1)}\n"
             f"#define JD_NL {len(exprs)}\n#define JD_COLS {p * PLANE_BODY}\n"

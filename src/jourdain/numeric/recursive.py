@@ -113,6 +113,17 @@ def _disjoint(columns: tuple[tuple[int, ...], ...]) -> bool:
     return len(flat) == len(set(flat))
 
 
+def column_tables(columns: tuple[tuple[int, ...], ...]) -> tuple[list[int], list[int]]:
+    """The engines' column tables: where each body's columns start (one more entry than
+    bodies), and each column's coordinate."""
+    start = [0]
+    coord: list[int] = []
+    for c in columns:
+        coord.extend(c)
+        start.append(start[-1] + len(c))
+    return start, coord
+
+
 def c_table(name: str, values: list[int], ctype: str = "int") -> str:
     """A static C array of integers (one 0 where there are none: C has no empty arrays)."""
     body = ", ".join(str(v) for v in values) if values else "0"
@@ -159,11 +170,7 @@ def _parts(system: System, full: bool, directions: tuple | None) -> tuple[str, s
     names = argument_names(system.y, system.yd, system.t, system.parameter_symbols,
                            system.inputs)
     local = function_source("jd_local", list(lay.exprs), names)
-    col_start = [0]
-    col_coord: list[int] = []
-    for c in lay.columns:
-        col_coord.extend(c)
-        col_start.append(col_start[-1] + len(c))
+    col_start, col_coord = column_tables(lay.columns)
     n_q = sum(lay.directions)
     aba = _disjoint(lay.columns)
     dir_start = [0]
