@@ -200,3 +200,12 @@ def test_symbolic_projection_derived_only_where_it_can_win(monkeypatch):
     choice = evaluation_path(system)
     assert choice.path == "symbolic" and calls and choice.features["nodes"] > 0
     evaluation_path.cache_clear()
+
+
+def test_closed_system_refused_by_name():
+    """The paths compute the open tree's ÿ: a closed system is refused, naming the way to its
+    tree; its tree takes a path as any tree does."""
+    system = models.four_bar()
+    with pytest.raises(jd.ClosedSystemError, match="system.tree"):
+        evaluation_path(system)
+    assert evaluation_path(system.tree).path in ("symbolic", "planar", "spatial")

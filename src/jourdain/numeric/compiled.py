@@ -26,7 +26,7 @@ from .ccode import HEADER, argument_names, function_source
 from .cost import evaluation_path
 from .integrator_ldl import ldl_source  # the solve written out per f (H1)
 from .planar_recursion import planar_units
-from .recursive import LDL_SOLVE, recursive_units
+from .recursive import LDL_SOLVE, layout, recursive_units
 from .toolchain import (
     CompilerError,
     build,
@@ -322,6 +322,7 @@ def clear_cache(disk: bool = False) -> None:
     dynamics_function.cache_clear()
     planar_function.cache_clear()
     evaluation_path.cache_clear()
+    layout.cache_clear()
     if disk:
         d = cache_dir()
         if d.is_dir():

@@ -33,6 +33,7 @@ from functools import lru_cache
 from types import MappingProxyType
 from typing import TYPE_CHECKING
 
+from ..errors import refuse_closed
 from ..graph import count_graph, count_nodes
 from ..stages.kinematics import kinematics
 from ..stages.newton_euler import newton_euler
@@ -71,7 +72,8 @@ class PathChoice:
     right-hand side of every path considered (the symbolic one only where derived);
     ``features``: what the prediction read (``f``, ``bodies``, ``columns``, ``local`` nodes,
     ``shared`` coordinates (1 or 0), ``planar`` (1 or 0), ``nodes`` and library ``calls`` of
-    the symbolic graph, counted up to where it loses); ``eom``: the symbolic projection where it was derived."""
+    the symbolic graph, counted up to where it loses); ``eom``: the symbolic projection where
+    it was derived and taken."""
 
     path: str
     cost: Mapping[str, float]
@@ -108,7 +110,11 @@ def symbolic_cost(nodes: int, calls: int, f: int) -> float:
 @lru_cache(maxsize=32)
 def evaluation_path(system: System) -> PathChoice:
     """The cheapest path per right-hand side for ``system`` by the cost model (memoized per
-    system), deriving the symbolic projection only where it can win."""
+    system), deriving the symbolic projection only where it can win. A closed system (closing
+    joints, contacts, generalized velocities) is refused by name: these paths compute the open
+    tree's ÿ."""
+    refuse_closed(system, "the evaluation paths compute the open tree's ÿ",
+                  "use system.tree for the open tree")
     feats = recursion_features(system)
     cost = {"spatial": recursion_cost("spatial", feats)}
     if feats["planar"]:

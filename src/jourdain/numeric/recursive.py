@@ -37,6 +37,7 @@ both with Pinocchio.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 from importlib import resources
 from typing import TYPE_CHECKING
 
@@ -68,6 +69,7 @@ class RecursiveLayout:
     directions: tuple[int, ...] = ()
 
 
+@lru_cache(maxsize=32)
 def layout(system: System, directions: tuple | None = None) -> RecursiveLayout:
     """The local expressions of every joint and body, in the order of the C arrays;
     ``directions``: per body the unit wrenches of its joint's constrained directions
