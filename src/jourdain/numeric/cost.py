@@ -11,12 +11,14 @@ Three paths compute the integrator's ÿ = M⁻¹(q − k) (``jd_accel``):
 Both recursions take the articulated-body ÿ where every coordinate belongs to one joint, else
 LDLᵀ of their M. Their cost per right-hand side is predicted from the model's structure alone
 (bodies, Jacobian columns, the operations of the per-joint expressions, f); the symbolic
-path's from the nodes and the C library's calls of its expression graph, and f. The symbolic projection is derived only
-where a lower bound of its cost (the LDLᵀ solve and one operation per entry of M, k, q) beats
+path's from the nodes and the C library's calls of its expression graph, and f. The symbolic
+projection is derived only where a lower bound of its cost (the LDLᵀ solve and one operation per entry of M, k, q) beats
 the best recursion, and its graph is counted only up to the size at which it would lose
 (never deriving what the chosen path does not need). Past :data:`SYMBOLIC_MAX_NODES` it is not
-taken however fast: its compile time grows faster than its graph (a 24-link planar chain's
-symbolic code took 9.5 s to compile).
+taken however fast: its code generation and compile time grow faster than its graph, and a
+model's first simulation waits for them (the 7-joint arm's 3 320 nodes: 1.2-1.4 s against
+0.3-0.7 s for the recursion, for 0.96 against 1.14 µs per state; a 24-link planar chain's
+symbolic code took 9.5 s).
 
 The constants (:data:`COST_NS`) are fitted by ``benchmarks/paths.py --fit`` to the measured
 times of every path on planar and spatial chains and trees, f = 1 … 128; the same script shows
@@ -58,8 +60,8 @@ COST_NS: Mapping[str, Mapping[str, float]] = MappingProxyType({
     "symbolic": MappingProxyType({"node": 0.30, "call": 3.5, "entry": 0.0, "solve": 0.00066,
                                   "base": 7.3}),
 })
-#: the symbolic path is not taken above this many nodes of its graph (compile time)
-SYMBOLIC_MAX_NODES = 8000
+#: the symbolic path is not taken above this many nodes of its graph (its compile time)
+SYMBOLIC_MAX_NODES = 3000
 #: nor above this many coordinates (its graph is not derived)
 SYMBOLIC_MAX_F = 24
 
