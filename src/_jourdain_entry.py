@@ -4,7 +4,8 @@ while it imports ends the command with exit status 130 and one line, not a trace
 This module lies outside the ``jourdain`` package on purpose: importing anything inside it
 runs ``jourdain/__init__`` first (NumPy, SymEngine, SymPy: the first 0.1–0.5 s of every
 command), and an exception raised there reaches no handler of the command line. Nothing
-here imports more than :mod:`sys` and :mod:`signal` before that import.
+here imports more than :mod:`sys` and :mod:`signal` before that import, and the extension
+modules are imported with Ctrl-C held back (:func:`_import_extensions`).
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ def main() -> int:
     once the command is done, Ctrl-C changes nothing (Python's finalization would otherwise
     die by the signal, a status of 130 for a command whose files say it finished)."""
     try:
+        _import_extensions()
         from jourdain.cli import main as run
     except KeyboardInterrupt:
         return _interrupted("while starting")
@@ -38,6 +40,25 @@ def main() -> int:
         if _by_interrupt(exc):
             return _interrupted("")
         raise
+
+
+def _import_extensions() -> None:
+    """Import NumPy and SymEngine with SIGINT held back (where the platform can block a signal).
+
+    Ctrl-C while SymEngine's extension module initializes killed the interpreter with SIGSEGV,
+    no message and no status of ours (its module initialization does not survive the
+    KeyboardInterrupt raised inside it: reproduced by SIGINT 10-20 ms after start-up with an
+    empty compile cache, 7 times in 12). Held back, the signal arrives when the imports are
+    done, as a KeyboardInterrupt that :func:`main` turns into exit status 130.
+    """
+    block = hasattr(signal, "pthread_sigmask")
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT}) if block else None
+    try:
+        import numpy  # noqa: F401 - imported for its side effect: initialized whole
+        import symengine  # noqa: F401
+    finally:
+        if old is not None:
+            signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
 def _by_interrupt(exc: BaseException | None) -> bool:
