@@ -18,7 +18,7 @@ import jourdain as jd
 from jourdain import models
 from jourdain.numeric import cost, evaluation_path, lambdify, mkq_function, planar_function
 from jourdain.numeric.planar_recursion import is_planar, plane_normal
-from tests.tolerance import assert_close_eval, eval_tol, ydd_of, ydd_tol
+from tests.tolerance import assert_close_eval, assert_close_solved, eval_tol, ydd_of, ydd_tol
 
 
 def planar_mechanism() -> jd.System:
@@ -209,3 +209,22 @@ def test_closed_system_refused_by_name():
     with pytest.raises(jd.ClosedSystemError, match="system.tree"):
         evaluation_path(system)
     assert evaluation_path(system.tree).path in ("symbolic", "planar", "spatial")
+
+
+def test_large_planar_tree_on_the_heap(rng):
+    """A planar tree of 150 bodies keeps the planar engine's work on the heap (threads may have
+    small stacks); its M, k, q equal the spatial recursion's, and its ÿ solves them."""
+    from jourdain.numeric import dynamics_function
+
+    system = models.planar_tree(150, seed=7)
+    fn, ref = planar_function(system), dynamics_function(system)
+    assert "#define JD_PLANE_STACK 0" in fn.lib_source()
+    pv = np.array(list(system.parameter_values.values()), dtype=float)
+    y, yd = rng.uniform(-1, 1, system.f), rng.uniform(-1, 1, system.f)
+    a, b = ref(y, yd, 0.0, pv, []), fn(y, yd, 0.0, pv, [])
+    for name in ("M", "k", "q"):
+        assert_close_eval(b[name], a[name], 6 * len(system.bodies), np.abs(a[name]).max() + 1.0)
+    status, ydd, _ = _accel(fn, y, yd, 0.0, pv, np.zeros(0))
+    assert status == 0
+    M, rhs = a["M"], np.ravel(a["q"]) - np.ravel(a["k"])
+    assert_close_solved(ydd, np.linalg.solve(M, rhs), [M, M])

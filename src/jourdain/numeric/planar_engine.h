@@ -125,13 +125,23 @@ static void jd_plane_project(const jd_plane *W, double *M, double *k, double *q)
         for (int s = 0; s < r; ++s) M[r * JD_F + s] = M[s * JD_F + r];
 }
 
+/* the work on the stack when small (JD_PLANE_STACK, as recursive_engine.h's JD_WORK_STACK:
+   threads may have small stacks), else on the heap */
 void jd_fn(const double *y, const double *yd, double t, const double *p, const double *u,
            double *out) {
     double L[JD_NL > 0 ? JD_NL : 1];
-    jd_plane W;
+#if JD_PLANE_STACK
+    jd_plane work, *W = &work;
+#else
+    jd_plane *W = (jd_plane *)malloc(sizeof(jd_plane));
+    if (!W) { for (long a = 0; a < JD_F * JD_F + 2 * JD_F; ++a) out[a] = NAN; return; }
+#endif
     jd_local(y, yd, t, p, u, L);
-    jd_plane_recursion(L, yd, &W, 1);
-    jd_plane_project(&W, out, out + JD_F * JD_F, out + JD_F * JD_F + JD_F);
+    jd_plane_recursion(L, yd, W, 1);
+    jd_plane_project(W, out, out + JD_F * JD_F, out + JD_F * JD_F + JD_F);
+#if !JD_PLANE_STACK
+    free(W);
+#endif
 }
 
 void jd_fn_batch(long n, long f, const double *y, const double *yd, const double *t,
@@ -180,8 +190,12 @@ static int jd_small_inverse(int n, const double *D, double *Dinv, double scale) 
     return 0;
 }
 
-static int jd_plane_aba(const jd_plane *W, double *ydd) {
+typedef struct {
     double IA[6 * JD_P], pA[3 * JD_P], U[3 * JD_NC], Dinv[9 * JD_P], uu[JD_NC], X[3 * JD_P];
+} jd_plane_aba_work;
+
+static int jd_plane_aba(const jd_plane *W, jd_plane_aba_work *K, double *ydd) {
+    double *IA = K->IA, *pA = K->pA, *U = K->U, *Dinv = K->Dinv, *uu = K->uu, *X = K->X;
     double scale = 0.0;
     for (int i = 0; i < JD_P; ++i) {
         const double *I = W->I + 4 * i;
@@ -258,14 +272,24 @@ static int jd_plane_aba(const jd_plane *W, double *ydd) {
 int jd_accel(const double *y, const double *yd, double t, const double *p, const double *u,
              double *ydd, double *power) {
     double L[JD_NL > 0 ? JD_NL : 1];
-    jd_plane W;
+    typedef struct { jd_plane W; jd_plane_aba_work K; } jd_plane_all;
+#if JD_PLANE_STACK
+    jd_plane_all work, *A = &work;
+#else
+    jd_plane_all *A = (jd_plane_all *)malloc(sizeof(jd_plane_all));
+    if (!A) return 2;
+#endif
     jd_local(y, yd, t, p, u, L);
-    jd_plane_recursion(L, yd, &W, 1);
+    jd_plane_recursion(L, yd, &A->W, 1);
     double w = 0.0;
     for (int b = 0; b < JD_P; ++b)
         for (int c = jd_col_start[b]; c < jd_col_start[b + 1]; ++c)
-            w += yd[jd_col_coord[c]] * jd_dot3(W.V + 3 * c, W.Wc + 3 * b);
+            w += yd[jd_col_coord[c]] * jd_dot3(A->W.V + 3 * c, A->W.Wc + 3 * b);
     *power = w;
-    return jd_plane_aba(&W, ydd);
+    int status = jd_plane_aba(&A->W, &A->K, ydd);
+#if !JD_PLANE_STACK
+    free(A);
+#endif
+    return status;
 }
 #endif

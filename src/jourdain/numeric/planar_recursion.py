@@ -41,8 +41,8 @@ if TYPE_CHECKING:
 #: numbers per body in the local array (see planar_engine.h) and per Jacobian column
 PLANE_BODY = 17
 PLANE_COLUMN = 3
-#: bodies above which the planar engine's work (on the stack) is not used
-PLANE_MAX_BODIES = 256
+#: bodies above which the planar engine is not used (a bound on its generated tables)
+PLANE_MAX_BODIES = 1024
 
 
 def _zero(x: se.Basic) -> bool:
@@ -111,6 +111,8 @@ def planar_units(system: System, accel_template: str) -> tuple[str, str, bool]:
     head = (f"#define JD_P {p}\n#define JD_F {f}\n#define JD_NC {max(len(col_coord), 1)}\n"
             f"#define JD_NL {len(exprs)}\n#define JD_COLS {p * PLANE_BODY}\n"
             f"#define JD_ABA {1 if aba else 0}\n"
+            # the work on the stack when small (64 kB, as the spatial engine's)
+            f"#define JD_PLANE_STACK {1 if 8 * (51 * p + 7 * len(col_coord)) <= 65536 else 0}\n"
             + c_table("jd_parent", list(lay.parent))
             + c_table("jd_col_start", col_start)
             + c_table("jd_col_coord", col_coord))
