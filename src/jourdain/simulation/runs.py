@@ -108,14 +108,14 @@ class _Sigint:
             signal.signal(signal.SIGINT, self.old)
 
 
-def _chunk(out: np.ndarray, o: int, cap: int, n: int, f: int, m: int
+def _chunk(out: np.ndarray, o: int, cap: int, n: int, f: int, m: int, copy: bool = True
            ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The ``m`` samples that a call wrote to ``out`` from ``o`` on (``cap`` times, ``cap``
-    states, ``cap`` derivatives of the state): views of t and x, a copy of ÿ only (half the
-    memory)."""
+    states, ``cap`` derivatives of the state): views of t and x, and of ÿ only, copied with
+    ``copy`` (half the memory of the derivatives kept)."""
     e = o + cap * (1 + n)
-    return (out[o:o + m], out[o + cap:o + cap + m * n].reshape(m, n),
-            out[e:e + m * n].reshape(m, n)[:, f:2 * f].copy())
+    ydd = out[e:e + m * n].reshape(m, n)[:, f:2 * f]
+    return out[o:o + m], out[o + cap:o + cap + m * n].reshape(m, n), ydd.copy() if copy else ydd
 
 
 def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray | None,
@@ -250,10 +250,7 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
     cnt = _COUNTERS.unpack_from(buf, 8 * o_int)  # type: ignore[arg-type]
     dx_out: np.ndarray | None
     if te is not None:
-        m = cnt[6]
-        e = o + cap * (1 + n)
-        t_out, x_out = out[o:o + m], out[o + cap:o + cap + m * n].reshape(m, n)
-        dx_out = out[e:e + m * n].reshape(m, n)[:, f:2 * f]
+        t_out, x_out, dx_out = _chunk(out, o, cap, n, f, cnt[6], copy=False)
     elif len(chunks) == 1 and len(chunks[0][0]):  # a run done in one call: t copied off
         t_out, x_out, dx_out = chunks[0][0].copy(), chunks[0][1], chunks[0][2]
     elif sum(len(c[0]) for c in chunks):
