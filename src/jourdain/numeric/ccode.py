@@ -179,6 +179,20 @@ def function_source(name: str, exprs: Sequence[se.Basic], names: Mapping[str, st
                               "finite double (an infinite or undefined constant)") from None
 
 
+def batch_source(name: str, size: str) -> str:
+    """C source of ``NAME_batch(n, f, y, yd, t, p, p_stride, u, u_stride, out)``: ``NAME`` at
+    ``n`` states one after the other, ``size`` (a C expression) outputs each."""
+    return f"""
+void {name}_batch(long n, long f, const double *y, const double *yd, const double *t,
+                  const double *p, long p_stride, const double *u, long u_stride,
+                  double *out) {{
+    for (long i = 0; i < n; ++i)
+        {name}(y + i * f, yd + i * f, t[i], p + i * p_stride, u + i * u_stride,
+               out + i * {size});
+}}
+"""
+
+
 def _function_source(name: str, exprs: Sequence[se.Basic], names: Mapping[str, str],
                      whole: bool = False, symmetric: int = 0) -> str:
     """C source of ``NAME(y, yd, t, p, u, out)`` and ``NAME_batch`` computing ``exprs``.
@@ -307,15 +321,7 @@ def _function_source(name: str, exprs: Sequence[se.Basic], names: Mapping[str, s
             lines.append(f"    out[{k}] = {code[r]};")
     args = ("const double *y, const double *yd, double t, const double *p,\n"
             "            const double *u, double *out")
-    batch = f"""
-void {name}_batch(long n, long f, const double *y, const double *yd, const double *t,
-                  const double *p, long p_stride, const double *u, long u_stride,
-                  double *out) {{
-    for (long i = 0; i < n; ++i)
-        {name}(y + i * f, yd + i * f, t[i], p + i * p_stride, u + i * u_stride,
-               out + i * {len(exprs)});
-}}
-"""
+    batch = batch_source(name, str(len(exprs)))
 
     def trig_block(indent: str, decl: str, s: str, c: str) -> str:
         """The arguments of the sin/cos pairs and the one call of jd_sincos_n ("" if none)."""

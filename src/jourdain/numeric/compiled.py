@@ -25,7 +25,7 @@ from .cachefile import dump_pickle, keep_sealed, load_pickle
 from .ccode import HEADER, argument_names, function_source
 from .cost import evaluation_path
 from .integrator_ldl import ldl_source  # the solve written out per f (H1)
-from .planar_recursion import planar_units
+from .planar_recursion import planar_units, plane_normal
 from .recursive import LDL_SOLVE, layout, recursive_units
 from .toolchain import (
     CompilerError,
@@ -328,6 +328,7 @@ def clear_cache(disk: bool = False) -> None:
     planar_function.cache_clear()
     evaluation_path.cache_clear()
     layout.cache_clear()
+    plane_normal.cache_clear()
     if disk:
         d = cache_dir()
         if d.is_dir():

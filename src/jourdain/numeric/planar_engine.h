@@ -30,7 +30,9 @@ static inline void jd_inertia_twist3(const double *I, const double *V, double *F
     F[2] = I[3] * V[2] + I[1] * V[0];
 }
 
-static void jd_plane_recursion(const double *L, const double *yd, jd_plane *W, int sums) {
+/* own_only (the articulated bodies): only Wc is summed over the sub-trees (for the power
+   ẏᵀq); the articulated-body pass reads each body's own I, B, Wr */
+static void jd_plane_recursion(const double *L, const double *yd, jd_plane *W, int own_only) {
     for (int i = 0; i < JD_P; ++i) {
         const double *b = L + i * JD_PB;
         const double cA = b[0], sA = b[1], *d = b + 2, *vb = b + 5, *ab = b + 8;
@@ -83,17 +85,18 @@ static void jd_plane_recursion(const double *L, const double *yd, jd_plane *W, i
         Wr[0] = ccx * fe[1] - ccy * fe[0] + le;
         I[0] = Izz + m * (ccx * ccx + ccy * ccy); I[1] = m * ccx; I[2] = m * ccy; I[3] = m;
     }
-    if (!sums) return;
-    for (int a = 0; a < 4 * JD_P; ++a) W->Ic[a] = W->I[a];
-    for (int a = 0; a < 3 * JD_P; ++a) { W->Bc[a] = W->B[a]; W->Wc[a] = W->Wr[a]; }
+    for (int a = 0; a < 3 * JD_P; ++a) W->Wc[a] = W->Wr[a];
+    if (!own_only) {
+        for (int a = 0; a < 4 * JD_P; ++a) W->Ic[a] = W->I[a];
+        for (int a = 0; a < 3 * JD_P; ++a) W->Bc[a] = W->B[a];
+    }
     for (int i = JD_P - 1; i >= 0; --i) {  /* composite bodies: children before parents */
         const int lam = jd_parent[i];
         if (lam < 0) continue;
+        for (int a = 0; a < 3; ++a) W->Wc[3 * lam + a] += W->Wc[3 * i + a];
+        if (own_only) continue;
         for (int a = 0; a < 4; ++a) W->Ic[4 * lam + a] += W->Ic[4 * i + a];
-        for (int a = 0; a < 3; ++a) {
-            W->Bc[3 * lam + a] += W->Bc[3 * i + a];
-            W->Wc[3 * lam + a] += W->Wc[3 * i + a];
-        }
+        for (int a = 0; a < 3; ++a) W->Bc[3 * lam + a] += W->Bc[3 * i + a];
     }
 }
 
@@ -137,19 +140,14 @@ void jd_fn(const double *y, const double *yd, double t, const double *p, const d
     if (!W) { for (long a = 0; a < JD_F * JD_F + 2 * JD_F; ++a) out[a] = NAN; return; }
 #endif
     jd_local(y, yd, t, p, u, L);
-    jd_plane_recursion(L, yd, W, 1);
+    jd_plane_recursion(L, yd, W, 0);
     jd_plane_project(W, out, out + JD_F * JD_F, out + JD_F * JD_F + JD_F);
 #if !JD_PLANE_STACK
     free(W);
 #endif
 }
 
-void jd_fn_batch(long n, long f, const double *y, const double *yd, const double *t,
-                 const double *p, long p_stride, const double *u, long u_stride, double *out) {
-    for (long i = 0; i < n; ++i)
-        jd_fn(y + i * f, yd + i * f, t[i], p + i * p_stride, u + i * u_stride,
-              out + i * (JD_F * JD_F + 2 * JD_F));
-}
+/* jd_fn_batch: ccode.batch_source, appended by planar_recursion.py */
 
 #if JD_ABA
 /* The articulated-body recursion (recursive_engine.h's jd_aba) in planar vectors: the

@@ -26,13 +26,14 @@ Floor: numeric (it reads the stages' joint motions, as :mod:`jourdain.numeric.re
 
 from __future__ import annotations
 
+from functools import lru_cache
 from importlib import resources
 from typing import TYPE_CHECKING
 
 import symengine as se
 
 from ..stages.kinematics import JointMotion, joint_motions
-from .ccode import HEADER, argument_names, function_source
+from .ccode import HEADER, argument_names, batch_source, function_source
 from .recursive import _disjoint, c_table, column_tables, layout
 
 if TYPE_CHECKING:
@@ -54,11 +55,13 @@ def _zero(x: se.Basic) -> bool:
 PLANES = {2: (0, 1), 0: (1, 2), 1: (2, 0)}
 
 
+@lru_cache(maxsize=32)
 def plane_normal(system: System) -> int | None:
     """The axis (0, 1, 2 for x, y, z) about which every joint of ``system`` turns its child and
     across which none moves it, by literal zeros and one in the joints' local expressions
     (see the module docstring), or None; z is tried first. Bodies' forces need not be planar
-    (those across the plane are carried by the joints)."""
+    (those across the plane are carried by the joints). Memoized per system: the cost model
+    and the planar engine's source both ask."""
     if not system.bodies or len(system.bodies) > PLANE_MAX_BODIES:
         return None
     motions = joint_motions(system)
@@ -118,7 +121,8 @@ def planar_units(system: System, accel_template: str) -> tuple[str, str, bool]:
             + c_table("jd_col_coord", col_coord))
     decl = ("void jd_local(const double *y, const double *yd, double t, const double *p,\n"
             "              const double *u, double *out);\n")
-    engine = head + ENGINE + ("" if aba else accel_template)
+    engine = (head + ENGINE + batch_source("jd_fn", "(JD_F * JD_F + 2 * JD_F)")
+              + ("" if aba else accel_template))
     return HEADER + local, HEADER + decl + engine, aba
 
 

@@ -46,7 +46,7 @@ import symengine as se
 from ..model.forces import Gravity
 from ..stages.kinematics import joint_motions, kinematics
 from ..stages.newton_euler import applied_forces
-from .ccode import HEADER, argument_names, function_source
+from .ccode import HEADER, argument_names, batch_source, function_source
 
 if TYPE_CHECKING:
     from ..model.system import System
@@ -193,7 +193,8 @@ def _parts(system: System, full: bool, directions: tuple | None) -> tuple[str, s
             + c_table("jd_col_start", col_start)
             + c_table("jd_col_coord", col_coord)
             + c_table("jd_dir_start", dir_start if lay.directions else [0]))
-    return local, head + ENGINE.replace("/* LDL_SOLVE */\n", LDL_SOLVE), aba
+    engine = ENGINE.replace("/* LDL_SOLVE */\n", LDL_SOLVE) + batch_source("jd_fn", "JD_SIZE")
+    return local, head + engine, aba
 
 
 #: ÿ = M⁻¹(q − k) by LDLᵀ for f = JD_F (the integrator's jd_accel of the symbolic code and the

@@ -285,11 +285,7 @@ void jd_fn(const double *y, const double *yd, double t, const double *p, const d
 #endif
 }
 
-void jd_fn_batch(long n, long f, const double *y, const double *yd, const double *t,
-                 const double *p, long p_stride, const double *u, long u_stride, double *out) {
-    for (long i = 0; i < n; ++i)
-        jd_fn(y + i * f, yd + i * f, t[i], p + i * p_stride, u + i * u_stride, out + i * JD_SIZE);
-}
+/* jd_fn_batch: ccode.batch_source, appended by recursive.py */
 
 #if !JD_ABA
 /* Joint wrenches for given ÿ (the sub-tree's Newton–Euler equations summed, as RNEA does):
