@@ -24,7 +24,6 @@ through const pointers, and the results copy what they keep), so runs in threads
 
 from __future__ import annotations
 
-import ctypes
 from collections.abc import Mapping, Sequence
 from functools import lru_cache
 from typing import TYPE_CHECKING, Any
@@ -48,7 +47,7 @@ class RunTemplate:
 
     Attributes
     ----------
-    setup : the C loop's problem (:class:`.problem._Setup`), ``problem_ref`` its pointer
+    setup : the C loop's problem (:class:`.problem._Setup`; ``setup.problem_ref`` its pointer)
     method, rtol : as checked; ``atol`` the 2f absolute tolerances (read-only)
     parameters : parameter values by name (each results object gets a copy)
     coordinate_names, input_names, units, name : the results' labels (copied likewise)
@@ -56,7 +55,7 @@ class RunTemplate:
     """
 
     __slots__ = ("atol", "coordinate_names", "input_names", "method", "name", "parameters",
-                 "problem_ref", "rtol", "setup", "u_row", "units")
+                 "rtol", "setup", "u_row", "units")
 
     def __init__(self, system: System, mkq: CompiledFunction, p: np.ndarray,
                  inputs: Mapping[str, Any] | None, events: Sequence[Event],
@@ -64,7 +63,6 @@ class RunTemplate:
                  first_step: float) -> None:
         self.setup = setup = _Setup(system, mkq, p, inputs, events, C_METHODS.get(method, 1),
                                     rtol, atol_x, max_step, first_step)
-        self.problem_ref = ctypes.byref(setup.problem)
         self.method, self.rtol = method, rtol
         self.atol = atol_x[:-1]
         self.parameters = dict(zip((k for k, _ in system.parameters), setup.p.tolist(),
