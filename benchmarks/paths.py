@@ -45,6 +45,8 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from benchmarks.per_state import interleaved  # noqa: E402 - the interleaved rounds, best of each
+
 LOOP = r"""
 typedef int (*jd_accel_t)(const double *, const double *, double, const double *,
                           const double *, double *, double *);
@@ -173,15 +175,13 @@ def mujoco_row(mjcf: str, Y: np.ndarray, YD: np.ndarray, rounds: int,
         data.qpos[:], data.qvel[:] = y, yd
         mujoco.mj_forward(model, data)
         diff = max(diff, float(np.abs(data.qacc[order] - a).max() / max(np.abs(a).max(), 1.0)))
-    best = {"call": math.inf, "floor": math.inf}
-    for _ in range(rounds):
-        for what in best:
-            t0 = time.perf_counter()
-            for y, yd in zip(Y, YD, strict=True):
-                data.qpos[:], data.qvel[:] = y, yd
-                if what == "call":
-                    mujoco.mj_forward(model, data)
-            best[what] = min(best[what], time.perf_counter() - t0)
+    def loop(call: bool) -> None:
+        for y, yd in zip(Y, YD, strict=True):
+            data.qpos[:], data.qvel[:] = y, yd
+            if call:
+                mujoco.mj_forward(model, data)
+
+    best = interleaved({"call": lambda: loop(True), "floor": lambda: loop(False)}, rounds)
     return {"mj_forward_us": best["call"] / len(Y) * 1e6,
             "mj_floor_us": best["floor"] / len(Y) * 1e6, "mj_agreement": diff}
 
@@ -200,16 +200,13 @@ def measure(name: str, make, lib: ctypes.CDLL, n_states: int, rounds: int,  # no
     p = parameter_vector(system, None)
     u = np.zeros(max(1, len(system.inputs)))
     out = {k: np.empty_like(Y) for k in fns}
-    best = dict.fromkeys(fns, math.inf)
-    for _ in range(rounds):
-        for k, fn in fns.items():
-            t0 = time.perf_counter()
-            bad = lib.jd_loop_accel(fn.accel_address, n_states, f, Y.ctypes.data,
-                                    YD.ctypes.data, p.ctypes.data, u.ctypes.data,
-                                    out[k].ctypes.data)
-            best[k] = min(best[k], time.perf_counter() - t0)
-            if bad:
-                raise RuntimeError(f"{name}: the {k} path failed at a random state ({bad})")
+    def run(k: str) -> None:
+        bad = lib.jd_loop_accel(fns[k].accel_address, n_states, f, Y.ctypes.data,
+                                YD.ctypes.data, p.ctypes.data, u.ctypes.data, out[k].ctypes.data)
+        if bad:
+            raise RuntimeError(f"{name}: the {k} path failed at a random state ({bad})")
+
+    best = interleaved({k: lambda k=k: run(k) for k in fns}, rounds)
     us = {k: v / n_states * 1e6 for k, v in best.items()}
     ref = out[min(us, key=us.get)]
     scale = max(float(np.abs(ref).max()), 1.0)  # relative to the largest entry, or absolute
