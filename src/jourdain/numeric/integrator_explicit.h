@@ -24,7 +24,7 @@ int jd_integrate(const jd_problem *P, double t_end, double *st, double *x, doubl
     long nu = P->nu > 0 ? P->nu : 1;
     /* M and its factor: none where the problem brings its own accel (the monodromy matrix's
        columns of analysis/floquet.py are 2f² coordinates, an f⁴ matrix never formed) */
-    long ff = P->accel ? 0 : f * f;
+    long ff = (P->accel || P->accel_ctx) ? 0 : f * f;
     double *mem = (double *)malloc(sizeof(double) *
         (2 * nu + ff + 2 * f + ff + n * (16 + 7 + 5) + 3 * (nev + 1)));
     if (!mem) return JD_ENOMEM;

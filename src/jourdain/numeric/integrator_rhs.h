@@ -10,6 +10,9 @@ typedef void (*jd_model)(const double *y, const double *yd, double t, const doub
 typedef int (*jd_input_cb)(double t, const double *y, const double *yd, double *u);
 typedef int (*jd_accel_fn)(const double *y, const double *yd, double t, const double *p,
                            const double *u, double *ydd, double *power);
+/* the same with a context (an interpreted model: numeric/interpreter.py) */
+typedef int (*jd_accel_ctx_fn)(const void *ctx, const double *y, const double *yd, double t,
+                               const double *p, const double *u, double *ydd, double *power);
 
 /* return codes */
 #define JD_DONE 0
@@ -40,6 +43,8 @@ typedef struct {
     const double *atol;    /* n = 2f + 1 */
     double h_max, h_first;
     jd_accel_fn accel;     /* the model's fused M, k, q and Cholesky solve, or NULL */
+    jd_accel_ctx_fn accel_ctx; /* or this one, called with ctx (accel NULL then) */
+    const void *ctx;
 } jd_problem;
 
 typedef struct {
@@ -101,8 +106,9 @@ static int rhs(jd_ctx *c, double t, const double *x, double *dx) {
         if (r == JD_ENAN) goto nan;
         if (r) { c->fail_t = t; memcpy(c->fail_x, x, c->n * sizeof(double)); return r; }
     }
-    if (P->accel) {
-        int r = P->accel(y, yd, t, P->p, c->u, dx + f, dx + 2 * f);
+    if (P->accel || P->accel_ctx) {
+        int r = P->accel ? P->accel(y, yd, t, P->p, c->u, dx + f, dx + 2 * f)
+                         : P->accel_ctx(P->ctx, y, yd, t, P->p, c->u, dx + f, dx + 2 * f);
         for (long i = 0; i < f; ++i) dx[i] = yd[i];
         if (r == 2) goto nan;
         if (r == 1) {

@@ -64,6 +64,7 @@ class _Problem(ctypes.Structure):
         ("tab_v", ctypes.c_void_p), ("ev_dir", ctypes.c_void_p), ("ev_term", ctypes.c_void_p),
         ("method", ctypes.c_int), ("rtol", ctypes.c_double), ("atol", ctypes.c_void_p),
         ("h_max", ctypes.c_double), ("h_first", ctypes.c_double), ("accel", ctypes.c_void_p),
+        ("accel_ctx", ctypes.c_void_p), ("ctx", ctypes.c_void_p),
     ]
 
 
