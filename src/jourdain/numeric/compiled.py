@@ -32,6 +32,7 @@ from .toolchain import (
     build,
     build_soon,
     cache_dir,
+    cached_library,
     compiler,
     content_key,
     library_dir,
@@ -248,7 +249,8 @@ def mkq_function(system: System) -> CompiledFunction:
         return dynamics_function(system)
     choice = evaluation_path(system)
     if choice.path == "symbolic" and choice.eom is not None:
-        return symbolic_mkq(system, choice.eom)
+        names, shapes, source, _ = _symbolic_parts(system)  # the source the first run read
+        return _load(system, names, shapes, source)
     if choice.path == "planar":
         return planar_function(system)
     return dynamics_function(system)
@@ -261,9 +263,78 @@ def symbolic_mkq(system: System, eom: EquationsOfMotion) -> CompiledFunction:
     every evaluation slower: n-link pendulum on a cart, n = 18, 1 481 nodes, 9.1 against 6.0
     ms per 10 s run), and ``jd_accel`` taking M's diagonal and upper triangle from
     ``jd_fn_upper`` (the solve reads no other entries; 1.5 % less time per run at n = 12)."""
-    return lambdify(system, {"M": eom.M, "k": eom.k, "q": eom.q},
-                    extra_source="#define JD_FN_M jd_fn_upper\n" + _accel_source(system.f),
-                    whole=True, symmetric=system.f)
+    names, shapes, source = _symbolic_source(system, eom)
+    return _load(system, names, shapes, source)
+
+
+def _symbolic_source(system: System, eom: EquationsOfMotion
+                     ) -> tuple[tuple[str, ...], tuple[tuple[int, int], ...], str]:
+    """The names, shapes and C source of :func:`symbolic_mkq`."""
+    f = system.f
+    cnames = argument_names(system.y, system.yd, system.t, system.parameter_symbols,
+                            system.inputs)
+    exprs = [*eom.M.entries(), *eom.k.entries(), *eom.q.entries()]
+    body = function_source("jd_fn", exprs, cnames, whole=True, symmetric=f)
+    source = HEADER + body + "#define JD_FN_M jd_fn_upper\n" + _accel_source(f)
+    return ("M", "k", "q"), ((f, f), (f, 1), (f, 1)), source
+
+
+@lru_cache(maxsize=32)
+def _symbolic_parts(system: System) -> tuple:
+    """:func:`_symbolic_source` of the path that :func:`evaluation_path` chose, with its
+    equations (None where it chose another path)."""
+    choice = evaluation_path(system)
+    if choice.path != "symbolic" or choice.eom is None:
+        return None  # type: ignore[return-value]
+    return (*_symbolic_source(system, choice.eom), choice.eom)
+
+
+@lru_cache(maxsize=32)
+def _run_function(system: System) -> CompiledFunction:
+    """:func:`mkq_function`, or where it takes the symbolic path and its library is neither
+    loaded nor cached nor prebuilt, the same source on the interpreter
+    (:class:`~jourdain.numeric.interpreter.FirstFunction`) while a thread compiles it."""
+    from .interpreter import FirstFunction, Interpreted, Unreadable, interpreter_library, program
+
+    _refuse_closed(system)
+    try:
+        compiler()
+    except CompilerError:
+        return mkq_function(system)
+    parts = _symbolic_parts(system) if FIRST_RUN_INTERPRETED else None
+    if not parts or not _accel_source(system.f):
+        return mkq_function(system)
+    names, shapes, source, _ = parts
+    key = content_key(_GENERATOR_VERSION, source)
+    if cached_library(key) is not None:
+        return mkq_function(system)
+    f = system.f
+    try:
+        prog = program(source, "jd_fn", f, len(system.parameters), len(system.inputs),
+                       f * f + 2 * f)
+        lib = interpreter_library()
+    except (Unreadable, CompilerError):
+        return mkq_function(system)
+    first = FirstFunction(names, shapes, arguments(system), key, f, len(system.parameters),
+                          len(system.inputs), lib,
+                          interp=Interpreted(prog, bool(ldl_source(f))))
+    build_soon(lambda: first.compiled.append(mkq_function(system)),
+               name="jourdain-model-build")
+    return first
+
+
+def run_function(system: System) -> CompiledFunction:
+    """What a simulation of ``system`` evaluates: :func:`mkq_function`, except on the first
+    run of a model whose symbolic code is not compiled yet, which is interpreted to the same
+    bits while a thread compiles it (:mod:`jourdain.numeric.interpreter`); once compiled, the
+    compiled function."""
+    fn = _run_function(system)
+    compiled = getattr(fn, "compiled", None)
+    return compiled[0] if compiled else fn
+
+
+#: the first run of a model interpreted while its library compiles (:func:`run_function`)
+FIRST_RUN_INTERPRETED = True
 
 
 @lru_cache(maxsize=32)
@@ -324,6 +395,8 @@ def clear_cache(disk: bool = False) -> None:
     on-disk cache of compiled libraries (:func:`cache_dir`)."""
     _eom_function.cache_clear()
     mkq_function.cache_clear()
+    _run_function.cache_clear()
+    _symbolic_parts.cache_clear()
     dynamics_function.cache_clear()
     planar_function.cache_clear()
     evaluation_path.cache_clear()

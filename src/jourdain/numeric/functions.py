@@ -67,6 +67,18 @@ class CompiledFunction:
             return None
 
     @property
+    def accel_ctx_address(self) -> int | None:
+        """The integrator's right-hand side with a context (``jd_problem.accel_ctx``): None
+        here; where the model is interpreted
+        (:class:`jourdain.numeric.interpreter.FirstFunction`), the interpreter's."""
+        return None
+
+    @property
+    def ctx_address(self) -> int | None:
+        """The context of :attr:`accel_ctx_address` (None here)."""
+        return None
+
+    @property
     def address(self) -> int:
         """Address of the C function ``void fn(y, yd, t, p, u, out)`` (for compiled loops)."""
         return ctypes.cast(getattr(self.lib, self.symbol), ctypes.c_void_p).value or 0

@@ -60,6 +60,11 @@ UNITS: tuple[tuple[str, tuple[str, ...], tuple[str, ...]], ...] = (
     ("", ("rk_tables.h", "integrator_rhs.h", "integrator_kernels.h", "integrator_output.h",
           "integrator_radau.h", "integrator_explicit.h"), ()),
     ("#define JD_KERNELS 1\n", ("integrator_kernels.h",), ("-O3",)),
+    # the interpreter of generated code, with the generated code's inline functions and its
+    # solve's loop (ldl_solve.h) taking the size as a parameter
+    ("#define JD_SOLVE_N_PARAM const long jd_n_,\n#define JD_F jd_n_\n"
+     "#define jd_solve_mkq jd_solve_loop\n",
+     ("jd_inline.h", "sincos.h", "ldl_solve.h", "interpreter.h"), ()),
 )
 
 _TABLE = re.compile(r"static const double (\w+)(?:\[\d+\])? = \{?([^};]*)\}?;")

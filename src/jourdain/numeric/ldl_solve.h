@@ -9,8 +9,13 @@
    operations and their order unchanged (no reassociation), so the results are too */
 __attribute__((optimize("unroll-loops")))
 #endif
-static int jd_solve_mkq(const double *M, const double *k, const double *q, double *ydd,
-                        double *L /* f×f work */) {
+/* JD_SOLVE_N_PARAM: empty for the generated code (JD_F a constant); the interpreter
+   (interpreter.h) defines it as a size parameter and JD_F as that parameter */
+#ifndef JD_SOLVE_N_PARAM
+#define JD_SOLVE_N_PARAM
+#endif
+static int jd_solve_mkq(JD_SOLVE_N_PARAM const double *M, const double *k, const double *q,
+                        double *ydd, double *L /* f×f work */) {
     double D[JD_F], Dinv[JD_F], E[JD_F], dmax = 0.0;
     for (int i = 0; i < JD_F; ++i) { ydd[i] = q[i] - k[i]; dmax = fmax(dmax, fabs(M[i * JD_F + i])); }
     for (int j = 0; j < JD_F; ++j) {

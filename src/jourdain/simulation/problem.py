@@ -324,7 +324,8 @@ class _Setup:
             self.ev_fn.address if self.ev_fn else None,
             ctypes.cast(self._cb, ctypes.c_void_p).value if self._cb else None,
             d[0], d[1], a32, address(self.tab_off), d[2], d[3], i_dir, i_dir + w * m_ev, method,
-            float(rtol), d[4], float(max_step), float(first_step), mkq.accel_address)
+            float(rtol), d[4], float(max_step), float(first_step), mkq.accel_address,
+            mkq.accel_ctx_address, mkq.ctx_address)
         self.problem_ref = ctypes.byref(self.problem)  # the C loop's argument, made once
 
     def _callback(self, t: float, y: Any, yd: Any, u: Any) -> int:

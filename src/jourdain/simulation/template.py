@@ -30,7 +30,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..numeric import CompiledFunction, mkq_function, parameter_vector
+from ..numeric import CompiledFunction, parameter_vector
+from ..numeric.compiled import run_function
 from ..units import model_units
 from .options import C_METHODS
 from .problem import Event, _Setup
@@ -92,7 +93,7 @@ def run_template(system: System, parameters: Mapping[str, float] | None,
                  inputs: Mapping[str, Any] | None, events: Sequence[Event],
                  method: str, rtol: float, atol_x: np.ndarray, max_step: float,
                  first_step: float) -> RunTemplate:
-    """The template of a run of ``system``'s compiled M, k, q (:func:`mkq_function`), from
+    """The template of a run of ``system``'s compiled M, k, q (:func:`run_function`), from
     the memo where the run has numbers as inputs and no events (see the module docs). Checked
     in this order, as before the memo: the parameters (unknown names, values that are not
     finite or not physical), the model compiled, then the inputs and events
@@ -100,7 +101,7 @@ def run_template(system: System, parameters: Mapping[str, float] | None,
     inputs_key = _number_inputs(inputs)
     fresh = bool(events) or inputs_key is None
     p = parameter_vector(system, parameters) if parameters or fresh else None
-    mkq = mkq_function(system)
+    mkq = run_function(system)
     if fresh:
         return RunTemplate(system, mkq, parameter_vector(system, None) if p is None else p,
                            inputs, events, method, rtol, atol_x, max_step, first_step)

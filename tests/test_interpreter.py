@@ -1,0 +1,255 @@
+"""The first run interpreted while the model compiles (numeric/interpreter.py): the interpreter
+reads the generated C and must give the compiled library's numbers to the bit (M, k, q, ÿ, the
+solve's failures, whole motions), switch to the library once built, and give up (the caller
+then compiles) on what it cannot read exactly."""
+
+from __future__ import annotations
+
+import ctypes
+import time
+
+import numpy as np
+import pytest
+import symengine as se
+
+import jourdain as jd
+from jourdain.models import n_link_pendulum_on_cart, spatial_chain
+from jourdain.numeric import compiled, parameter_vector
+from jourdain.numeric.ccode import HEADER, argument_names, function_source
+from jourdain.numeric.interpreter import (
+    FirstFunction,
+    Interpreted,
+    Unreadable,
+    interpreter_library,
+    program,
+)
+from jourdain.numeric.toolchain import build, content_key
+
+
+@pytest.fixture
+def fresh_cache(tmp_path, monkeypatch):
+    """An empty library cache (the prebuilt integrator still found), nothing memoized."""
+    monkeypatch.setenv("JOURDAIN_CACHE", str(tmp_path))
+    compiled.clear_cache()
+    yield tmp_path
+    compiled.clear_cache()
+
+
+def _wait(fn: FirstFunction, limit: float = 300.0) -> None:
+    t0 = time.monotonic()
+    while not fn.compiled and time.monotonic() - t0 < limit:
+        time.sleep(0.02)
+    assert fn.compiled, "the model's library was not built in the background"
+
+
+def _states(f: int, n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    rng = np.random.default_rng(seed)
+    return rng.uniform(-3, 3, (n, f)), rng.uniform(-5, 5, (n, f))
+
+
+@pytest.mark.parametrize("model", [n_link_pendulum_on_cart(1), n_link_pendulum_on_cart(4),
+                                   n_link_pendulum_on_cart(11), spatial_chain(2)],
+                         ids=["cart1", "cart4", "cart11", "chain2"])
+def test_first_run_is_the_compiled_run_to_the_bit(fresh_cache, model):
+    """f = 2 and 5 (the written-out solve), 12 (the solve's loop) and a spatial chain: the
+    interpreted first run and the compiled run after it agree to the bit, in the motion, in
+    ÿ and in M, k, q at random states."""
+    first = compiled.run_function(model)
+    assert isinstance(first, FirstFunction)
+    f = model.f
+    y0, yd0 = np.linspace(0.1, 0.5, f), np.linspace(-0.3, 0.2, f)
+    inputs = {u: 0.25 for u in model.input_names}
+    r1 = model.simulate((0.0, 1.5), y0, yd0, inputs=inputs)
+    _wait(first)
+    final = compiled.run_function(model)
+    assert final is first.compiled[0] and not isinstance(final, FirstFunction)
+    r2 = model.simulate((0.0, 1.5), y0, yd0, inputs=inputs)
+    assert r1.t.size > 20
+    for a, b in ((r1.t, r2.t), (r1.y, r2.y), (r1.yd, r2.yd), (r1.ydd, r2.ydd)):
+        assert np.array_equal(a, b)
+    Y, YD = _states(f, 50, 3)
+    p, u = parameter_vector(model, None), np.full(len(model.inputs), 0.7)
+    a, b = first.batch(Y, YD, 0.4, p, u), final.batch(Y, YD, 0.4, p, u)
+    assert all(np.array_equal(a[k], b[k]) for k in ("M", "k", "q"))
+    # M symmetric, as the compiled jd_fn writes it (the mirrors copied)
+    assert np.array_equal(a["M"], np.swapaxes(a["M"], 1, 2))
+
+
+def _accel(fn, model, y, yd, u):
+    """ÿ, the power and the status of the integrator's right-hand side of ``fn``."""
+    f = model.f
+    ydd, power = np.empty(f), np.empty(1)
+    p = parameter_vector(model, None)
+    args = (y.ctypes.data, yd.ctypes.data, ctypes.c_double(0.2), p.ctypes.data,
+            u.ctypes.data, ydd.ctypes.data, power.ctypes.data)
+    if fn.ctx_address is not None:
+        proto = ctypes.CFUNCTYPE(ctypes.c_int, *([ctypes.c_void_p] * 3), ctypes.c_double,
+                                 *([ctypes.c_void_p] * 4))
+        status = proto(fn.accel_ctx_address)(fn.ctx_address, *args)
+    else:
+        proto = ctypes.CFUNCTYPE(ctypes.c_int, *([ctypes.c_void_p] * 2), ctypes.c_double,
+                                 *([ctypes.c_void_p] * 4))
+        status = proto(fn.accel_address)(*args)
+    return ydd, power[0], status
+
+
+@pytest.mark.parametrize("n", [3, 10])
+def test_right_hand_side_and_its_failures_to_the_bit(fresh_cache, n):
+    """The integrator's ÿ and power at random states, and the solve's verdicts: 1 where M is
+    not positive definite (a negative mass), 2 where a state is NaN, as the compiled one."""
+    model = n_link_pendulum_on_cart(n)
+    first = compiled.run_function(model)
+    final = compiled.mkq_function(model)
+    assert isinstance(first, FirstFunction) and not isinstance(final, FirstFunction)
+    Y, YD = _states(model.f, 40, 7)
+    u = np.array([0.3])
+    for y, yd in zip(Y, YD, strict=True):
+        a, b = _accel(first, model, y, yd, u), _accel(final, model, y, yd, u)
+        assert a[2] == b[2] == 0
+        assert np.array_equal(a[0], b[0]) and a[1] == b[1]
+    y = Y[0].copy()
+    y[1] = np.nan
+    assert _accel(first, model, y, YD[0], u)[2] == _accel(final, model, y, YD[0], u)[2] == 2
+
+
+def test_a_non_physical_mass_matrix_fails_alike(fresh_cache):
+    """A negative link mass: M is not positive definite; both say 1, or both give the same ÿ."""
+    model = n_link_pendulum_on_cart(4)
+    first = compiled.run_function(model)
+    final = compiled.mkq_function(model)
+    Y, YD = _states(model.f, 30, 11)
+    names = [k for k, _ in model.parameters]
+    p = parameter_vector(model, None)
+    p[names.index(next(k for k in names if k.startswith("m")))] = -5.0
+    u = np.array([0.0])
+    verdicts = set()
+    for y, yd in zip(Y, YD, strict=True):
+        out = []
+        for fn in (first, final):
+            ydd, power = np.empty(model.f), np.empty(1)
+            args = (y.ctypes.data, yd.ctypes.data, ctypes.c_double(0.0), p.ctypes.data,
+                    u.ctypes.data, ydd.ctypes.data, power.ctypes.data)
+            if fn.ctx_address is not None:
+                st = ctypes.CFUNCTYPE(ctypes.c_int, *([ctypes.c_void_p] * 3), ctypes.c_double,
+                                      *([ctypes.c_void_p] * 4))(fn.accel_ctx_address)(
+                    fn.ctx_address, *args)
+            else:
+                st = ctypes.CFUNCTYPE(ctypes.c_int, *([ctypes.c_void_p] * 2), ctypes.c_double,
+                                      *([ctypes.c_void_p] * 4))(fn.accel_address)(*args)
+            out.append((st, ydd.tobytes() if st == 0 else b""))
+        assert out[0] == out[1]
+        verdicts.add(out[0][0])
+    assert 1 in verdicts
+
+
+def _compiled_and_interpreted(exprs, syms, n_sym):
+    """``exprs`` (the first n_sym² a symmetric matrix) as the generated jd_fn, compiled and
+    read by the interpreter."""
+    y, yd, t, p, u = syms
+    names = argument_names(y, yd, t, p, u)
+    body = function_source("jd_fn", exprs, names, whole=True, symmetric=n_sym)
+    source = HEADER + body
+    lib = build(content_key("interpreter-test", source), source)
+    lib.jd_fn.argtypes = [ctypes.c_void_p] * 2 + [ctypes.c_double] + [ctypes.c_void_p] * 3
+    prog = program(source, "jd_fn", len(y), len(p), len(u), len(exprs))
+    return lib, Interpreted(prog, True)
+
+
+def test_every_construct_of_the_generated_code_to_the_bit(fresh_cache):
+    """Functions, powers, signs, quotients, sums of angles, negative and rational constants,
+    repeated outputs: jd_fn compiled and interpreted at random arguments, bit for bit."""
+    y = se.symbols("q0 q1 q2")
+    yd = se.symbols("w0 w1 w2")
+    t = se.Symbol("t")
+    p = se.symbols("a b")
+    u = (se.Symbol("F"),)
+    a, b = p
+    q0, q1, q2 = y
+    m01 = a * se.cos(q0 - q1) + se.Rational(3, 7) * b
+    exprs = [a + b * se.sin(q0) ** 2, m01, m01, se.sqrt(a) * se.cos(q0 + q1 - q2) + 2,
+             se.exp(yd[0] * t) - se.log(a) / b, se.atan2(q1, q2) * se.Abs(yd[1]) ** se.Rational(3, 2),
+             (q0 ** -3) * se.sign(yd[2]) - 2.5 * q1 ** 5 + 1 / se.sqrt(b + q2 ** 2),
+             se.Max(q0, q1, yd[0]) * se.Min(u[0], t) + se.tanh(q2) * se.atan(q1) * -1,
+             se.floor(q0) + se.ceiling(yd[1]) + se.erf(q2) + se.sinh(q0) * se.cosh(q1) + se.tan(q2)
+             + se.asin(se.sin(q1) / 2) + se.acos(se.cos(q2) / 3) + se.asinh(q0)
+             + se.acosh(2 + q1 ** 2) + se.atanh(se.tanh(q0) / 2) + se.sin(2 * q0) * se.cos(q1 / 3),
+             -q0 * q1 * yd[2], se.Integer(0), se.Float(-0.0) + q2, se.sin(q0 - q1 - q2) ** 7]
+    lib, interp = _compiled_and_interpreted(exprs, (y, yd, t, p, u), 2)
+    il = interpreter_library()
+    rng = np.random.default_rng(5)
+    for _ in range(200):
+        Y, YD = rng.uniform(-2, 2, 3), rng.uniform(-2, 2, 3)
+        P, U = rng.uniform(0.1, 3, 2), rng.uniform(-1, 1, 1)
+        tt = float(rng.uniform(0, 2))
+        ref, got = np.empty(len(exprs)), np.empty(len(exprs))
+        args = (Y.ctypes.data, YD.ctypes.data, ctypes.c_double(tt), P.ctypes.data,
+                U.ctypes.data)
+        lib.jd_fn(*args, ref.ctypes.data)
+        il.jd_interp_fn(interp.address, *args, got.ctypes.data)
+        assert ref.tobytes() == got.tobytes()
+
+
+@pytest.mark.parametrize("source, why", [
+    ("static void jd_fn_upper(a) {\n    out[0] = sin(1.0);\n}\n\nvoid jd_fn(a) {\n}\n",
+     "sin of a constant"),
+    ("static void jd_fn_upper(a) {\n    out[0] = y[0] % 2.0;\n}\n\nvoid jd_fn(a) {\n}\n",
+     "unknown characters"),
+    ("static void jd_fn_upper(a) {\n    for (;;) x = 1;\n}\n\nvoid jd_fn(a) {\n}\n",
+     "unknown statement"),
+    ("static void jd_fn_upper(a) {\n    out[0] = y[7];\n}\n\nvoid jd_fn(a) {\n}\n",
+     "out of range"),
+    ("static void jd_fn_upper(a) {\n    out[0] = hypot(y[0], y[1]);\n}\n\nvoid jd_fn(a) {\n}\n",
+     "unknown function"),
+])
+def test_what_the_reader_cannot_read_exactly_it_refuses(source, why):
+    with pytest.raises(Unreadable, match=why):
+        program(source, "jd_fn", 2, 0, 0, 1)
+
+
+def test_c_precedence_and_folding():
+    """``(-a*b)`` is (−a)·b, ``a - b*c`` is a − (b·c), ``(3.0/7.0)`` the exact quotient,
+    ``-0.0`` and ``0.0`` two constants."""
+    src = ("static void jd_fn_upper(a) {\n"
+           "    const double x0 = (-y[0]*y[1]);\n"
+           "    out[0] = x0 - y[0]*y[1] + (3.0/7.0);\n"
+           "    out[1] = -0.0;\n    out[2] = 0.0;\n    out[3] = jd_powi(y[1], -3);\n"
+           "}\n\nvoid jd_fn(a) {\n    jd_fn_upper(y, yd, t, p, u, out);\n}\n")
+    prog = program(src, "jd_fn", 2, 0, 0, 4)
+    interp = Interpreted(prog, True)
+    il = interpreter_library()
+    y, z = np.array([0.1, 0.7]), np.zeros(2)
+    out = np.empty(4)
+    il.jd_interp_fn(interp.address, y.ctypes.data, z.ctypes.data, ctypes.c_double(0.0),
+                    z.ctypes.data, z.ctypes.data, out.ctypes.data)
+    assert out[0] == (-0.1) * 0.7 - 0.1 * 0.7 + 3.0 / 7.0
+    assert np.signbit(out[1]) and not np.signbit(out[2])
+    assert out[3] == 1.0 / (0.7 * (0.7 * 0.7))  # jd_powi's square-and-multiply
+
+
+def test_an_unreadable_model_waits_for_the_compiler(fresh_cache, monkeypatch):
+    """Where the reader gives up, the first run takes the compiled library, as before."""
+    import jourdain.numeric.interpreter as interpreter
+
+    def refuse(*args, **kwargs):
+        raise Unreadable("refused for the test")
+
+    monkeypatch.setattr(interpreter, "program", refuse)
+    model = n_link_pendulum_on_cart(2)
+    fn = compiled.run_function(model)
+    assert not isinstance(fn, FirstFunction) and fn is compiled.mkq_function(model)
+
+
+def test_a_cached_library_is_taken_at_once(fresh_cache):
+    """With the library in the cache (another process built it), no interpreter."""
+    model = n_link_pendulum_on_cart(3)
+    compiled.mkq_function(model)
+    compiled.clear_cache()
+    assert not isinstance(compiled.run_function(model), FirstFunction)
+
+
+def test_recursion_paths_are_compiled_as_before(fresh_cache):
+    """The interpreter reads the symbolic path's code; a model on the recursion waits for its
+    library (and its numbers are the library's)."""
+    model = jd.models.planar_chain(40)
+    fn = compiled.run_function(model)
+    assert not isinstance(fn, FirstFunction)
