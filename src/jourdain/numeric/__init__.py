@@ -16,8 +16,9 @@ compiler, evaluation falls back to SymEngine's ``Lambdify`` (:class:`Interpreted
 
 
 from .compiled import (
-    ACCEL_MAX_F,
-    ACCEL_TEMPLATE,
+    _eom_function as _eom_function,
+)
+from .compiled import (
     arguments,
     build_eom_soon,
     clear_cache,
@@ -26,13 +27,11 @@ from .compiled import (
     mkq_function,
     planar_function,
 )
-from .compiled import (
-    _eom_function as _eom_function,
-)
 from .cost import SYMBOLIC_MAX_F, PathChoice, evaluation_path
 from .functions import CompiledFunction, InterpretedFunction
 from .state import _vector as _vector
 from .state import evaluate, parameter_vector, state_vectors, time_value
+from .symbolic_accel import ACCEL_MAX_F, ACCEL_TEMPLATE
 from .toolchain import CompilerError, cache_dir
 
 __all__ = ["ACCEL_MAX_F", "ACCEL_TEMPLATE", "SYMBOLIC_MAX_F", "time_value",

@@ -26,7 +26,8 @@ from .ccode import HEADER, argument_names, function_source
 from .cost import evaluation_path
 from .integrator_ldl import ldl_source  # the solve written out per f (H1)
 from .planar_recursion import planar_units, plane_normal
-from .recursive import LDL_SOLVE, layout, recursive_units
+from .recursive import layout, recursive_units
+from .symbolic_accel import accel_source, symbolic_source
 from .toolchain import (
     CompilerError,
     build,
@@ -191,7 +192,7 @@ def _recursive(system: System, full: bool, extra_source: str = "",
             mats["Q_bar"] = reactions(eom.newton_euler).Q_bar
         return lambdify(system, mats, extra_source)
     units = recursive_units(system, full, directions, extra_source,
-                            _accel_source(f) if accel else None)
+                            accel_source(f) if accel else None)
     return _load(system, names, shapes, units, n_bodies=p, unit_flags=((), ENGINE_FLAGS))
 
 
@@ -229,8 +230,6 @@ def build_eom_soon(system: System) -> None:
 #: time: a 60-hinge tree 11.3 -> 9.6 µs, the build +0.03 s against +0.2 s at -O3); neither
 #: reorders arithmetic, so the numbers are those of -O2
 ENGINE_FLAGS = ("-fpeel-loops", "-funswitch-loops")
-#: largest f for which the integrator's jd_accel is compiled (its work arrays live on the stack)
-ACCEL_MAX_F = 128
 
 
 @lru_cache(maxsize=32)
@@ -263,20 +262,8 @@ def symbolic_mkq(system: System, eom: EquationsOfMotion) -> CompiledFunction:
     every evaluation slower: n-link pendulum on a cart, n = 18, 1 481 nodes, 9.1 against 6.0
     ms per 10 s run), and ``jd_accel`` taking M's diagonal and upper triangle from
     ``jd_fn_upper`` (the solve reads no other entries; 1.5 % less time per run at n = 12)."""
-    names, shapes, source = _symbolic_source(system, eom)
+    names, shapes, source = symbolic_source(system, eom)
     return _load(system, names, shapes, source)
-
-
-def _symbolic_source(system: System, eom: EquationsOfMotion
-                     ) -> tuple[tuple[str, ...], tuple[tuple[int, int], ...], str]:
-    """The names, shapes and C source of :func:`symbolic_mkq`."""
-    f = system.f
-    cnames = argument_names(system.y, system.yd, system.t, system.parameter_symbols,
-                            system.inputs)
-    exprs = [*eom.M.entries(), *eom.k.entries(), *eom.q.entries()]
-    body = function_source("jd_fn", exprs, cnames, whole=True, symmetric=f)
-    source = HEADER + body + "#define JD_FN_M jd_fn_upper\n" + _accel_source(f)
-    return ("M", "k", "q"), ((f, f), (f, 1), (f, 1)), source
 
 
 @lru_cache(maxsize=32)
@@ -286,7 +273,7 @@ def _symbolic_parts(system: System) -> tuple:
     choice = evaluation_path(system)
     if choice.path != "symbolic" or choice.eom is None:
         return None  # type: ignore[return-value]
-    return (*_symbolic_source(system, choice.eom), choice.eom)
+    return (*symbolic_source(system, choice.eom), choice.eom)
 
 
 @lru_cache(maxsize=32)
@@ -302,7 +289,7 @@ def _run_function(system: System) -> CompiledFunction:
     except CompilerError:
         return mkq_function(system)
     parts = _symbolic_parts(system) if FIRST_RUN_INTERPRETED else None
-    if not parts or not _accel_source(system.f):
+    if not parts or not accel_source(system.f):
         return mkq_function(system)
     names, shapes, source, _ = parts
     key = content_key(_GENERATOR_VERSION, source)
@@ -354,40 +341,9 @@ def planar_function(system: System) -> CompiledFunction:
     :func:`~jourdain.numeric.planar_recursion.is_planar`), memoized per system."""
     _refuse_closed(system)
     f = system.f
-    local, engine, _ = planar_units(system, _accel_source(f))
+    local, engine, _ = planar_units(system, accel_source(f))
     return _load(system, ("M", "k", "q"), ((f, f), (f, 1), (f, 1)), (local, engine),
                  unit_flags=((), ENGINE_FLAGS))
-
-
-def _accel_source(f: int) -> str:
-    """The integrator's ``jd_accel`` by LDLᵀ of M for ``f`` coordinates ("" above ACCEL_MAX_F:
-    its work arrays live on the stack)."""
-    # ldl_source: the solve written out for small f (integrator_ldl), else LDL_SOLVE's loop
-    return (ldl_source(f) + ACCEL_TEMPLATE.replace("JD_F_VALUE", str(f))
-            if f <= ACCEL_MAX_F else "")
-
-
-# ÿ = M⁻¹(q − k) with the size known to the compiler, which unrolls the small loops and
-# inlines jd_fn; returns 0, 1 (M not positive definite) or 2 (NaN or inf)
-ACCEL_TEMPLATE = r"""
-#ifndef JD_F
-#define JD_F JD_F_VALUE
-#endif
-#ifndef JD_FN_M
-#define JD_FN_M jd_fn
-#endif
-""" + LDL_SOLVE + r"""
-int jd_accel(const double *y, const double *yd, double t, const double *p, const double *u,
-             double *ydd, double *power) {
-    double buf[JD_F * JD_F + 2 * JD_F], L[JD_F * JD_F];
-    JD_FN_M(y, yd, t, p, u, buf);  /* M's upper triangle (and diagonal), k, q */
-    const double *M = buf, *k = buf + JD_F * JD_F, *q = k + JD_F;
-    double w = 0.0;
-    for (int i = 0; i < JD_F; ++i) w += yd[i] * q[i];
-    *power = w;
-    return jd_solve_mkq(M, k, q, ydd, L);
-}
-"""
 
 
 def clear_cache(disk: bool = False) -> None:
