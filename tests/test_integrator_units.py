@@ -42,8 +42,9 @@ def test_each_unit_is_compiled_with_its_own_flags(fresh_cache):
 def test_the_units_follow_their_table():
     """The kernels' unit defines JD_KERNELS (the definitions) and is the one at -O3; the step
     loops' unit declares the kernels and holds the entry points."""
-    (main, main_flags), (kernels, kernel_flags) = integrator_c.units()
-    assert main_flags == () and kernel_flags == ("-O3",)
+    (main, main_flags), (kernels, kernel_flags), (interp, interp_flags) = integrator_c.units()
+    assert main_flags == () and kernel_flags == ("-O3",) and interp_flags == ()
+    assert "int jd_interp_accel(" in interp and "int jd_interp_accel(" not in main
     assert kernels.startswith("#define JD_KERNELS 1") and "JD_KERNELS 1" not in main
     assert "int jd_integrate(" in main and "int jd_integrate(" not in kernels
     assert "void stage_sum(" in main and "void stage_sum(" in kernels  # declared; defined
@@ -66,8 +67,9 @@ def test_two_units_give_the_numbers_of_one_unit_bit_for_bit(fresh_cache, monkeyp
     called across units) must give the same trajectories and evaluation counts to the last
     bit for the explicit methods and Radau IIA: vectorizing reorders no sum."""
     two = _runs()
-    (main, _), _ = integrator_c.units()
-    monkeypatch.setattr(integrator_c, "units", lambda: (("#define JD_KERNELS 1\n" + main, ()),))
+    (main, _), _, interp = integrator_c.units()
+    monkeypatch.setattr(integrator_c, "units",
+                        lambda: (("#define JD_KERNELS 1\n" + main, ()), interp))
     problem.integrator_library.cache_clear()
     one = _runs()
     for (y2, yd2, n2), (y1, yd1, n1) in zip(two, one, strict=True):

@@ -14,7 +14,7 @@ import symengine as se
 
 import jourdain as jd
 from jourdain.models import n_link_pendulum_on_cart, spatial_chain
-from jourdain.numeric import compiled, parameter_vector
+from jourdain.numeric import compiled, parameter_vector, toolchain
 from jourdain.numeric.ccode import HEADER, argument_names, function_source
 from jourdain.numeric.interpreter import (
     FirstFunction,
@@ -30,6 +30,7 @@ from jourdain.numeric.toolchain import build, content_key
 def fresh_cache(tmp_path, monkeypatch):
     """An empty library cache (the prebuilt integrator still found), nothing memoized."""
     monkeypatch.setenv("JOURDAIN_CACHE", str(tmp_path))
+    monkeypatch.setattr(toolchain, "_loaded", {})  # libraries loaded by earlier tests
     compiled.clear_cache()
     yield tmp_path
     compiled.clear_cache()
@@ -253,3 +254,35 @@ def test_recursion_paths_are_compiled_as_before(fresh_cache):
     model = jd.models.planar_chain(40)
     fn = compiled.run_function(model)
     assert not isinstance(fn, FirstFunction)
+
+
+def test_a_child_forked_during_the_build_compiles_for_itself(fresh_cache):
+    """The thread that builds is not in a forked child: there run_function takes the compiled
+    library (built by the child or found on disk) and gives the first run's numbers."""
+    import os
+    import warnings
+
+    model = n_link_pendulum_on_cart(2)
+    first = compiled.run_function(model)
+    assert isinstance(first, FirstFunction)
+    y0, yd0 = np.array([0.0, 0.4, -0.2]), np.zeros(3)
+    ref = model.simulate((0.0, 1.0), y0, yd0, inputs={"F": 0.0}).y[-1]
+    read, write = os.pipe()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)  # fork with a thread running
+        pid = os.fork()
+    if pid == 0:  # the child: one line, then out without the parent's handlers
+        code = 1
+        try:
+            fn = compiled.run_function(model)
+            y = model.simulate((0.0, 1.0), y0, yd0, inputs={"F": 0.0}).y[-1]
+            ok = not isinstance(fn, FirstFunction) and y.tobytes() == ref.tobytes()
+            os.write(write, b"ok" if ok else b"bad")
+            code = 0
+        finally:
+            os._exit(code)
+    os.close(write)
+    answer = os.read(read, 16)
+    os.close(read)
+    _, status = os.waitpid(pid, 0)
+    assert answer == b"ok" and os.waitstatus_to_exitcode(status) == 0

@@ -6,6 +6,7 @@ its ``jd_accel``, memoized per system (:func:`clear_cache`).
 from __future__ import annotations
 
 import ctypes
+import os
 import shutil
 import warnings
 from collections.abc import Mapping
@@ -317,7 +318,14 @@ def run_function(system: System) -> CompiledFunction:
     compiled function."""
     fn = _run_function(system)
     compiled = getattr(fn, "compiled", None)
-    return compiled[0] if compiled else fn
+    if compiled:
+        return compiled[0]
+    if compiled is not None and getattr(fn, "pid", None) != os.getpid():
+        # a child forked while the build ran: the thread is not in it; it compiles (or loads
+        # what the parent built) for itself
+        compiled.append(mkq_function(system))
+        return compiled[0]
+    return fn
 
 
 #: the first run of a model interpreted while its library compiles (:func:`run_function`)

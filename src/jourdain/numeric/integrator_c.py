@@ -42,8 +42,10 @@ integrators and closed-form motions (tests/test_simulate.py).
 
 from __future__ import annotations
 
+import ctypes
 import re
 from fractions import Fraction
+from functools import lru_cache
 from importlib import resources
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -135,7 +137,27 @@ def library_source() -> tuple[str, list[str], list[tuple[str, ...]]]:
 
 def prebuild(dest: Path) -> Path:
     """Compile the library into ``dest`` at install time (``setup.py``): found there by
-    :func:`jourdain.simulation.problem.integrator_library` on a machine's first run, as long as
+    :func:`integrator_library` on a machine's first run, as long as
     its key matches (:func:`jourdain.numeric.toolchain.prebuild`)."""
     key, texts, flags = library_source()
     return toolchain.prebuild(dest, key, texts, flags)
+
+
+@lru_cache(maxsize=1)
+def integrator_library() -> ctypes.CDLL:
+    """The compiled integrator (built once, cached on disk like the model code, or prebuilt):
+    its translation units (:data:`UNITS`: the step loops at -O2, the kernels at -O3, the
+    interpreter of generated code), its entry points typed."""
+    key, texts, flags = library_source()
+    lib = toolchain.build(key, texts, unit_flags=flags)
+    vp, lg, db = ctypes.c_void_p, ctypes.c_long, ctypes.c_double
+    lib.jd_integrate.restype = ctypes.c_int
+    lib.jd_integrate.argtypes = [vp, db, vp, vp, vp, vp, vp, vp, lg, vp, vp, vp, vp, lg, vp, vp,
+                                 vp, vp, lg, vp, lg, vp]
+    lib.jd_rhs.restype = ctypes.c_int
+    lib.jd_rhs.argtypes = [vp, db, vp, vp, vp]
+    lib.jd_interp_fn.restype = None
+    lib.jd_interp_fn.argtypes = [vp, vp, vp, db, vp, vp, vp]
+    lib.jd_interp_batch.restype = None
+    lib.jd_interp_batch.argtypes = [vp, lg, lg, vp, vp, vp, vp, lg, vp, lg, vp]
+    return lib

@@ -22,14 +22,15 @@ call after the build, runs take the compiled library (:func:`jourdain.numeric.co
 from __future__ import annotations
 
 import ctypes
+import os
 import re
 import struct
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 
 from .functions import CompiledFunction
+from .integrator_c import integrator_library
 
 #: operation codes (interpreter.h's JI_* in order)
 (ADD, SUB, MUL, DIV, NEG, SQ, CUBE, POWI, SQRT, FN1, ATAN2, POW, FMAX, FMIN, SINCOS, STORE,
@@ -332,17 +333,9 @@ class Interpreted:
         self.address = ctypes.addressof(self.struct)
 
 
-def interpreter_library() -> Any:
-    """The integrator's library (which holds the interpreter), its functions typed."""
-    from ..simulation.problem import integrator_library
-
-    lib = integrator_library()
-    vp, lg, db = ctypes.c_void_p, ctypes.c_long, ctypes.c_double
-    lib.jd_interp_fn.restype = None
-    lib.jd_interp_fn.argtypes = [vp, vp, vp, db, vp, vp, vp]
-    lib.jd_interp_batch.restype = None
-    lib.jd_interp_batch.argtypes = [vp, lg, lg, vp, vp, vp, vp, lg, vp, lg, vp]
-    return lib
+def interpreter_library() -> ctypes.CDLL:
+    """The integrator's library, which holds the interpreter (``jd_interp_*``)."""
+    return integrator_library()
 
 
 @dataclass(frozen=True, eq=False)
@@ -354,6 +347,8 @@ class FirstFunction(CompiledFunction):
 
     interp: Interpreted | None = field(default=None, repr=False)
     compiled: list = field(default_factory=list, repr=False)
+    #: the process whose thread builds the library (a forked child builds its own)
+    pid: int = field(default_factory=os.getpid)
 
     @property
     def address(self) -> int:

@@ -11,7 +11,6 @@ import math
 import numbers
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from functools import lru_cache
 from typing import TYPE_CHECKING, Any, overload
 
 import numpy as np
@@ -20,8 +19,8 @@ import symengine as se
 from ..errors import EvaluationError, JourdainError
 from ..model.expressions import as_expr
 from ..numeric import CompiledFunction, lambdify
-from ..numeric.integrator_c import library_source as integrator_source
-from ..numeric.toolchain import build, build_soon
+from ..numeric.integrator_c import integrator_library
+from ..numeric.toolchain import build_soon
 from ..symbolic import SymMatrix
 from .options import C_METHODS
 
@@ -70,22 +69,6 @@ class _Problem(ctypes.Structure):
 
 _CALLBACK = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, ctypes.POINTER(ctypes.c_double),
                              ctypes.POINTER(ctypes.c_double), ctypes.POINTER(ctypes.c_double))
-
-
-@lru_cache(maxsize=1)
-def integrator_library() -> ctypes.CDLL:
-    """The compiled integrator (built once, cached on disk like the model code): two
-    translation units, the step loops at -O2 and the kernels at -O3
-    (:data:`jourdain.numeric.integrator_c.UNITS`)."""
-    key, texts, flags = integrator_source()
-    lib = build(key, texts, unit_flags=flags)
-    vp, lg, db = ctypes.c_void_p, ctypes.c_long, ctypes.c_double
-    lib.jd_integrate.restype = ctypes.c_int
-    lib.jd_integrate.argtypes = [vp, db, vp, vp, vp, vp, vp, vp, lg, vp, vp, vp, vp, lg, vp, vp,
-                                 vp, vp, lg, vp, lg, vp]
-    lib.jd_rhs.restype = ctypes.c_int
-    lib.jd_rhs.argtypes = [vp, db, vp, vp, vp]
-    return lib
 
 
 def build_integrator_soon() -> None:
