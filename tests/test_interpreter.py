@@ -286,3 +286,25 @@ def test_a_child_forked_during_the_build_compiles_for_itself(fresh_cache):
     os.close(read)
     _, status = os.waitpid(pid, 0)
     assert answer == b"ok" and os.waitstatus_to_exitcode(status) == 0
+
+
+def test_a_long_first_run_takes_the_library_when_it_is_built(fresh_cache):
+    """The run's C loop returns every 1 024 steps; from the call after the build the problem
+    takes the library's right-hand side. The whole motion is the compiled run's to the bit,
+    and the problem then points at the library."""
+    from jourdain.simulation.problem import _Setup
+
+    model = n_link_pendulum_on_cart(4)
+    first = compiled.run_function(model)
+    assert isinstance(first, FirstFunction)
+    y0, yd0 = np.array([0.0, 2.0, 2.2, 2.4, 2.6]), np.zeros(5)
+    r1 = model.simulate((0.0, 60.0), y0, yd0, inputs={"F": 0.0})
+    setup = _Setup(model, first, parameter_vector(model, None), {"F": 0.0}, (), 1, 1e-6,
+                   np.full(11, 1e-6), np.inf, 0.0)
+    assert setup.problem.accel is None and setup.problem.accel_ctx
+    _wait(first)
+    setup.take_compiled()
+    assert setup.problem.accel == first.compiled[0].accel_address and setup.pending is None
+    r2 = model.simulate((0.0, 60.0), y0, yd0, inputs={"F": 0.0})
+    assert r1.nfev == r2.nfev and r1.t.size > 2 * 1024  # the loop returned twice at least
+    assert r1.y.tobytes() == r2.y.tobytes() and r1.ydd.tobytes() == r2.ydd.tobytes()

@@ -191,6 +191,8 @@ def _run_c(setup: _Setup, t0: float, t1: float, x0: np.ndarray, te: np.ndarray |
                 a_out + 8 * cap, a_out + 8 * cap * (1 + n), cap, p_cnt + 6 * di, p_evt, p_evx,
                 p_evi, ev_cap, p_cnt + 7 * di, max_steps, p_fail)
             cnt = _COUNTERS.unpack_from(buf, 8 * o_int)  # type: ignore[arg-type]
+            if setup.pending is not None:  # a first run interpreted: the library once built
+                setup.take_compiled()
             if te is None:
                 chunks.append(_chunk(out, o, cap, n, f, cnt[6]))
                 pending = None
