@@ -46,7 +46,7 @@ def test_the_units_follow_their_table():
     assert main_flags == () and kernel_flags == ("-O3",)
     assert kernels.startswith("#define JD_KERNELS 1") and "JD_KERNELS 1" not in main
     assert "int jd_integrate(" in main and "int jd_integrate(" not in kernels
-    assert "void stage_sum(" in main and "void stage_sum(" in kernels  # declared; defined
+    assert "int stage_sum(" in main and "int stage_sum(" in kernels  # declared; defined
 
 
 def _runs() -> list[tuple[np.ndarray, np.ndarray, int]]:

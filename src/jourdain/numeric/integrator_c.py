@@ -57,7 +57,7 @@ if TYPE_CHECKING:  # imported where used: setup.py builds the library without Nu
 #: JD_KERNELS: their definitions; elsewhere their declarations), its files in order, and its
 #: compiler flags after :data:`jourdain.numeric.toolchain.CFLAGS` (see the module docstring)
 UNITS: tuple[tuple[str, tuple[str, ...], tuple[str, ...]], ...] = (
-    ("", ("rk_tables.h", "integrator_rhs.h", "integrator_kernels.h", "integrator_output.h",
+    ("", ("rk_tables.h", "integrator_kernels.h", "integrator_rhs.h", "integrator_output.h",
           "integrator_radau.h", "integrator_explicit.h"), ()),
     ("#define JD_KERNELS 1\n", ("integrator_kernels.h",), ("-O3",)),
 )

@@ -8,15 +8,23 @@
  * (n-link pendulum on a cart, n = 4 and 12, DOP853, RK45; Radau IIA within 1 %), and so are the
  * numbers, to the bit: no sum is reordered (no -ffast-math). */
 #include <math.h>
+#include <string.h>
 #if defined(__GNUC__)
 #define JD_INTERNAL __attribute__((visibility("hidden")))  /* not exported by the library */
 #else
 #define JD_INTERNAL
 #endif
 
-/* out = x + Σ_j (h·a[j])·K_j over the stages j < s (x NULL: 0 + ...) */
-JD_INTERNAL void stage_sum(long n, int s, double h, const double *a, const double *x,
-                           const double *K, double *out);
+/* a row of a method's table without its zeros: the q coefficients a[t] ≠ 0 of the stages
+   j[t], in the order of j (row_of: from the first s entries of a full row) */
+typedef struct { int q; int j[16]; double a[16]; } jd_row;
+JD_INTERNAL void row_of(int s, const double *a, jd_row *r);
+/* out = x + Σ_t (h·a[t])·K_j[t] over the row r (x NULL: 0 + ...); 1: every component of out
+   finite, else 0 */
+JD_INTERNAL int stage_sum(long n, const jd_row *r, double h, const double *x, const double *K,
+                          double *out);
+/* 1: every x_i finite, else 0 */
+JD_INTERNAL int all_finite(long n, const double *x);
 /* sqrt(Σ (v_i / sc_i)² / n) */
 JD_INTERNAL double rms_scaled(long n, const double *v, const double *sc);
 /* sc_i = atol_i + rtol·max(|x_i|, |x_new_i|) (both finite) */
@@ -50,36 +58,97 @@ JD_INTERNAL void lu_solve_cplx(long n, const double *Ar, const double *Ai, const
                                double *br, double *bi);
 
 #ifdef JD_KERNELS  /* the definitions: in the kernels' unit only */
-/* out = x + h·Σ_j a[j]·K_j over the stages j < s with a[j] ≠ 0 (the zeros of the tables
-   skipped; x NULL: 0 + h·Σ ...): each component's sum kept in a register over the stages, four
-   components at a time, instead of out[] read and written once per stage, the terms added in
-   the order of j as before, so the results are bit-identical to that form; 1.5-7 % less time
-   per run of the n-link pendulum on a cart (n = 12 and 4) */
-void stage_sum(long n, int s, double h, const double *a, const double *x,
-               const double *K, double *out) {
-    double w[16];
-    const double *Kp[16];
-    int q = 0;
-    for (int j = 0; j < s; ++j) {
-        double aj = h * a[j];
-        if (aj == 0.0) continue;
-        w[q] = aj; Kp[q] = K + j * n; ++q;
+void row_of(int s, const double *a, jd_row *r) {
+    r->q = 0;
+    for (int j = 0; j < s; ++j)
+        if (a[j] != 0.0) { r->j[r->q] = j; r->a[r->q] = a[j]; ++r->q; }
+}
+
+/* out = x + Σ_t (h·a[t])·K_j[t]: each component's terms added in the order of the stages, so
+   the results are bit-identical to out[] read and written once per stage (before: the zeros
+   of the full row skipped at each call, that is for h·a[j] = 0). The components go in groups
+   of four lanes (the last group at n − 4, overlapping the one before when 4 ∤ n: their common
+   components computed twice, alike), three groups to a tile whose twelve sums stay in
+   registers over the stages: twelve independent chains of additions, where before a group of
+   four waited on its one chain's latency and the tail of n mod 4 components on a chain each
+   (see integrator_c.py for the times). */
+#if defined(__GNUC__)  /* four lanes as one vector (GCC's and Clang's vector extension) */
+typedef double jd_v4 __attribute__((vector_size(32)));
+#define JD_LOAD4(v, p) memcpy(&(v), (p), sizeof(v))  /* unaligned */
+#define JD_INLINE static inline __attribute__((always_inline))
+
+/* the groups of four at o[0 … G) of one tile; returns Σ out·0 over them */
+JD_INLINE double tile(int G, const jd_row *r, double h, const double *K, long n,
+                      const double *x, const long *o, double *out) {
+    jd_v4 acc[3], kt;
+    for (int g = 0; g < G; ++g) {
+        if (x) JD_LOAD4(acc[g], x + o[g]);
+        else acc[g] = (jd_v4){0.0, 0.0, 0.0, 0.0};
     }
-    long i = 0;
-    for (; i + 4 <= n; i += 4) {
-        double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
-        if (x) { s0 = x[i]; s1 = x[i + 1]; s2 = x[i + 2]; s3 = x[i + 3]; }
-        for (int t = 0; t < q; ++t) {
-            const double *kt = Kp[t] + i, wt = w[t];
-            s0 += wt * kt[0]; s1 += wt * kt[1]; s2 += wt * kt[2]; s3 += wt * kt[3];
-        }
-        out[i] = s0; out[i + 1] = s1; out[i + 2] = s2; out[i + 3] = s3;
+    for (int t = 0; t < r->q; ++t) {
+        const double *k = K + r->j[t] * n, w = h * r->a[t];
+        jd_v4 wt = {w, w, w, w};
+        for (int g = 0; g < G; ++g) { JD_LOAD4(kt, k + o[g]); acc[g] += wt * kt; }
     }
-    for (; i < n; ++i) {
+    jd_v4 z = acc[0] * 0.0;
+    for (int g = 0; g < G; ++g) {
+        memcpy(out + o[g], &acc[g], sizeof acc[g]);
+        if (g) z += acc[g] * 0.0;
+    }
+    return (z[0] + z[1]) + (z[2] + z[3]);
+}
+
+JD_INLINE int stage_body(long n, const jd_row *r, double h, const double *x, const double *K,
+                         double *out) {
+    double z = 0.0;  /* x·0 is 0 for finite x, NaN for inf or NaN */
+    long groups = (n + 3) / 4;
+    for (long g = 0; g < groups; g += 3) {
+        long o[3];
+        for (int k = 0; k < 3; ++k) o[k] = 4 * (g + k) < n - 4 ? 4 * (g + k) : n - 4;
+        long left = groups - g;
+        z += left >= 3 ? tile(3, r, h, K, n, x, o, out) : left == 2 ? tile(2, r, h, K, n, x, o, out)
+                                                                     : tile(1, r, h, K, n, x, o, out);
+    }
+    return z == 0.0;
+}
+#define JD_FIXED(N)                                                                           \
+static int stage_sum_##N(const jd_row *r, double h, const double *x, const double *K,       \
+                         double *out) { return stage_body(N, r, h, x, K, out); }
+JD_FIXED(11)
+
+int stage_sum(long n, const jd_row *r, double h, const double *x, const double *K,
+              double *out) {
+    switch (n) {
+    case 11: return stage_sum_11(r, h, x, K, out);
+    default: break;
+    }
+    if (n >= 4) return stage_body(n, r, h, x, K, out);
+#else
+int stage_sum(long n, const jd_row *r, double h, const double *x, const double *K,
+              double *out) {
+#endif
+    double z = 0.0;  /* component by component (n < 4, or no vector extension) */
+    for (long i = 0; i < n; ++i) {
         double s0 = x ? x[i] : 0.0;
-        for (int t = 0; t < q; ++t) s0 += w[t] * Kp[t][i];
+        for (int t = 0; t < r->q; ++t) s0 += (h * r->a[t]) * K[r->j[t] * n + i];
         out[i] = s0;
+        z += s0 * 0.0;
     }
+    return z == 0.0;
+}
+
+/* x·0 is 0 for finite x, NaN for inf or NaN: summed in four lanes (one chain of additions
+   over the n components before) */
+int all_finite(long n, const double *x) {
+    double r = 0.0;
+    long i = 0;
+#if defined(__GNUC__)
+    jd_v4 z = {0.0, 0.0, 0.0, 0.0}, v;
+    for (; i + 4 <= n; i += 4) { JD_LOAD4(v, x + i); z += v * 0.0; }
+    r = (z[0] + z[1]) + (z[2] + z[3]);
+#endif
+    for (; i < n; ++i) r += x[i] * 0.0;
+    return r == 0.0;
 }
 
 double rms_scaled(long n, const double *v, const double *sc) {
