@@ -6,7 +6,24 @@
  * on a 2-core AMD EPYC, most of it spent vectorizing loops that run once per run or per
  * event; the two units take 0.34 s and 0.30 s, in parallel. The time per run is the same
  * (n-link pendulum on a cart, n = 4 and 12, DOP853, RK45; Radau IIA within 1 %), and so are the
- * numbers, to the bit: no sum is reordered (no -ffast-math). */
+ * numbers, to the bit: no sum is reordered (no -ffast-math).
+ *
+ * The step loop's share (issue 35: at most 30 % of a right-hand side at n = 4). Measured
+ * 2026-11-27 with perf on the 4-link pendulum on a cart (f = 5, n = 11, DOP853, 10 s, 8 894
+ * right-hand sides): of the run's samples, the model's jd_accel 45 %, stage_sum 19 % (its sums
+ * of four lanes in one register waiting on the latency of their chain of additions, the
+ * n mod 4 others on one chain each), rhs() 5 % (most of it its NaN check, one chain of n
+ * additions), inputs() 1.6 %, pow 1.5 %. Now: the stage sums in tiles of three groups of four
+ * lanes in vectors (below), the state of each stage checked finite by stage_sum as it writes
+ * it (rhs_at), constant inputs set once per run (inputs_fix): stage_sum 12 %, rhs 1.5 %,
+ * inputs 0; one process alternating the old and the new library (best of 300 runs each):
+ * 1.17-1.19 → 1.02-1.05 ms per run, 0.132-0.134 → 0.115-0.118 µs per right-hand side, against
+ * jd_accel alone 0.077 µs: the loop 69-74 % → 48-53 % of a right-hand side, the target not
+ * met. Tried and left out, no faster within the noise: stage_sum compiled for n = 11 (n known
+ * to the compiler), and each stage's sum but its last term summed one stage ahead (while the
+ * previous stage's right-hand side runs, the last term added once its K is known). What is
+ * left is spread thin: jd_integrate 2 %, pow 1.8 %, memcpy 1.2 %, error_sums8 0.9 %, and
+ * jd_accel itself about 6 % slower inside the loop than alone (perf's share). */
 #include <math.h>
 #include <string.h>
 #if defined(__GNUC__)
@@ -65,13 +82,14 @@ void row_of(int s, const double *a, jd_row *r) {
 }
 
 /* out = x + Σ_t (h·a[t])·K_j[t]: each component's terms added in the order of the stages, so
-   the results are bit-identical to out[] read and written once per stage (before: the zeros
-   of the full row skipped at each call, that is for h·a[j] = 0). The components go in groups
+   the results are bit-identical to out[] read and written once per stage (the zeros of the
+   rows are dropped once per run, where the full rows were scanned at each call for
+   h·a[j] = 0: the same unless h·a[j] underflows, h < 1e-290). The components go in groups
    of four lanes (the last group at n − 4, overlapping the one before when 4 ∤ n: their common
    components computed twice, alike), three groups to a tile whose twelve sums stay in
    registers over the stages: twelve independent chains of additions, where before a group of
    four waited on its one chain's latency and the tail of n mod 4 components on a chain each
-   (see integrator_c.py for the times). */
+   (the times: at the top of this file). */
 #if defined(__GNUC__)  /* four lanes as one vector (GCC's and Clang's vector extension) */
 typedef double jd_v4 __attribute__((vector_size(32)));
 #define JD_LOAD4(v, p) memcpy(&(v), (p), sizeof(v))  /* unaligned */
@@ -111,17 +129,9 @@ JD_INLINE int stage_body(long n, const jd_row *r, double h, const double *x, con
     }
     return z == 0.0;
 }
-#define JD_FIXED(N)                                                                           \
-static int stage_sum_##N(const jd_row *r, double h, const double *x, const double *K,       \
-                         double *out) { return stage_body(N, r, h, x, K, out); }
-JD_FIXED(11)
 
 int stage_sum(long n, const jd_row *r, double h, const double *x, const double *K,
               double *out) {
-    switch (n) {
-    case 11: return stage_sum_11(r, h, x, K, out);
-    default: break;
-    }
     if (n >= 4) return stage_body(n, r, h, x, K, out);
 #else
 int stage_sum(long n, const jd_row *r, double h, const double *x, const double *K,
