@@ -35,7 +35,9 @@ Measured 2026-11-27 (issue 35's memo of run templates; the same 2-core machine, 
 doubled some runs): the plain call 71-72 → 18.6-19.0 µs, with t_eval 80-81 → 19.2-19.9 µs, a
 new parameter value each call 75 → 55 µs; the step loop 0.174 µs per right-hand side (8 894
 in a 10 s run of 1.55 ms, best of 20) against jd_accel's 0.095 µs alone: the loop 80 % of a
-right-hand side (target 30 %: not met; M, k, q alone 0.055-0.069 µs).
+right-hand side (target 30 %: not met; M, k, q alone 0.055-0.069 µs). Then the step loop's
+vector tiles (``numeric/integrator_kernels.h``; ``--quick`` twice, old and new trees in turn):
+0.137-0.145 → 0.117 µs per right-hand side, jd_accel 0.077-0.083 µs: 75-78 → 46-51 % (not met).
 
     .venv/bin/python benchmarks/setup.py                   # f = 2 … 32, 5 trials (minutes)
     .venv/bin/python benchmarks/setup.py --quick           # f = 2 and 5, 2 trials

@@ -47,7 +47,7 @@ def test_the_units_follow_their_table():
     assert "int jd_interp_accel(" in interp and "int jd_interp_accel(" not in main
     assert kernels.startswith("#define JD_KERNELS 1") and "JD_KERNELS 1" not in main
     assert "int jd_integrate(" in main and "int jd_integrate(" not in kernels
-    assert "void stage_sum(" in main and "void stage_sum(" in kernels  # declared; defined
+    assert "int stage_sum(" in main and "int stage_sum(" in kernels  # declared; defined
 
 
 def _runs() -> list[tuple[np.ndarray, np.ndarray, int]]:

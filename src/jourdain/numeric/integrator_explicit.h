@@ -28,7 +28,9 @@ int jd_integrate(const jd_problem *P, double t_end, double *st, double *x, doubl
     double *mem = (double *)malloc(sizeof(double) *
         (2 * nu + ff + 2 * f + ff + n * (16 + 7 + 5) + 3 * (nev + 1)));
     if (!mem) return JD_ENOMEM;
-    jd_ctx c = {P, n, mem, mem + nu, mem + 2 * nu, mem + 2 * nu + ff + 2 * f, 0, 0.0, fail + 1};
+    jd_ctx c = {P, n, mem, mem + nu, mem + 2 * nu, mem + 2 * nu + ff + 2 * f, 0, 0.0, fail + 1,
+                0, 0};
+    inputs_fix(&c);
     double *K = c.L + ff, *F = K + 16 * n, *x_new = F + 7 * n, *xs = x_new + n,
            *sc = xs + n, *err = sc + n, *xe = err + n, *g_new = xe + n, *g_tmp = g_new + nev + 1,
            *roots = g_tmp + nev + 1;
@@ -81,6 +83,15 @@ int jd_integrate(const jd_problem *P, double t_end, double *st, double *x, doubl
        as one */
     int rejected = st[2] != 0.0;
     double en_old = st[3] > 0.0 ? st[3] : 1e-4;
+    /* the rows of the tables without their zeros: the stages 1 … S − 1, the solution (S) and
+       DOP853's two error estimates (S + 1, S + 2) */
+    jd_row rows[16];
+    for (int si = 1; si < S; ++si) row_of(si, m->A + si * m->lda, rows + si);
+    row_of(S, m->B, rows + S);
+    if (P->method == 1) {
+        row_of(S + 1, RK8_E5, rows + S + 1);
+        row_of(S + 1, RK8_E3, rows + S + 2);
+    }
     while (1) {
         if (t >= t_end) { status = JD_DONE; break; }
         if (steps >= max_steps) { status = JD_CONTINUE; break; }
@@ -94,13 +105,13 @@ int jd_integrate(const jd_problem *P, double t_end, double *st, double *x, doubl
         /* stages */
         memcpy(K, k0, n * sizeof(double));
         r = 0;
-        for (int si = 1; si < S && !r; ++si) {
-            stage_sum(n, si, h, m->A + si * m->lda, x, K, xs);
-            r = rhs(&c, t + m->C[si] * h, xs, K + si * n);
+        for (int si = 1; si < S && !r; ++si) {  /* each stage's state checked as it is summed */
+            int fin = stage_sum(n, rows + si, h, x, K, xs);
+            r = rhs_at(&c, t + m->C[si] * h, xs, K + si * n, fin);
         }
         if (!r) {
-            stage_sum(n, S, h, m->B, x, K, x_new);
-            r = rhs(&c, t_new, x_new, K + S * n);
+            int fin = stage_sum(n, rows + S, h, x, K, x_new);
+            r = rhs_at(&c, t_new, x_new, K + S * n, fin);
         }
         cnt[1]++; steps++;
         if (r == JD_ECALLBACK || r == JD_ENOMEM) { fail[0] = c.fail_t; status = r; break; }
@@ -115,8 +126,8 @@ int jd_integrate(const jd_problem *P, double t_end, double *st, double *x, doubl
         double en;
         if (P->method == 1) {
             double e5 = 0.0, e3 = 0.0, *a3v = xe;
-            stage_sum(n, S + 1, 1.0, RK8_E5, NULL, K, err);
-            stage_sum(n, S + 1, 1.0, RK8_E3, NULL, K, a3v);
+            stage_sum(n, rows + S + 1, 1.0, NULL, K, err);
+            stage_sum(n, rows + S + 2, 1.0, NULL, K, a3v);
             error_sums8(n, err, a3v, sc, &e5, &e3);
             en = (e5 == 0.0 && e3 == 0.0) ? 0.0 : h * e5 / sqrt((e5 + 0.01 * e3) * (double)n);
         } else {
@@ -172,7 +183,8 @@ int jd_rhs(const jd_problem *P, double t, const double *x, double *dx, double *f
     long nu = P->nu > 0 ? P->nu : 1;
     double *mem = (double *)malloc(sizeof(double) * (2 * nu + 2 * f * f + 2 * f));
     if (!mem) return JD_ENOMEM;
-    jd_ctx c = {P, n, mem, mem + nu, mem + 2 * nu, mem + 2 * nu + f * f + 2 * f, 0, 0.0, fail + 1};
+    jd_ctx c = {P, n, mem, mem + nu, mem + 2 * nu, mem + 2 * nu + f * f + 2 * f, 0, 0.0, fail + 1,
+                0, 0};
     int r = rhs(&c, t, x, dx);
     fail[0] = c.fail_t;
     free(mem);

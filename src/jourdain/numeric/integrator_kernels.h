@@ -6,17 +6,42 @@
  * on a 2-core AMD EPYC, most of it spent vectorizing loops that run once per run or per
  * event; the two units take 0.34 s and 0.30 s, in parallel. The time per run is the same
  * (n-link pendulum on a cart, n = 4 and 12, DOP853, RK45; Radau IIA within 1 %), and so are the
- * numbers, to the bit: no sum is reordered (no -ffast-math). */
+ * numbers, to the bit: no sum is reordered (no -ffast-math).
+ *
+ * The step loop's share (issue 35: at most 30 % of a right-hand side at n = 4). Measured
+ * 2026-11-27 with perf on the 4-link pendulum on a cart (f = 5, n = 11, DOP853, 10 s, 8 894
+ * right-hand sides): of the run's samples, the model's jd_accel 45 %, stage_sum 19 % (its sums
+ * of four lanes in one register waiting on the latency of their chain of additions, the
+ * n mod 4 others on one chain each), rhs() 5 % (most of it its NaN check, one chain of n
+ * additions), inputs() 1.6 %, pow 1.5 %. Now: the stage sums in tiles of three groups of four
+ * lanes in vectors (below), the state of each stage checked finite by stage_sum as it writes
+ * it (rhs_at), constant inputs set once per run (inputs_fix): stage_sum 12 %, rhs 1.5 %,
+ * inputs 0; one process alternating the old and the new library (best of 300 runs each):
+ * 1.17-1.19 → 1.02-1.05 ms per run, 0.132-0.134 → 0.115-0.118 µs per right-hand side, against
+ * jd_accel alone 0.077 µs: the loop 69-74 % → 48-53 % of a right-hand side, the target not
+ * met. Tried and left out, no faster within the noise: stage_sum compiled for n = 11 (n known
+ * to the compiler), and each stage's sum but its last term summed one stage ahead (while the
+ * previous stage's right-hand side runs, the last term added once its K is known). What is
+ * left is spread thin: jd_integrate 2 %, pow 1.8 %, memcpy 1.2 %, error_sums8 0.9 %, and
+ * jd_accel itself about 6 % slower inside the loop than alone (perf's share). */
 #include <math.h>
+#include <string.h>
 #if defined(__GNUC__)
 #define JD_INTERNAL __attribute__((visibility("hidden")))  /* not exported by the library */
 #else
 #define JD_INTERNAL
 #endif
 
-/* out = x + Σ_j (h·a[j])·K_j over the stages j < s (x NULL: 0 + ...) */
-JD_INTERNAL void stage_sum(long n, int s, double h, const double *a, const double *x,
-                           const double *K, double *out);
+/* a row of a method's table without its zeros: the q coefficients a[t] ≠ 0 of the stages
+   j[t], in the order of j (row_of: from the first s entries of a full row) */
+typedef struct { int q; int j[16]; double a[16]; } jd_row;
+JD_INTERNAL void row_of(int s, const double *a, jd_row *r);
+/* out = x + Σ_t (h·a[t])·K_j[t] over the row r (x NULL: 0 + ...); 1: every component of out
+   finite, else 0 */
+JD_INTERNAL int stage_sum(long n, const jd_row *r, double h, const double *x, const double *K,
+                          double *out);
+/* 1: every x_i finite, else 0 */
+JD_INTERNAL int all_finite(long n, const double *x);
 /* sqrt(Σ (v_i / sc_i)² / n) */
 JD_INTERNAL double rms_scaled(long n, const double *v, const double *sc);
 /* sc_i = atol_i + rtol·max(|x_i|, |x_new_i|) (both finite) */
@@ -50,36 +75,90 @@ JD_INTERNAL void lu_solve_cplx(long n, const double *Ar, const double *Ai, const
                                double *br, double *bi);
 
 #ifdef JD_KERNELS  /* the definitions: in the kernels' unit only */
-/* out = x + h·Σ_j a[j]·K_j over the stages j < s with a[j] ≠ 0 (the zeros of the tables
-   skipped; x NULL: 0 + h·Σ ...): each component's sum kept in a register over the stages, four
-   components at a time, instead of out[] read and written once per stage, the terms added in
-   the order of j as before, so the results are bit-identical to that form; 1.5-7 % less time
-   per run of the n-link pendulum on a cart (n = 12 and 4) */
-void stage_sum(long n, int s, double h, const double *a, const double *x,
-               const double *K, double *out) {
-    double w[16];
-    const double *Kp[16];
-    int q = 0;
-    for (int j = 0; j < s; ++j) {
-        double aj = h * a[j];
-        if (aj == 0.0) continue;
-        w[q] = aj; Kp[q] = K + j * n; ++q;
+void row_of(int s, const double *a, jd_row *r) {
+    r->q = 0;
+    for (int j = 0; j < s; ++j)
+        if (a[j] != 0.0) { r->j[r->q] = j; r->a[r->q] = a[j]; ++r->q; }
+}
+
+/* out = x + Σ_t (h·a[t])·K_j[t]: each component's terms added in the order of the stages, so
+   the results are bit-identical to out[] read and written once per stage (the zeros of the
+   rows are dropped once per run, where the full rows were scanned at each call for
+   h·a[j] = 0: the same unless h·a[j] underflows, h < 1e-290). The components go in groups
+   of four lanes (the last group at n − 4, overlapping the one before when 4 ∤ n: their common
+   components computed twice, alike), three groups to a tile whose twelve sums stay in
+   registers over the stages: twelve independent chains of additions, where before a group of
+   four waited on its one chain's latency and the tail of n mod 4 components on a chain each
+   (the times: at the top of this file). */
+#if defined(__GNUC__)  /* four lanes as one vector (GCC's and Clang's vector extension) */
+typedef double jd_v4 __attribute__((vector_size(32)));
+#define JD_LOAD4(v, p) memcpy(&(v), (p), sizeof(v))  /* unaligned */
+#define JD_INLINE static inline __attribute__((always_inline))
+
+/* the groups of four at o[0 … G) of one tile; returns Σ out·0 over them */
+JD_INLINE double tile(int G, const jd_row *r, double h, const double *K, long n,
+                      const double *x, const long *o, double *out) {
+    jd_v4 acc[3], kt;
+    for (int g = 0; g < G; ++g) {
+        if (x) JD_LOAD4(acc[g], x + o[g]);
+        else acc[g] = (jd_v4){0.0, 0.0, 0.0, 0.0};
     }
-    long i = 0;
-    for (; i + 4 <= n; i += 4) {
-        double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
-        if (x) { s0 = x[i]; s1 = x[i + 1]; s2 = x[i + 2]; s3 = x[i + 3]; }
-        for (int t = 0; t < q; ++t) {
-            const double *kt = Kp[t] + i, wt = w[t];
-            s0 += wt * kt[0]; s1 += wt * kt[1]; s2 += wt * kt[2]; s3 += wt * kt[3];
-        }
-        out[i] = s0; out[i + 1] = s1; out[i + 2] = s2; out[i + 3] = s3;
+    for (int t = 0; t < r->q; ++t) {
+        const double *k = K + r->j[t] * n, w = h * r->a[t];
+        jd_v4 wt = {w, w, w, w};
+        for (int g = 0; g < G; ++g) { JD_LOAD4(kt, k + o[g]); acc[g] += wt * kt; }
     }
-    for (; i < n; ++i) {
+    jd_v4 z = acc[0] * 0.0;
+    for (int g = 0; g < G; ++g) {
+        memcpy(out + o[g], &acc[g], sizeof acc[g]);
+        if (g) z += acc[g] * 0.0;
+    }
+    return (z[0] + z[1]) + (z[2] + z[3]);
+}
+
+JD_INLINE int stage_body(long n, const jd_row *r, double h, const double *x, const double *K,
+                         double *out) {
+    double z = 0.0;  /* x·0 is 0 for finite x, NaN for inf or NaN */
+    long groups = (n + 3) / 4;
+    for (long g = 0; g < groups; g += 3) {
+        long o[3];
+        for (int k = 0; k < 3; ++k) o[k] = 4 * (g + k) < n - 4 ? 4 * (g + k) : n - 4;
+        long left = groups - g;
+        z += left >= 3 ? tile(3, r, h, K, n, x, o, out) : left == 2 ? tile(2, r, h, K, n, x, o, out)
+                                                                     : tile(1, r, h, K, n, x, o, out);
+    }
+    return z == 0.0;
+}
+
+int stage_sum(long n, const jd_row *r, double h, const double *x, const double *K,
+              double *out) {
+    if (n >= 4) return stage_body(n, r, h, x, K, out);
+#else
+int stage_sum(long n, const jd_row *r, double h, const double *x, const double *K,
+              double *out) {
+#endif
+    double z = 0.0;  /* component by component (n < 4, or no vector extension) */
+    for (long i = 0; i < n; ++i) {
         double s0 = x ? x[i] : 0.0;
-        for (int t = 0; t < q; ++t) s0 += w[t] * Kp[t][i];
+        for (int t = 0; t < r->q; ++t) s0 += (h * r->a[t]) * K[r->j[t] * n + i];
         out[i] = s0;
+        z += s0 * 0.0;
     }
+    return z == 0.0;
+}
+
+/* x·0 is 0 for finite x, NaN for inf or NaN: summed in four lanes (one chain of additions
+   over the n components before) */
+int all_finite(long n, const double *x) {
+    double r = 0.0;
+    long i = 0;
+#if defined(__GNUC__)
+    jd_v4 z = {0.0, 0.0, 0.0, 0.0}, v;
+    for (; i + 4 <= n; i += 4) { JD_LOAD4(v, x + i); z += v * 0.0; }
+    r = (z[0] + z[1]) + (z[2] + z[3]);
+#endif
+    for (; i < n; ++i) r += x[i] * 0.0;
+    return r == 0.0;
 }
 
 double rms_scaled(long n, const double *v, const double *sc) {

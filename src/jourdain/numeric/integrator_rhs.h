@@ -1,5 +1,5 @@
-/* jourdain's integrator library, part 1 of 4 (numeric/integrator_c.py joins them, with the
- * declarations of integrator_kernels.h after this one): the problem
+/* jourdain's integrator library, part 1 of 4 (numeric/integrator_c.py joins them, after the
+ * declarations of integrator_kernels.h): the problem
  * a run integrates, its inputs, and the right-hand side dx = [yd, M^-1 (q - k), yd.q]. */
 #include <math.h>
 #include <stdlib.h>
@@ -54,6 +54,8 @@ typedef struct {
     long nfev;
     double fail_t;
     double *fail_x;
+    int u_fixed;   /* 1: the inputs are constants, in u for every t (inputs_fix) */
+    int u_bad;     /* with u_fixed: one of them is not finite */
 } jd_ctx;
 
 static void inputs_const(const jd_problem *P, double t, double *u) {
@@ -73,8 +75,20 @@ static void inputs_const(const jd_problem *P, double t, double *u) {
     }
 }
 
+/* inputs all constant (no table, expression or callback): u set here once for the run,
+   instead of at each right-hand side */
+static void inputs_fix(jd_ctx *c) {
+    const jd_problem *P = c->P;
+    if (P->uexpr || P->ucb) return;
+    for (long i = 0; i < P->nu; ++i) if (P->u_kind[i] == 1) return;
+    inputs_const(P, 0.0, c->u);
+    c->u_fixed = 1;
+    for (long i = 0; i < P->nu; ++i) if (!isfinite(c->u[i])) c->u_bad = 1;
+}
+
 static int inputs(jd_ctx *c, double t, const double *y, const double *yd) {
     const jd_problem *P = c->P;
+    if (c->u_fixed) return c->u_bad ? JD_ENAN : 0;
     inputs_const(P, t, c->u);
     if (P->uexpr) {
         P->uexpr(y, yd, t, P->p, c->u, c->u2);
@@ -89,19 +103,16 @@ static int inputs(jd_ctx *c, double t, const double *y, const double *yd) {
     return 0;
 }
 
-/* dx = [yd, M^-1 (q - k), yd.q] with M = L L^T (Cholesky) */
-static int rhs(jd_ctx *c, double t, const double *x, double *dx) {
+/* dx = [yd, M^-1 (q - k), yd.q] with M = L L^T (Cholesky), at x whose every component is
+   finite where finite is 1 (the caller checked, as stage_sum does while it writes x), else
+   JD_ENAN */
+static int rhs_at(jd_ctx *c, double t, const double *x, double *dx, int finite) {
     const jd_problem *P = c->P;
     long f = P->f;
     const double *y = x, *yd = x + f;
     c->nfev++;
-    {   /* every component finite: x·0 is 0 for finite x, NaN for inf or NaN (no branch per
-           component, so the loop vectorizes) */
-        double z = 0.0;
-        for (long i = 0; i < c->n; ++i) z += x[i] * 0.0;
-        if (z != 0.0) goto nan;
-    }
-    {
+    if (!finite || c->u_bad) goto nan;
+    if (!c->u_fixed) {
         int r = inputs(c, t, y, yd);
         if (r == JD_ENAN) goto nan;
         if (r) { c->fail_t = t; memcpy(c->fail_x, x, c->n * sizeof(double)); return r; }
@@ -163,4 +174,9 @@ static int rhs(jd_ctx *c, double t, const double *x, double *dx) {
 nan:
     c->fail_t = t; memcpy(c->fail_x, x, c->n * sizeof(double));
     return JD_ENAN;
+}
+
+/* the same at any x (checked here) */
+static int rhs(jd_ctx *c, double t, const double *x, double *dx) {
+    return rhs_at(c, t, x, dx, all_finite(c->n, x));
 }
