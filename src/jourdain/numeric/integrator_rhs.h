@@ -43,7 +43,7 @@ typedef struct {
     const double *atol;    /* n = 2f + 1 */
     double h_max, h_first;
     jd_accel_fn accel;     /* the model's fused M, k, q and Cholesky solve, or NULL */
-    jd_accel_ctx_fn accel_ctx; /* or this one, called with ctx (accel NULL then) */
+    jd_accel_ctx_fn accel_ctx; /* where accel is NULL: this one, called with ctx */
     const void *ctx;
 } jd_problem;
 
