@@ -39,6 +39,25 @@ right-hand side (target 30 %: not met; M, k, q alone 0.055-0.069 µs). Then the 
 vector tiles (``numeric/integrator_kernels.h``; ``--quick`` twice, old and new trees in turn):
 0.137-0.145 → 0.117 µs per right-hand side, jd_accel 0.077-0.083 µs: 75-78 → 46-51 % (not met).
 
+The first run interpreted while the model compiles (``numeric/interpreter.py``; symbolic-path
+models), 2026-11-27, ``--trials 3 --mujoco``, one run each, the same machine (before: the tree
+without it, minutes earlier, ``--trials 2``; every motion the same to the bit, cold and warm):
+
+| model | f | path | cold s before → after | warm s after | MuJoCo s |
+| --- | ---: | --- | ---: | ---: | ---: |
+| cart(1) | 2 | symbolic | 0.345 → 0.202 | 0.193 | 0.220 |
+| cart(4) | 5 | symbolic | 0.410 → 0.171 | 0.165 | 0.241 |
+| cart(8) | 9 | symbolic | 0.441 → 0.193 | 0.206 | 0.229 |
+| cart(16) | 17 | symbolic | 0.790 → 0.220 | 0.216 | 0.246 |
+| cart(31) | 32 | planar | 0.561 → 0.509 | 0.186 | 0.185 |
+| chain(2) | 3 | symbolic | 0.376 → 0.142 | 0.152 | 0.124 |
+| chain(4) | 7 | symbolic | 1.061 → 0.212 | 0.216 | 0.171 |
+| chain(8) | 15 | spatial | 0.936 → 0.898 | 0.212 | 0.141 |
+| chain(16) | 31 | spatial | 0.864 → 0.773 | 0.187 | 0.147 |
+
+(build + first step after the import, cold: 0.017-0.079 s on the symbolic path, against
+0.12-0.92 s before; the recursions' engines still wait for the compiler: 0.37-0.73 s.)
+
     .venv/bin/python benchmarks/setup.py                   # f = 2 … 32, 5 trials (minutes)
     .venv/bin/python benchmarks/setup.py --quick           # f = 2 and 5, 2 trials
     .venv/bin/python benchmarks/setup.py --mujoco --json setup.json
@@ -286,6 +305,9 @@ def overhead(repeat: int = 300) -> dict:
     f = system.f
     y0, yd0 = np.full(f, 0.1), np.zeros(f)
     u = {"F": 0.0}
+    # compiled first: with an empty cache the first runs are interpreted while the library
+    # compiles in a thread (numeric/interpreter.py); this measures the compiled runs
+    fn = mkq_function(system)
     short = system.simulate((0.0, 1e-9), y0, yd0, inputs=u)
     g = iter(9.81 + 1e-6 * np.arange(1, 10 * repeat + 2))
     plain = per_call_us(lambda: system.simulate((0.0, 1e-9), y0, yd0, inputs=u), repeat)
@@ -295,7 +317,6 @@ def overhead(repeat: int = 300) -> dict:
                                                 parameters={"g": next(g)}), repeat)
     long = min((system.simulate((0.0, 10.0), y0, yd0, inputs=u) for _ in range(3)),
                key=lambda r: r.wall_time)
-    fn = mkq_function(system)
     rng = np.random.default_rng(0)
     m = 10000
     Y, YD = rng.uniform(-1, 1, (m, f)), rng.uniform(-1, 1, (m, f))
