@@ -229,12 +229,10 @@ def test_c_precedence_and_folding():
 
 def test_an_unreadable_model_waits_for_the_compiler(fresh_cache, monkeypatch):
     """Where the reader gives up, the first run takes the compiled library, as before."""
-    import jourdain.numeric.interpreter as interpreter
-
     def refuse(*args, **kwargs):
         raise Unreadable("refused for the test")
 
-    monkeypatch.setattr(interpreter, "program", refuse)
+    monkeypatch.setattr(compiled, "program", refuse)
     model = n_link_pendulum_on_cart(2)
     fn = compiled.run_function(model)
     assert not isinstance(fn, FirstFunction) and fn is compiled.mkq_function(model)
@@ -308,3 +306,36 @@ def test_a_long_first_run_takes_the_library_when_it_is_built(fresh_cache):
     r2 = model.simulate((0.0, 60.0), y0, yd0, inputs={"F": 0.0})
     assert r1.nfev == r2.nfev and r1.t.size > 2 * 1024  # the loop returned twice at least
     assert r1.y.tobytes() == r2.y.tobytes() and r1.ydd.tobytes() == r2.ydd.tobytes()
+
+
+def test_a_failed_build_is_reported_and_the_runs_go_on(fresh_cache, monkeypatch):
+    """The thread's compiler fails: a run after it warns once, naming the model and the error,
+    and runs stay interpreted, with the library's numbers (compared once it can be built)."""
+    import warnings
+
+    from jourdain.numeric.toolchain import CompilerError
+
+    def broken(system):
+        raise CompilerError("the compiler crashed (for the test)")
+
+    model = n_link_pendulum_on_cart(2)
+    y0, yd0 = np.array([0.0, 0.4, -0.2]), np.zeros(3)
+    with monkeypatch.context() as mp, warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        mp.setattr(compiled, "mkq_function", broken)
+        first = compiled.run_function(model)
+        assert isinstance(first, FirstFunction)
+        t0 = time.monotonic()
+        while not first.failed and time.monotonic() - t0 < 60:
+            time.sleep(0.01)
+        r1 = model.simulate((0.0, 1.0), y0, yd0, inputs={"F": 0.0})
+        model.simulate((0.0, 1.0), y0, yd0, inputs={"F": 0.0})
+    said = [str(w.message) for w in caught if issubclass(w.category, RuntimeWarning)]
+    assert len(said) == 1 and "pendulum" in said[0] and "crashed" in said[0]
+    assert "stay interpreted" in said[0]
+    lib = compiled.mkq_function(model)
+    assert not isinstance(lib, FirstFunction)
+    Y, YD = _states(3, 20, 1)
+    p = parameter_vector(model, None)
+    a, b = first.batch(Y, YD, 0.0, p, [0.1]), lib.batch(Y, YD, 0.0, p, [0.1])
+    assert all(np.array_equal(a[k], b[k]) for k in a) and np.isfinite(r1.y).all()

@@ -26,6 +26,7 @@ from .cachefile import dump_pickle, keep_sealed, load_pickle
 from .ccode import HEADER, argument_names, function_source
 from .cost import evaluation_path
 from .integrator_ldl import ldl_source  # the solve written out per f (H1)
+from .interpreter import FirstFunction, Interpreted, Unreadable, interpreter_library, program
 from .planar_recursion import planar_units, plane_normal
 from .recursive import layout, recursive_units
 from .symbolic_accel import accel_source, symbolic_source
@@ -249,7 +250,9 @@ def mkq_function(system: System) -> CompiledFunction:
         return dynamics_function(system)
     choice = evaluation_path(system)
     if choice.path == "symbolic" and choice.eom is not None:
-        names, shapes, source, _ = _symbolic_parts(system)  # the source the first run read
+        parts = _symbolic_parts(system)  # the source that the first run read
+        assert parts is not None
+        names, shapes, source, _ = parts
         return _load(system, names, shapes, source)
     if choice.path == "planar":
         return planar_function(system)
@@ -268,12 +271,12 @@ def symbolic_mkq(system: System, eom: EquationsOfMotion) -> CompiledFunction:
 
 
 @lru_cache(maxsize=32)
-def _symbolic_parts(system: System) -> tuple:
+def _symbolic_parts(system: System) -> tuple | None:
     """:func:`_symbolic_source` of the path that :func:`evaluation_path` chose, with its
     equations (None where it chose another path)."""
     choice = evaluation_path(system)
     if choice.path != "symbolic" or choice.eom is None:
-        return None  # type: ignore[return-value]
+        return None
     return (*symbolic_source(system, choice.eom), choice.eom)
 
 
@@ -282,8 +285,6 @@ def _run_function(system: System) -> CompiledFunction:
     """:func:`mkq_function`, or where it takes the symbolic path and its library is neither
     loaded nor cached nor prebuilt, the same source on the interpreter
     (:class:`~jourdain.numeric.interpreter.FirstFunction`) while a thread compiles it."""
-    from .interpreter import FirstFunction, Interpreted, Unreadable, interpreter_library, program
-
     _refuse_closed(system)
     try:
         compiler()
@@ -306,8 +307,14 @@ def _run_function(system: System) -> CompiledFunction:
     first = FirstFunction(names, shapes, arguments(system), key, f, len(system.parameters),
                           len(system.inputs), lib,
                           interp=Interpreted(prog, bool(ldl_source(f))))
-    build_soon(lambda: first.compiled.append(mkq_function(system)),
-               name="jourdain-model-build")
+
+    def build_it() -> None:
+        try:
+            first.compiled.append(mkq_function(system))
+        except Exception as exc:  # noqa: BLE001 - reported by run_function, in this thread
+            first.failed.append(exc)
+
+    build_soon(build_it, name="jourdain-model-build")
     return first
 
 
@@ -317,14 +324,20 @@ def run_function(system: System) -> CompiledFunction:
     bits while a thread compiles it (:mod:`jourdain.numeric.interpreter`); once compiled, the
     compiled function."""
     fn = _run_function(system)
-    compiled = getattr(fn, "compiled", None)
-    if compiled:
-        return compiled[0]
-    if compiled is not None and getattr(fn, "pid", None) != os.getpid():
+    if not isinstance(fn, FirstFunction):
+        return fn
+    if fn.compiled:
+        return fn.compiled[0]
+    if fn.failed and not fn.warned:
+        fn.warned.append(True)
+        warnings.warn(f"the compiled library of {system.name!r} could not be built "
+                      f"({fn.failed[0]}); its runs stay interpreted (the same numbers, slower)",
+                      RuntimeWarning, stacklevel=3)
+    if fn.pid != os.getpid():
         # a child forked while the build ran: the thread is not in it; it compiles (or loads
         # what the parent built) for itself
-        compiled.append(mkq_function(system))
-        return compiled[0]
+        fn.compiled.append(mkq_function(system))
+        return fn.compiled[0]
     return fn
 
 

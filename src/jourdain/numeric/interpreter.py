@@ -358,6 +358,9 @@ class FirstFunction(CompiledFunction):
     compiled: list = field(default_factory=list, repr=False)
     #: the process whose thread builds the library (a forked child builds its own)
     pid: int = field(default_factory=os.getpid)
+    #: the build's error, where it failed, and whether it was reported
+    failed: list = field(default_factory=list, repr=False)
+    warned: list = field(default_factory=list, repr=False)
 
     @property
     def address(self) -> int:
