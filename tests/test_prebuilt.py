@@ -37,6 +37,10 @@ from jourdain.simulation.problem import integrator_library
 system = load_model(sys.argv[1]).system
 r = system.simulate((0.0, 2.0), [0.3, -0.2], [0.0, 0.5], rtol=1e-9, atol=1e-9)
 np.save(sys.argv[2], np.concatenate([r.t, r.y.ravel(), r.yd.ravel()]))
+import threading  # the model's library compiles in a thread while its first run is interpreted
+for t in threading.enumerate():
+    if t.name.startswith("jourdain-"):
+        t.join()
 print(json.dumps({"built": built, "integrator": integrator_library()._name}))
 """
 
