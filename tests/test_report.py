@@ -162,8 +162,10 @@ def test_report_embeds_the_3d_view(report):
 def test_report_compiles_the_evaluation_library_beside_the_summarys(tmp_path, monkeypatch):
     """write_report starts System.evaluate's library (the recursion's M̄, J̄, …, Q̄) in its own
     thread before the summary compiles the integrator's M, k, q: both libraries are built, the
-    evaluation's in that thread and the summary's in the calling one, and the numbers are those
-    of the library built in this thread alone. Whether the two compilers overlap in time is the
+    evaluation's in that thread and the summary's in the calling one (or in the model's build
+    thread, where the summary's first run is interpreted while it compiles: whichever of the
+    two gets there first), and the numbers are those of the library built in this thread
+    alone. Whether the two compilers overlap in time is the
     scheduler's business, not a test's (benchmarks/report.py times whole runs)."""
     import threading
 
@@ -187,7 +189,7 @@ def test_report_compiles_the_evaluation_library_beside_the_summarys(tmp_path, mo
     eom_key = compiled._eom_function(model.system).key
     mkq_key = compiled.mkq_function(model.system).key
     assert built_in[eom_key] == "jourdain-eom-build"
-    assert built_in[mkq_key] == threading.main_thread().name
+    assert built_in[mkq_key] in (threading.main_thread().name, "jourdain-model-build")
     doc = json.loads((tmp_path / "out" / "values.json").read_text())
     numeric.clear_cache()
     toolchain._loaded.clear()
