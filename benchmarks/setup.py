@@ -56,7 +56,12 @@ without it, minutes earlier, ``--trials 2``; every motion the same to the bit, c
 | chain(16) | 31 | spatial | 0.864 → 0.773 | 0.187 | 0.147 |
 
 (build + first step after the import, cold: 0.017-0.079 s on the symbolic path, against
-0.12-0.92 s before; the recursions' engines still wait for the compiler: 0.37-0.73 s.)
+0.12-0.92 s before; the recursions' engines still wait for the compiler: 0.37-0.73 s.) Then
+the recursions' first runs on their units compiled at -O0 while the -O2 library compiles
+(``numeric/first_run.py``; the old and the new tree in turn, ``--trials 3``, a loaded
+machine: import 0.23-0.26 s; motions the same to the bit): cold, build + first step after
+the import, cart(31) 0.311 → 0.224 s, chain(8) 0.625 → 0.241 s, chain(16) 0.709 → 0.238 s;
+import → first step 0.564 → 0.455, 0.936 → 0.472 and 0.952 → 0.509 s.
 
     .venv/bin/python benchmarks/setup.py                   # f = 2 … 32, 5 trials (minutes)
     .venv/bin/python benchmarks/setup.py --quick           # f = 2 and 5, 2 trials

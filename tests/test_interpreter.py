@@ -14,7 +14,7 @@ import symengine as se
 
 import jourdain as jd
 from jourdain.models import n_link_pendulum_on_cart, spatial_chain
-from jourdain.numeric import compiled, parameter_vector, toolchain
+from jourdain.numeric import compiled, first_run, parameter_vector, toolchain
 from jourdain.numeric.ccode import HEADER, argument_names, function_source
 from jourdain.numeric.interpreter import (
     FirstFunction,
@@ -55,14 +55,14 @@ def test_first_run_is_the_compiled_run_to_the_bit(fresh_cache, model):
     """f = 2 and 5 (the written-out solve), 12 (the solve's loop) and a spatial chain: the
     interpreted first run and the compiled run after it agree to the bit, in the motion, in
     ÿ and in M, k, q at random states."""
-    first = compiled.run_function(model)
+    first = first_run.run_function(model)
     assert isinstance(first, FirstFunction)
     f = model.f
     y0, yd0 = np.linspace(0.1, 0.5, f), np.linspace(-0.3, 0.2, f)
     inputs = {u: 0.25 for u in model.input_names}
     r1 = model.simulate((0.0, 1.5), y0, yd0, inputs=inputs)
     _wait(first)
-    final = compiled.run_function(model)
+    final = first_run.run_function(model)
     assert final is first.compiled[0] and not isinstance(final, FirstFunction)
     r2 = model.simulate((0.0, 1.5), y0, yd0, inputs=inputs)
     assert r1.t.size > 20
@@ -99,7 +99,7 @@ def test_right_hand_side_and_its_failures_to_the_bit(fresh_cache, n):
     """The integrator's ÿ and power at random states, and the solve's verdicts: 1 where M is
     not positive definite (a negative mass), 2 where a state is NaN, as the compiled one."""
     model = n_link_pendulum_on_cart(n)
-    first = compiled.run_function(model)
+    first = first_run.run_function(model)
     final = compiled.mkq_function(model)
     assert isinstance(first, FirstFunction) and not isinstance(final, FirstFunction)
     Y, YD = _states(model.f, 40, 7)
@@ -116,7 +116,7 @@ def test_right_hand_side_and_its_failures_to_the_bit(fresh_cache, n):
 def test_a_non_physical_mass_matrix_fails_alike(fresh_cache):
     """A negative link mass: M is not positive definite; both say 1, or both give the same ÿ."""
     model = n_link_pendulum_on_cart(4)
-    first = compiled.run_function(model)
+    first = first_run.run_function(model)
     final = compiled.mkq_function(model)
     Y, YD = _states(model.f, 30, 11)
     names = [k for k, _ in model.parameters]
@@ -232,9 +232,9 @@ def test_an_unreadable_model_waits_for_the_compiler(fresh_cache, monkeypatch):
     def refuse(*args, **kwargs):
         raise Unreadable("refused for the test")
 
-    monkeypatch.setattr(compiled, "program", refuse)
+    monkeypatch.setattr(first_run, "program", refuse)
     model = n_link_pendulum_on_cart(2)
-    fn = compiled.run_function(model)
+    fn = first_run.run_function(model)
     assert not isinstance(fn, FirstFunction) and fn is compiled.mkq_function(model)
 
 
@@ -243,15 +243,35 @@ def test_a_cached_library_is_taken_at_once(fresh_cache):
     model = n_link_pendulum_on_cart(3)
     compiled.mkq_function(model)
     compiled.clear_cache()
-    assert not isinstance(compiled.run_function(model), FirstFunction)
+    assert not isinstance(first_run.run_function(model), FirstFunction)
 
 
-def test_recursion_paths_are_compiled_as_before(fresh_cache):
-    """The interpreter reads the symbolic path's code; a model on the recursion waits for its
-    library (and its numbers are the library's)."""
-    model = jd.models.planar_chain(40)
-    fn = compiled.run_function(model)
-    assert not isinstance(fn, FirstFunction)
+@pytest.mark.parametrize("model", [jd.models.planar_chain(40), spatial_chain(8)],
+                         ids=["planar", "spatial"])
+def test_recursion_paths_run_first_on_their_build_at_O0(fresh_cache, monkeypatch, model):
+    """The interpreter reads the symbolic path's code; a model on a recursion runs first on its
+    units compiled at -O0 (where no JOURDAIN_OPTIMIZE level is set) while the optimized
+    library compiles: the same motion to the bit, then the library."""
+    from jourdain.numeric.functions import ProvisionalFunction
+
+    monkeypatch.setenv("JOURDAIN_OPTIMIZE", "1")  # a short compile already: no first build
+    assert not isinstance(first_run.run_function(model), ProvisionalFunction)
+    compiled.clear_cache()
+    monkeypatch.setattr(toolchain, "_loaded", {})
+    monkeypatch.setenv("JOURDAIN_CACHE", str(fresh_cache / "again"))
+    monkeypatch.delenv("JOURDAIN_OPTIMIZE")
+    first = first_run.run_function(model)
+    assert isinstance(first, ProvisionalFunction) and not isinstance(first, FirstFunction)
+    f = model.f
+    y0, yd0 = np.linspace(-0.3, 0.3, f), np.linspace(0.2, -0.1, f)
+    r1 = model.simulate((0.0, 0.5), y0, yd0)
+    _wait(first)
+    final = first_run.run_function(model)
+    assert final is first.compiled[0] and final.key != first.key
+    r2 = model.simulate((0.0, 0.5), y0, yd0)
+    assert r1.t.size > 5 and r1.y.tobytes() == r2.y.tobytes()
+    assert r1.ydd.tobytes() == r2.ydd.tobytes()
+
 
 
 def test_a_child_forked_during_the_build_compiles_for_itself(fresh_cache):
@@ -261,7 +281,7 @@ def test_a_child_forked_during_the_build_compiles_for_itself(fresh_cache):
     import warnings
 
     model = n_link_pendulum_on_cart(2)
-    first = compiled.run_function(model)
+    first = first_run.run_function(model)
     assert isinstance(first, FirstFunction)
     y0, yd0 = np.array([0.0, 0.4, -0.2]), np.zeros(3)
     ref = model.simulate((0.0, 1.0), y0, yd0, inputs={"F": 0.0}).y[-1]
@@ -272,7 +292,7 @@ def test_a_child_forked_during_the_build_compiles_for_itself(fresh_cache):
     if pid == 0:  # the child: one line, then out without the parent's handlers
         code = 1
         try:
-            fn = compiled.run_function(model)
+            fn = first_run.run_function(model)
             y = model.simulate((0.0, 1.0), y0, yd0, inputs={"F": 0.0}).y[-1]
             ok = not isinstance(fn, FirstFunction) and y.tobytes() == ref.tobytes()
             os.write(write, b"ok" if ok else b"bad")
@@ -293,7 +313,7 @@ def test_a_long_first_run_takes_the_library_when_it_is_built(fresh_cache):
     from jourdain.simulation.problem import _Setup
 
     model = n_link_pendulum_on_cart(4)
-    first = compiled.run_function(model)
+    first = first_run.run_function(model)
     assert isinstance(first, FirstFunction)
     y0, yd0 = np.array([0.0, 2.0, 2.2, 2.4, 2.6]), np.zeros(5)
     r1 = model.simulate((0.0, 60.0), y0, yd0, inputs={"F": 0.0})
@@ -322,8 +342,8 @@ def test_a_failed_build_is_reported_and_the_runs_go_on(fresh_cache, monkeypatch)
     y0, yd0 = np.array([0.0, 0.4, -0.2]), np.zeros(3)
     with monkeypatch.context() as mp, warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        mp.setattr(compiled, "mkq_function", broken)
-        first = compiled.run_function(model)
+        mp.setattr(first_run, "mkq_function", broken)
+        first = first_run.run_function(model)
         assert isinstance(first, FirstFunction)
         t0 = time.monotonic()
         while not first.failed and time.monotonic() - t0 < 60:
@@ -332,7 +352,7 @@ def test_a_failed_build_is_reported_and_the_runs_go_on(fresh_cache, monkeypatch)
         model.simulate((0.0, 1.0), y0, yd0, inputs={"F": 0.0})
     said = [str(w.message) for w in caught if issubclass(w.category, RuntimeWarning)]
     assert len(said) == 1 and "pendulum" in said[0] and "crashed" in said[0]
-    assert "stay interpreted" in said[0]
+    assert "interpreted or compiled at -O0" in said[0]
     lib = compiled.mkq_function(model)
     assert not isinstance(lib, FirstFunction)
     Y, YD = _states(3, 20, 1)

@@ -6,10 +6,9 @@ its ``jd_accel``, memoized per system (:func:`clear_cache`).
 from __future__ import annotations
 
 import ctypes
-import os
 import shutil
 import warnings
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from functools import lru_cache
 from typing import TYPE_CHECKING
 
@@ -25,8 +24,6 @@ from ..symbolic import SymMatrix
 from .cachefile import dump_pickle, keep_sealed, load_pickle
 from .ccode import HEADER, argument_names, function_source
 from .cost import evaluation_path
-from .integrator_ldl import ldl_source  # the solve written out per f (H1)
-from .interpreter import FirstFunction, Interpreted, Unreadable, interpreter_library, program
 from .planar_recursion import planar_units, plane_normal
 from .recursive import layout, recursive_units
 from .symbolic_accel import accel_source, symbolic_source
@@ -45,7 +42,7 @@ if TYPE_CHECKING:
     from ..model.system import System
     from ..stages.projection import EquationsOfMotion
 
-from .functions import CompiledFunction, InterpretedFunction, JitFunction
+from .functions import CompiledFunction, InterpretedFunction, JitFunction, ProvisionalFunction
 
 _GENERATOR_VERSION = "c3"
 
@@ -137,12 +134,21 @@ def _jit(system: System, names: tuple[str, ...], shapes: tuple[tuple[int, int], 
 
 def _load(system: System, names: tuple[str, ...], shapes: tuple[tuple[int, int], ...],
           source: str | tuple[str, ...], n_bodies: int = 0,
-          unit_flags: tuple[tuple[str, ...], ...] | None = None) -> CompiledFunction:
+          unit_flags: tuple[tuple[str, ...], ...] | None = None,
+          quick: bool = False) -> CompiledFunction:
     """Build (or load from the cache) the library of ``jd_fn`` and ``jd_fn_batch``
-    (``unit_flags``: compiler flags per unit of ``source``)."""
+    (``unit_flags``: compiler flags per unit of ``source``). ``quick``: where that library is
+    not at hand, the same source at -O0 under a key of its own, as a
+    :class:`ProvisionalFunction` (the same numbers to the bit: no -O level reorders
+    arithmetic, tests/test_native.py), for a first run while the library compiles."""
     units = (source,) if isinstance(source, str) else source
     key = content_key(_GENERATOR_VERSION, *units, *(" ".join(f) for f in unit_flags or ()))
-    lib = build(key, source, unit_flags=unit_flags)
+    kind: type[CompiledFunction] = CompiledFunction
+    if quick and cached_library(key) is None:
+        key, kind = content_key(_GENERATOR_VERSION, "-O0", key), ProvisionalFunction
+        lib = build(key, source, extra_flags=("-O0",), unit_flags=unit_flags)
+    else:
+        lib = build(key, source, unit_flags=unit_flags)
     vp = ctypes.c_void_p
     lib.jd_fn.restype = None
     lib.jd_fn.argtypes = [vp, vp, ctypes.c_double, vp, vp, vp]
@@ -153,8 +159,8 @@ def _load(system: System, names: tuple[str, ...], shapes: tuple[tuple[int, int],
         lib.jd_dynamics_batch.restype = ctypes.c_long
         lib.jd_dynamics_batch.argtypes = [ctypes.c_long, ctypes.c_long, vp, vp, vp, vp,
                                           ctypes.c_long, vp, ctypes.c_long, vp, vp]
-    return CompiledFunction(names, shapes, arguments(system), key, system.f,
-                            len(system.parameters), len(system.inputs), lib, n_bodies=n_bodies)
+    return kind(names, shapes, arguments(system), key, system.f, len(system.parameters),
+                len(system.inputs), lib, n_bodies=n_bodies)
 
 
 def _interpreted(system: System, names: tuple[str, ...], shapes: tuple[tuple[int, int], ...],
@@ -171,7 +177,8 @@ def _interpreted(system: System, names: tuple[str, ...], shapes: tuple[tuple[int
 
 
 def _recursive(system: System, full: bool, extra_source: str = "",
-               directions: tuple | None = None, accel: bool = False) -> CompiledFunction:
+               directions: tuple | None = None, accel: bool = False,
+               quick: bool = False) -> CompiledFunction:
     """Compile :func:`.recursive.recursive_source` (no symbolic M is formed)."""
     f, p = system.f, len(system.bodies)
     names: tuple[str, ...] = ("M", "k", "q")
@@ -195,7 +202,8 @@ def _recursive(system: System, full: bool, extra_source: str = "",
         return lambdify(system, mats, extra_source)
     units = recursive_units(system, full, directions, extra_source,
                             accel_source(f) if accel else None)
-    return _load(system, names, shapes, units, n_bodies=p, unit_flags=((), ENGINE_FLAGS))
+    return _load(system, names, shapes, units, n_bodies=p, unit_flags=((), ENGINE_FLAGS),
+                 quick=quick)
 
 
 def _refuse_closed(system: System) -> None:
@@ -281,82 +289,17 @@ def _symbolic_parts(system: System) -> tuple | None:
 
 
 @lru_cache(maxsize=32)
-def _run_function(system: System) -> CompiledFunction:
-    """:func:`mkq_function`, or where it takes the symbolic path and its library is neither
-    loaded nor cached nor prebuilt, the same source on the interpreter
-    (:class:`~jourdain.numeric.interpreter.FirstFunction`) while a thread compiles it."""
-    _refuse_closed(system)
-    try:
-        compiler()
-    except CompilerError:
-        return mkq_function(system)
-    parts = _symbolic_parts(system) if FIRST_RUN_INTERPRETED else None
-    if not parts or not accel_source(system.f):
-        return mkq_function(system)
-    names, shapes, source, _ = parts
-    key = content_key(_GENERATOR_VERSION, source)
-    if cached_library(key) is not None:
-        return mkq_function(system)
-    f = system.f
-    try:
-        prog = program(source, "jd_fn", f, len(system.parameters), len(system.inputs),
-                       f * f + 2 * f)
-        lib = interpreter_library()
-    except (Unreadable, CompilerError):
-        return mkq_function(system)
-    first = FirstFunction(names, shapes, arguments(system), key, f, len(system.parameters),
-                          len(system.inputs), lib,
-                          interp=Interpreted(prog, bool(ldl_source(f))))
-
-    def build_it() -> None:
-        try:
-            first.compiled.append(mkq_function(system))
-        except Exception as exc:  # noqa: BLE001 - reported by run_function, in this thread
-            first.failed.append(exc)
-
-    build_soon(build_it, name="jourdain-model-build")
-    return first
-
-
-def run_function(system: System) -> CompiledFunction:
-    """What a simulation of ``system`` evaluates: :func:`mkq_function`, except on the first
-    run of a model whose symbolic code is not compiled yet, which is interpreted to the same
-    bits while a thread compiles it (:mod:`jourdain.numeric.interpreter`); once compiled, the
-    compiled function."""
-    fn = _run_function(system)
-    if not isinstance(fn, FirstFunction):
-        return fn
-    if fn.compiled:
-        return fn.compiled[0]
-    if fn.failed and not fn.warned:
-        fn.warned.append(True)
-        warnings.warn(f"the compiled library of {system.name!r} could not be built "
-                      f"({fn.failed[0]}); its runs stay interpreted (the same numbers, slower)",
-                      RuntimeWarning, stacklevel=3)
-    if fn.pid != os.getpid():
-        # a child forked while the build ran: the thread is not in it; it compiles (or loads
-        # what the parent built) for itself
-        fn.compiled.append(mkq_function(system))
-        return fn.compiled[0]
-    return fn
-
-
-#: the first run of a model interpreted while its library compiles (:func:`run_function`)
-FIRST_RUN_INTERPRETED = True
-
-
-@lru_cache(maxsize=32)
-def dynamics_function(system: System) -> CompiledFunction:
+def dynamics_function(system: System, quick: bool = False) -> CompiledFunction:
     """Compiled recursion with ``M, k, q``, :meth:`CompiledFunction.dynamics` (ÿ and every
     joint wrench for a batch of states) and the integrator's ``jd_accel`` (articulated bodies
     where they apply, O(f), else LDLᵀ of M), memoized per system: one library serves
     :func:`mkq_function` where it takes the recursion."""
     _refuse_closed(system)
-    return _recursive(system, full=False, accel=True)
+    return _recursive(system, full=False, accel=True, quick=quick)
 
 
 @lru_cache(maxsize=32)
-def planar_function(system: System) -> CompiledFunction:
+def planar_function(system: System, quick: bool = False) -> CompiledFunction:
     """Compiled ``M, k, q`` and the integrator's ``jd_accel`` of a planar system by the
     recursion in planar vectors (:mod:`jourdain.numeric.planar_recursion`; the caller checks
     :func:`~jourdain.numeric.planar_recursion.is_planar`), memoized per system."""
@@ -364,7 +307,11 @@ def planar_function(system: System) -> CompiledFunction:
     f = system.f
     local, engine, _ = planar_units(system, accel_source(f))
     return _load(system, ("M", "k", "q"), ((f, f), (f, 1), (f, 1)), (local, engine),
-                 unit_flags=((), ENGINE_FLAGS))
+                 unit_flags=((), ENGINE_FLAGS), quick=quick)
+
+
+#: the memos of modules above this one that clear_cache empties too (they add themselves)
+ALSO_CLEARED: list[Callable[[], None]] = []
 
 
 def clear_cache(disk: bool = False) -> None:
@@ -372,8 +319,9 @@ def clear_cache(disk: bool = False) -> None:
     on-disk cache of compiled libraries (:func:`cache_dir`)."""
     _eom_function.cache_clear()
     mkq_function.cache_clear()
-    _run_function.cache_clear()
     _symbolic_parts.cache_clear()
+    for clear in ALSO_CLEARED:
+        clear()
     dynamics_function.cache_clear()
     planar_function.cache_clear()
     evaluation_path.cache_clear()

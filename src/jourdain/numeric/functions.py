@@ -6,6 +6,7 @@ without a C compiler).
 from __future__ import annotations
 
 import ctypes
+import os
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -177,6 +178,20 @@ class CompiledFunction:
             ctypes.c_long(n), ctypes.c_long(self.f), Y.ctypes.data, YD.ctypes.data,
             T.ctypes.data, P.ctypes.data, ctypes.c_long(ps), U.ctypes.data, ctypes.c_long(us),
             out.ctypes.data)
+
+
+@dataclass(frozen=True, eq=False)
+class ProvisionalFunction(CompiledFunction):
+    """A model's function for its first runs while its optimized library compiles in a thread
+    (:func:`jourdain.numeric.first_run.run_function`): the same numbers to the bit, sooner.
+    ``compiled`` receives the optimized function when the build is done, ``failed`` its error
+    where it failed (``warned``: reported); ``pid``: the process whose thread builds (a forked
+    child builds for itself)."""
+
+    compiled: list = field(default_factory=list, repr=False)
+    failed: list = field(default_factory=list, repr=False)
+    warned: list = field(default_factory=list, repr=False)
+    pid: int = field(default_factory=os.getpid)
 
 
 @dataclass(frozen=True, eq=False)

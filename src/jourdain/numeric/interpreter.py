@@ -22,23 +22,22 @@ operation, 3-35 times the compiled code, which a first short run does not notice
 run does not stay on it: the C loop returns every 1 024 steps, and from the call after the
 build the run takes the library's right-hand side (``_Setup.take_compiled`` in
 :mod:`jourdain.simulation.problem`); later runs take the library from their start
-(:func:`jourdain.numeric.compiled.run_function`).
+(:func:`jourdain.numeric.first_run.run_function`).
 
 Only the symbolic path is read: the recursions' engines are C compiled with the model's sizes
-as constants (a first run of a model on them waits for the compiler as before).
+as constants; their first runs take the same units compiled at -O0 (:mod:`.first_run`).
 """
 
 from __future__ import annotations
 
 import ctypes
-import os
 import re
 import struct
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from .functions import CompiledFunction
+from .functions import ProvisionalFunction
 from .integrator_c import integrator_library
 
 #: operation codes (interpreter.h's JI_* in order)
@@ -348,19 +347,13 @@ def interpreter_library() -> ctypes.CDLL:
 
 
 @dataclass(frozen=True, eq=False)
-class FirstFunction(CompiledFunction):
+class FirstFunction(ProvisionalFunction):
     """The interface of :class:`CompiledFunction` on the interpreter: ``lib`` is the
     integrator's library, ``interp`` the program; :attr:`accel_ctx_address` and
     :attr:`ctx_address` are the integrator's right-hand side (``jd_problem.accel_ctx``, ``ctx``).
     ``compiled`` holds the compiled function once the thread that builds it is done."""
 
     interp: Interpreted | None = field(default=None, repr=False)
-    compiled: list = field(default_factory=list, repr=False)
-    #: the process whose thread builds the library (a forked child builds its own)
-    pid: int = field(default_factory=os.getpid)
-    #: the build's error, where it failed, and whether it was reported
-    failed: list = field(default_factory=list, repr=False)
-    warned: list = field(default_factory=list, repr=False)
 
     @property
     def address(self) -> int:

@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..numeric import CompiledFunction, parameter_vector
-from ..numeric.compiled import run_function
+from ..numeric.first_run import run_function
 from ..units import model_units
 from .options import C_METHODS
 from .problem import Event, _Setup
