@@ -39,9 +39,15 @@ pytestmark = pytest.mark.skipif(os.name != "posix", reason="SIGINT to a child pr
 #: source tree, whatever script an older install left in the environment); it says when it
 #: has imported its entry module, before which Ctrl-C meets Python's own start-up (site,
 #: the script's first import: a window of some 20 ms no command line can handle)
-CONSOLE = ("import os, sys\nfrom _jourdain_entry import main\n"
-           "if os.environ.get('JD_READY'): open(os.environ['JD_READY'], 'w').close()\n"
-           "sys.argv[0] = 'jourdain'\nsys.exit(main())")
+#: (the marker is made inside main(), as its first step: made before main, a Ctrl-C sent at once
+#: could land between the marker and main, in this script's own lines, as a traceback of theirs)
+CONSOLE = ("import os, sys\nimport _jourdain_entry as entry\n"
+           "imports = entry._import_extensions\n"
+           "def ready_then_imports():\n"
+           "    if os.environ.get('JD_READY'): open(os.environ['JD_READY'], 'w').close()\n"
+           "    imports()\n"
+           "entry._import_extensions = ready_then_imports\n"
+           "sys.argv[0] = 'jourdain'\nsys.exit(entry.main())")
 
 
 def jourdain(*args: str) -> list[str]:
