@@ -106,10 +106,10 @@ def mark_study(out: str | None, plots: str | None, started: float) -> None:
                     "here: the same command resumes from them"))
                 write_text(parts / "manifest.json", json.dumps(manifest, indent=1))
         if out and _since(Path(out), started):
-            import h5py
+            from ..simulation.results.files import h5_file
 
             try:  # NetCDF-4 is HDF5: a global attribute
-                with h5py.File(out, "r+") as h:
+                with h5_file(out, "r+") as h:
                     h.attrs["status"] = "interrupted"
                     h.attrs["message"] = f"{message} after these results were written"
             except OSError:

@@ -8,6 +8,7 @@ from __future__ import annotations
 import json
 import os
 import re
+import time
 from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Self, TypeVar
@@ -23,6 +24,29 @@ from .energies import WithEnergies
 
 if TYPE_CHECKING:
     from ...model.system import System
+
+#: how long an HDF5 file whose lock is held is waited for (h5_file)
+LOCK_WAIT_S = 2.0
+
+
+def h5_file(path: str | Path, mode: str) -> Any:
+    """``h5py.File(path, mode)``, waiting up to :data:`LOCK_WAIT_S` while another holds the
+    file's lock. A compiler started by a thread of this process (a model's library built in
+    the background while its first run is interpreted) holds a copy of every open descriptor
+    from its fork to its exec, and with it the lock of an HDF5 file that this process has
+    just closed: a moment later the lock is free. Held longer (another process writing the
+    file), the error is raised."""
+    import h5py
+
+    deadline = time.monotonic() + LOCK_WAIT_S
+    while True:
+        try:
+            return h5py.File(path, mode)
+        except BlockingIOError:
+            if time.monotonic() > deadline:
+                raise
+            time.sleep(0.005)
+
 
 
 FORMAT = "jourdain-results"
@@ -90,9 +114,7 @@ class WithFiles(WithEnergies):
         return path
 
     def _save_h5(self, path: Path) -> None:
-        import h5py
-
-        with h5py.File(path, "w") as h:
+        with h5_file(path, "w") as h:
             for k, v in self._meta().items():
                 h.attrs[k] = v
             h["t"] = self.t
@@ -125,9 +147,7 @@ class WithFiles(WithEnergies):
         path = Path(path)
         if path.suffix.lower() == ".csv":
             return _load_csv(cls, path, system)
-        import h5py
-
-        with h5py.File(path, "r") as h:
+        with h5_file(path, "r") as h:
             if h.attrs.get("format") != FORMAT:
                 raise EvaluationError(f"{path} is not a jourdain results file")
             a = dict(h.attrs)
@@ -246,10 +266,8 @@ def open_incremental(path: str | Path, system: System) -> Any:
     fills while a run goes."""
     if Path(path).suffix.lower() == ".csv":
         return _PartialCsv(path, system)
-    import h5py
-
     n = 2 * system.f + 1
-    h = h5py.File(path, "w")
+    h = h5_file(path, "w")
     h.attrs["format"] = FORMAT
     h.attrs["version"] = VERSION
     h.attrs["system"] = system.name
@@ -294,10 +312,8 @@ def mark_interrupted(path: str | Path, message: str) -> bool:
     path = Path(path)
     text = " ".join(message.split())
     if path.suffix.lower() != ".csv":
-        import h5py
-
         try:
-            with h5py.File(path, "r+") as h:
+            with h5_file(path, "r+") as h:
                 if h.attrs.get("format") != FORMAT:
                     return False
                 if h.attrs.get("status") != "interrupted":  # else its own message stays
