@@ -16,11 +16,11 @@ import jourdain as jd
 from jourdain.models import n_link_pendulum_on_cart, spatial_chain
 from jourdain.numeric import compiled, first_run, parameter_vector, toolchain
 from jourdain.numeric.ccode import HEADER, argument_names, function_source
+from jourdain.numeric.integrator_c import integrator_library
 from jourdain.numeric.interpreter import (
     FirstFunction,
     Interpreted,
     Unreadable,
-    interpreter_library,
     program,
 )
 from jourdain.numeric.toolchain import build, content_key
@@ -176,7 +176,7 @@ def test_every_construct_of_the_generated_code_to_the_bit(fresh_cache):
              + se.acosh(2 + q1 ** 2) + se.atanh(se.tanh(q0) / 2) + se.sin(2 * q0) * se.cos(q1 / 3),
              -q0 * q1 * yd[2], se.Integer(0), se.Float(-0.0) + q2, se.sin(q0 - q1 - q2) ** 7]
     lib, interp = _compiled_and_interpreted(exprs, (y, yd, t, p, u), 2)
-    il = interpreter_library()
+    il = integrator_library()
     rng = np.random.default_rng(5)
     for _ in range(200):
         Y, YD = rng.uniform(-2, 2, 3), rng.uniform(-2, 2, 3)
@@ -217,7 +217,7 @@ def test_c_precedence_and_folding():
            "}\n\nvoid jd_fn(a) {\n    jd_fn_upper(y, yd, t, p, u, out);\n}\n")
     prog = program(src, "jd_fn", 2, 0, 0, 4)
     interp = Interpreted(prog, True)
-    il = interpreter_library()
+    il = integrator_library()
     y, z = np.array([0.1, 0.7]), np.zeros(2)
     out = np.empty(4)
     il.jd_interp_fn(interp.address, y.ctypes.data, z.ctypes.data, ctypes.c_double(0.0),

@@ -132,6 +132,13 @@ def _jit(system: System, names: tuple[str, ...], shapes: tuple[tuple[int, int], 
                        len(system.inputs), fn)
 
 
+def library_key(source: str | tuple[str, ...],
+                unit_flags: tuple[tuple[str, ...], ...] | None = None) -> str:
+    """The cache key of the library that :func:`_load` builds from ``source``."""
+    units = (source,) if isinstance(source, str) else source
+    return content_key(_GENERATOR_VERSION, *units, *(" ".join(f) for f in unit_flags or ()))
+
+
 def _load(system: System, names: tuple[str, ...], shapes: tuple[tuple[int, int], ...],
           source: str | tuple[str, ...], n_bodies: int = 0,
           unit_flags: tuple[tuple[str, ...], ...] | None = None,
@@ -141,8 +148,7 @@ def _load(system: System, names: tuple[str, ...], shapes: tuple[tuple[int, int],
     not at hand, the same source at -O0 under a key of its own, as a
     :class:`ProvisionalFunction` (the same numbers to the bit: no -O level reorders
     arithmetic, tests/test_native.py), for a first run while the library compiles."""
-    units = (source,) if isinstance(source, str) else source
-    key = content_key(_GENERATOR_VERSION, *units, *(" ".join(f) for f in unit_flags or ()))
+    key = library_key(source, unit_flags)
     kind: type[CompiledFunction] = CompiledFunction
     if quick and cached_library(key) is None:
         key, kind = content_key(_GENERATOR_VERSION, "-O0", key), ProvisionalFunction
@@ -280,7 +286,8 @@ def symbolic_mkq(system: System, eom: EquationsOfMotion) -> CompiledFunction:
 
 @lru_cache(maxsize=32)
 def _symbolic_parts(system: System) -> tuple | None:
-    """:func:`_symbolic_source` of the path that :func:`evaluation_path` chose, with its
+    """:func:`~jourdain.numeric.symbolic_accel.symbolic_source` of the path that
+    :func:`evaluation_path` chose, with its
     equations (None where it chose another path)."""
     choice = evaluation_path(system)
     if choice.path != "symbolic" or choice.eom is None:

@@ -27,21 +27,22 @@ from functools import lru_cache
 from typing import TYPE_CHECKING
 
 from .compiled import (
-    _GENERATOR_VERSION,
     ALSO_CLEARED,
     _refuse_closed,
     _symbolic_parts,
     arguments,
     dynamics_function,
+    library_key,
     mkq_function,
     planar_function,
 )
 from .cost import evaluation_path
 from .functions import CompiledFunction, ProvisionalFunction
+from .integrator_c import integrator_library
 from .integrator_ldl import ldl_source
-from .interpreter import FirstFunction, Interpreted, Unreadable, interpreter_library, program
+from .interpreter import FirstFunction, Interpreted, Unreadable, program
 from .symbolic_accel import accel_source
-from .toolchain import CompilerError, build_soon, cached_library, compiler, content_key
+from .toolchain import CompilerError, build_soon, cached_library, compiler
 
 if TYPE_CHECKING:
     from ..model.system import System
@@ -88,14 +89,14 @@ def _interpreted(system: System) -> FirstFunction | None:
     if not parts or not accel_source(system.f):
         return None
     names, shapes, source, _ = parts
-    key = content_key(_GENERATOR_VERSION, source)
+    key = library_key(source)
     if cached_library(key) is not None:
         return None
     f = system.f
     try:
         prog = program(source, "jd_fn", f, len(system.parameters), len(system.inputs),
                        f * f + 2 * f)
-        lib = interpreter_library()
+        lib = integrator_library()  # which holds the interpreter (jd_interp_*)
     except (Unreadable, CompilerError):
         return None
     return FirstFunction(names, shapes, arguments(system), key, f, len(system.parameters),

@@ -38,7 +38,6 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .functions import ProvisionalFunction
-from .integrator_c import integrator_library
 
 #: operation codes (interpreter.h's JI_* in order)
 (ADD, SUB, MUL, DIV, NEG, SQ, CUBE, POWI, SQRT, FN1, ATAN2, POW, FMAX, FMIN, SINCOS, STORE,
@@ -339,11 +338,6 @@ class Interpreted:
             int(written_out), self.consts.ctypes.data, self.ops.ctypes.data,
             self.mirror.ctypes.data)
         self.address = ctypes.addressof(self.struct)
-
-
-def interpreter_library() -> ctypes.CDLL:
-    """The integrator's library, which holds the interpreter (``jd_interp_*``)."""
-    return integrator_library()
 
 
 @dataclass(frozen=True, eq=False)

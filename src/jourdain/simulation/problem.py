@@ -301,7 +301,7 @@ class _Setup:
         w = self._i32.itemsize
         i_dir = a32 + w * self.u_kind.size
         self.mkq = mkq
-        #: the interpreted function's slot for its compiled one (None: compiled already)
+        #: a provisional function's slot for its compiled one (None: compiled already)
         self.pending: list | None = getattr(mkq, "compiled", None)
         self._cb = _CALLBACK(self._callback) if self.callables else None
         self.problem = _Problem(
@@ -314,11 +314,12 @@ class _Setup:
         self.problem_ref = ctypes.byref(self.problem)  # the C loop's argument, made once
 
     def take_compiled(self) -> None:
-        """Where this problem's M, k, q are interpreted while their library compiles
-        (:class:`jourdain.numeric.interpreter.FirstFunction`) and the build is done, the
-        library's right-hand side from the next call of the C loop on: the same numbers to the
-        bit, so a run may change between its calls. Only ``accel`` is set (the loop takes it
-        before the interpreter's, which stays valid for a thread that read it a moment ago)."""
+        """Where this problem's M, k, q are provisional while their library compiles
+        (:class:`jourdain.numeric.functions.ProvisionalFunction`: interpreted, or built at -O0)
+        and the build is done, the library's right-hand side from the next call of the C loop
+        on: the same numbers to the bit, so a run may change between its calls. Only ``accel``
+        is set (the loop takes it before the provisional one, which stays valid for a thread
+        that read it a moment ago)."""
         if self.pending:
             self.problem.accel = self.pending[0].accel_address
             self.pending = None
