@@ -43,6 +43,7 @@ def prebuild_integrator(dest: Path) -> Path:
     _module("jourdain.errors", SRC / "jourdain" / "errors.py")
     _module("jourdain.numeric.cachefile", SRC / "jourdain" / "numeric" / "cachefile.py")
     _module("jourdain.numeric.buildlock", SRC / "jourdain" / "numeric" / "buildlock.py")
+    _module("jourdain.numeric.native", SRC / "jourdain" / "numeric" / "native.py")
     _module("jourdain.numeric.toolchain", SRC / "jourdain" / "numeric" / "toolchain.py")
     ic = _module("jourdain.numeric.integrator_c", SRC / "jourdain" / "numeric" / "integrator_c.py")
     return ic.prebuild(dest)

@@ -25,6 +25,7 @@ from .cachefile import dump_pickle, keep_sealed, load_pickle
 from .ccode import HEADER, argument_names, function_source
 from .cost import evaluation_path
 from .planar_recursion import planar_units, plane_normal
+from .recipes import keep_recipe, load_recipe, recipe_key
 from .recursive import layout, recursive_units
 from .symbolic_accel import accel_source, symbolic_source
 from .toolchain import (
@@ -155,6 +156,13 @@ def _load(system: System, names: tuple[str, ...], shapes: tuple[tuple[int, int],
         lib = build(key, source, extra_flags=("-O0",), unit_flags=unit_flags)
     else:
         lib = build(key, source, unit_flags=unit_flags)
+    return _function(system, names, shapes, key, lib, n_bodies, kind)
+
+
+def _function(system: System, names: tuple[str, ...], shapes: tuple[tuple[int, int], ...],
+              key: str, lib: ctypes.CDLL, n_bodies: int = 0,
+              kind: type[CompiledFunction] = CompiledFunction) -> CompiledFunction:
+    """The function of the loaded library ``lib`` (its C signatures declared)."""
     vp = ctypes.c_void_p
     lib.jd_fn.restype = None
     lib.jd_fn.argtypes = [vp, vp, ctypes.c_double, vp, vp, vp]
@@ -262,15 +270,43 @@ def mkq_function(system: System) -> CompiledFunction:
         compiler()
     except CompilerError:  # evaluated without C: the recursion's fallback
         return dynamics_function(system)
+    known = _recipe_key(system)
+    fn = cached_mkq(system)
+    if fn is not None:
+        return fn
     choice = evaluation_path(system)
     if choice.path == "symbolic" and choice.eom is not None:
         parts = _symbolic_parts(system)  # the source that the first run read
         assert parts is not None
         names, shapes, source, _ = parts
-        return _load(system, names, shapes, source)
-    if choice.path == "planar":
-        return planar_function(system)
-    return dynamics_function(system)
+        fn = _load(system, names, shapes, source)
+    else:
+        fn = (planar_function if choice.path == "planar" else dynamics_function)(system)
+    if known is not None and type(fn) is CompiledFunction:
+        keep_recipe(known, {"path": choice.path, "key": fn.key, "n_bodies": fn.n_bodies})
+    return fn
+
+
+@lru_cache(maxsize=32)
+def _recipe_key(system: System) -> str | None:
+    return recipe_key(system, "mkq_function", _GENERATOR_VERSION, ENGINE_FLAGS)
+
+
+def cached_mkq(system: System) -> CompiledFunction | None:
+    """:func:`mkq_function`'s library where a recipe of this very model names it and it is
+    cached (:mod:`jourdain.numeric.recipes`): nothing derived, generated or compiled; else
+    None."""
+    known = _recipe_key(system)
+    rec = load_recipe(known) if known is not None else None
+    if (rec is None or not isinstance(rec.get("key"), str) or not rec["key"].isalnum()
+            or type(rec.get("n_bodies")) is not int):
+        return None
+    lib = cached_library(rec["key"])
+    if lib is None:
+        return None
+    f = system.f
+    return _function(system, ("M", "k", "q"), ((f, f), (f, 1), (f, 1)), rec["key"], lib,
+                     rec["n_bodies"])
 
 
 def symbolic_mkq(system: System, eom: EquationsOfMotion) -> CompiledFunction:
@@ -326,6 +362,7 @@ def clear_cache(disk: bool = False) -> None:
     on-disk cache of compiled libraries (:func:`cache_dir`)."""
     _eom_function.cache_clear()
     mkq_function.cache_clear()
+    _recipe_key.cache_clear()
     _symbolic_parts.cache_clear()
     for clear in ALSO_CLEARED:
         clear()
@@ -338,7 +375,7 @@ def clear_cache(disk: bool = False) -> None:
         d = cache_dir()
         if d.is_dir():
             for p in d.iterdir():
-                if (p.suffix in (".so", ".c", ".llvm", ".sha256")
+                if (p.suffix in (".so", ".c", ".llvm", ".recipe", ".target", ".sha256")
                         or p.name.endswith((".so.tmp", ".c.tmp"))):
                     p.unlink(missing_ok=True)
                 elif p.is_dir() and (p.name.startswith(".build-") or p.name == "meshes"):

@@ -31,6 +31,7 @@ from .compiled import (
     _refuse_closed,
     _symbolic_parts,
     arguments,
+    cached_mkq,
     dynamics_function,
     library_key,
     mkq_function,
@@ -62,6 +63,9 @@ def _run_function(system: System) -> CompiledFunction:
         compiler()
     except CompilerError:
         return mkq_function(system)
+    known = cached_mkq(system)  # a warm start: nothing derived
+    if known is not None:
+        return known
     first: ProvisionalFunction | None = _interpreted(system) if FIRST_RUN_INTERPRETED else None
     if first is None and FIRST_RUN_QUICK and not os.environ.get("JOURDAIN_OPTIMIZE", "").strip():
         path = evaluation_path(system).path

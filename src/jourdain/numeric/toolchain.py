@@ -69,6 +69,7 @@ from .buildlock import build_soon as build_soon
 from .cachefile import FORMAT, discard, read_sealed, seal, stamp, stamp_of, stamp_source
 from .cachefile import keep_file as keep_file  # the cache's writer, for the other layers
 from .cachefile import not_private as not_private
+from .native import native_target_of
 
 #: Compiler flags; part of every cache key. No -ffast-math: NaN checks must keep working. No
 #: contraction to fused multiply-adds: the same results with and without FMA hardware.
@@ -167,7 +168,7 @@ def native_target() -> str | None:
     """What ``-march=native`` means to the compiler on this machine (the processor and the
     instruction set extensions it enables, as its driver reports them with ``-###``), or None
     when native code is off (``JOURDAIN_NATIVE=0``) or the compiler does not know the flag.
-    Asked once per process and compiler (a few milliseconds)."""
+    Asked once per processor and compiler (:mod:`jourdain.numeric.native`)."""
     if os.environ.get("JOURDAIN_NATIVE", "1").strip().lower() in ("0", "no", "false", "off"):
         return None
     try:
@@ -179,21 +180,8 @@ def native_target() -> str | None:
 
 @lru_cache(maxsize=8)
 def _native_target(cc: str) -> str | None:
-    try:
-        r = subprocess.run([cc, *NATIVE_FLAGS, "-###", "-c", "-x", "c", os.devnull, "-o",
-                            os.devnull], capture_output=True, text=True, timeout=60)
-    except (OSError, subprocess.SubprocessError):
-        return None
-    text = r.stdout + r.stderr
-    if r.returncode != 0 or "unrecognized" in text or "unsupported" in text:
-        return None
-    # the expanded target options: gcc's -march=znver3 -mavx2 ... --param l1-cache-size=48,
-    # clang's "-target-cpu" "znver3" "-target-feature" "+avx2" ...; not its temporary files
-    words = text.replace('"', " ").split()
-    keep = [w for i, w in enumerate(words)
-            if w.startswith(("-m", "l1-", "l2-"))
-            or (i > 0 and words[i - 1] in ("-target-cpu", "-target-feature", "-tune-cpu"))]
-    return " ".join(keep) or None
+    # kept in the cache once it exists (an install, which prebuilds, creates none)
+    return native_target_of(cc, NATIVE_FLAGS, library_dir() if cache_dir().is_dir() else None)
 
 
 #: compilers whose native build failed in this process (then portable code)
