@@ -63,9 +63,8 @@ def _run_function(system: System) -> CompiledFunction:
         compiler()
     except CompilerError:
         return mkq_function(system)
-    known = cached_mkq(system)  # a warm start: nothing derived
-    if known is not None:
-        return known
+    if cached_mkq(system) is not None:  # a warm start: nothing derived
+        return mkq_function(system)  # (the memoized one, which takes the same recipe)
     first: ProvisionalFunction | None = _interpreted(system) if FIRST_RUN_INTERPRETED else None
     if first is None and FIRST_RUN_QUICK and not os.environ.get("JOURDAIN_OPTIMIZE", "").strip():
         path = evaluation_path(system).path
