@@ -23,7 +23,14 @@
  * to the compiler), and each stage's sum but its last term summed one stage ahead (while the
  * previous stage's right-hand side runs, the last term added once its K is known). What is
  * left is spread thin: jd_integrate 2 %, pow 1.8 %, memcpy 1.2 %, error_sums8 0.9 %, and
- * jd_accel itself about 6 % slower inside the loop than alone (perf's share). */
+ * jd_accel itself about 6 % slower inside the loop than alone (perf's share). A second pass
+ * (benchmarks/setup.py has its figures): jd_accel "alone" was timed on independent states,
+ * whose calls the processor overlaps (0.077 µs each); each waiting on the last, as a stage
+ * waits on the one before, it takes 0.100 µs, and the loop adds 0.01 µs to that (with a
+ * right-hand side of no cost the loop takes 0.029 µs per right-hand side, mostly hidden
+ * under jd_accel's latency). Tried and left out, slower: a stage sum's last term (the stage
+ * just computed) added in scalars (0.113 → 0.121 µs); no faster within the noise: K_0
+ * copied once per step instead of twice (x's and k0's copies are off the critical path). */
 #include <math.h>
 #include <string.h>
 #if defined(__GNUC__)
