@@ -29,7 +29,7 @@
  * waits on the one before, it takes 0.100 µs, and the loop adds 0.01 µs to that (with a
  * right-hand side of no cost the loop takes 0.029 µs per right-hand side, mostly hidden
  * under jd_accel's latency). Tried and left out, slower: a stage sum's last term (the stage
- * just computed) added in scalars (0.113 → 0.121 µs); no faster within the noise: K_0
+ * just computed) added in scalars (0.115 → 0.122 µs); no faster within the noise: K_0
  * copied once per step instead of twice (x's and k0's copies are off the critical path). */
 #include <math.h>
 #include <string.h>
