@@ -24,11 +24,15 @@ Below the table, in this process (the model compiled and memoized, as in a user'
   ``t_eval=[1e-9]``, and of calls with a new parameter value each (a sweep, which the memo of
   run templates never serves), in µs per call, next to the figures before the memo
   (:data:`BEFORE_US`): what a call costs outside the C step loop (the target: 20 µs);
-* ``step loop``: a 10 s run of the same model (DOP853, the default tolerances): its time per
-  right-hand side evaluation against one ``jd_accel`` call timed alone in C (the model's
-  ÿ = M⁻¹(q − k) with its LDLᵀ solve, :data:`ACCEL_LOOP` calling it on 10 000 states, best of
-  5): the loop's share of a right-hand side (its step arithmetic, error control and output;
-  the target: 30 %), and, as before, against the compiled M, k, q per state (``fn.batch``).
+* ``step loop``: a 10 s run of the same model (DOP853, the default tolerances; best of 20
+  runs, 3 before 2026-11-27's second pass: a 1 ms run on a shared machine needs more than 3
+  to reach its time): its time per right-hand side evaluation against one ``jd_accel`` call
+  timed alone in C (the model's ÿ = M⁻¹(q − k) with its LDLᵀ solve, :data:`ACCEL_LOOP`
+  calling it on 10 000 states, best of 5): the loop's share of a right-hand side (its step
+  arithmetic, error control and output; the target: 30 %), against the calls on
+  independent states (as before) and chained (each call's state waiting on the last call's
+  results, as each stage of a step waits on the one before: the time a stage must wait;
+  since 2026-11-27), and, as before, against the compiled M, k, q per state (``fn.batch``).
 
 Measured 2026-11-27 (issue 35's memo of run templates; the same 2-core machine, medians of
 3000 calls, the old and the new tree run one after the other in quiet minutes: other work
@@ -38,6 +42,18 @@ in a 10 s run of 1.55 ms, best of 20) against jd_accel's 0.095 µs alone: the lo
 right-hand side (target 30 %: not met; M, k, q alone 0.055-0.069 µs). Then the step loop's
 vector tiles (``numeric/integrator_kernels.h``; ``--quick`` twice, old and new trees in turn):
 0.137-0.145 → 0.117 µs per right-hand side, jd_accel 0.077-0.083 µs: 75-78 → 46-51 % (not met).
+Then a second pass (2026-11-27; the old and the new library alternated in one process by a C
+driver, best of 100 runs, 3-10 rounds each, a loaded 2-core AMD EPYC): the error norm and the
+PI factor before the right-hand side at x_new, the stage sums' tiles in registers
+(``integrator_kernels.h``, ``integrator_explicit.h``; the same numbers to the bit): 0.1132-0.1134
+→ 0.1120-0.1127 µs per right-hand side; jd_accel alone on independent states 0.077-0.083 µs
+(the loop 44-47 → 43-46 %, not met), chained 0.100-0.111 µs (the loop 2-13 → 1-12 %, met).
+What the profile showed: the loop with a right-hand side of no cost takes 0.029 µs per
+right-hand side (490 → 405 instructions), but beside the model's it adds 0.01 µs, hidden
+under jd_accel's latency; the rest of the 46 % is jd_accel's own latency (0.100 µs) against
+its throughput (0.077 µs: the processor overlaps consecutive independent calls, which the
+stages of a Runge–Kutta step, each waiting on the one before, never are). The chained figure
+measures what a stage waits for; the independent one stays printed beside it.
 
 The first run interpreted while the model compiles (``numeric/interpreter.py``; symbolic-path
 models), 2026-11-27, ``--trials 3 --mujoco``, one run each, the same machine (before: the tree
@@ -235,9 +251,13 @@ def starts(kind: str, n: int, trials: int, mujoco: bool) -> dict:
 #: function, 2-core AMD EPYC): the plain call and the one with t_eval (µs)
 BEFORE_US = {"plain": 72.0, "t_eval": 81.0}
 
-#: a C loop that calls the model's ``jd_accel`` (ÿ = M⁻¹(q − k) and the power ẏᵀq: the
-#: model's part of a right-hand side) on ``m`` states through a function pointer, as the
-#: integrator does, ``reps`` times
+#: C loops that call the model's ``jd_accel`` (ÿ = M⁻¹(q − k) and the power ẏᵀq: the model's
+#: part of a right-hand side) on ``m`` states through a function pointer, as the integrator
+#: does, ``reps`` times: ``jd_accel_loop`` on states independent of each other (the processor
+#: runs one call's start beside the last one's end: its throughput), ``jd_accel_chain`` with
+#: each call's ẏ waiting on the last call's ÿ and its y on the last call's ẏ, as the state of
+#: a Runge–Kutta stage waits on the stage before (its latency; the wait is one multiply and
+#: one add per component, the least that a stage's sum does)
 ACCEL_LOOP = r"""
 typedef int (*jd_accel_fn)(const double *y, const double *yd, double t, const double *p,
                            const double *u, double *ydd, double *power);
@@ -252,13 +272,32 @@ double jd_accel_loop(void *fn, const double *Y, const double *YD, long m, long f
         }
     return sum;
 }
+double jd_accel_chain(void *fn, const double *Y, const double *YD, long m, long f,
+                      const double *p, const double *u, long reps, double *ydd) {
+    jd_accel_fn accel = (jd_accel_fn)fn;
+    double power = 0.0, sum = 0.0, y[64], yd[64];
+    if (f > 64) return 0.0;
+    for (long j = 0; j < f; ++j) { yd[j] = 0.0; ydd[j] = 0.0; }
+    for (long r = 0; r < reps; ++r)
+        for (long i = 0; i < m; ++i) {
+            for (long j = 0; j < f; ++j) {  /* + 0·(the last call's results) */
+                y[j] = Y[i * f + j] + 0.0 * yd[j];
+                yd[j] = YD[i * f + j] + 0.0 * ydd[j];
+            }
+            accel(y, yd, 0.0, p, u, ydd, &power);
+            sum += ydd[0] + power;
+        }
+    return sum;
+}
 """
 
 
-def accel_seconds(fn, f: int, p, u, m: int = 10000, reps: int = 5) -> float:
+def accel_seconds(fn, f: int, p, u, m: int = 10000, reps: int = 5,
+                  chained: bool = False) -> float:
     """One ``jd_accel`` call of the compiled ``fn`` (:func:`jourdain.numeric.mkq_function`)
     timed alone in C (:data:`ACCEL_LOOP`: one ctypes call per ``m`` states, best of
-    ``reps``), at random states."""
+    ``reps``), at random states; ``chained``: each call's state waiting on the last call's
+    results, as in the stages of a step."""
     import ctypes
 
     import numpy as np
@@ -266,7 +305,7 @@ def accel_seconds(fn, f: int, p, u, m: int = 10000, reps: int = 5) -> float:
     from jourdain.numeric import toolchain
 
     lib = toolchain.build(toolchain.content_key("bench-accel-loop", ACCEL_LOOP), ACCEL_LOOP)
-    loop = lib.jd_accel_loop
+    loop = lib.jd_accel_chain if chained else lib.jd_accel_loop
     vp, lg = ctypes.c_void_p, ctypes.c_long
     loop.restype = ctypes.c_double
     loop.argtypes = [vp, vp, vp, lg, lg, vp, vp, lg, vp]
@@ -320,7 +359,7 @@ def overhead(repeat: int = 300) -> dict:
                                                  t_eval=[1e-9]), repeat)
     sweep = per_call_us(lambda: system.simulate((0.0, 1e-9), y0, yd0, inputs=u,
                                                 parameters={"g": next(g)}), repeat)
-    long = min((system.simulate((0.0, 10.0), y0, yd0, inputs=u) for _ in range(3)),
+    long = min((system.simulate((0.0, 10.0), y0, yd0, inputs=u) for _ in range(20)),
                key=lambda r: r.wall_time)
     rng = np.random.default_rng(0)
     m = 10000
@@ -331,13 +370,17 @@ def overhead(repeat: int = 300) -> dict:
         fn.batch(Y, YD, 0.0, None, np.zeros((m, 1)))
         best = min(best, time.perf_counter() - t0)
     mkq_s = best / m
-    accel_s = accel_seconds(fn, f, parameter_vector(system, None), [0.0])
+    pv = parameter_vector(system, None)
+    accel_s = accel_seconds(fn, f, pv, [0.0])
+    chain_s = accel_seconds(fn, f, pv, [0.0], chained=True)
     per_eval = long.wall_time / long.nfev
     return {"simulate_us": plain, "simulate_t_eval_us": t_eval, "simulate_sweep_us": sweep,
             "short_nfev": short.nfev, "run_s": long.wall_time, "run_nfev": long.nfev,
             "per_eval_us": 1e6 * per_eval, "mkq_us": 1e6 * mkq_s,
             "loop_share_pct": 100.0 * (per_eval - mkq_s) / mkq_s, "accel_us": 1e6 * accel_s,
-            "accel_share_pct": 100.0 * (per_eval - accel_s) / accel_s}
+            "accel_share_pct": 100.0 * (per_eval - accel_s) / accel_s,
+            "accel_chain_us": 1e6 * chain_s,
+            "chain_share_pct": 100.0 * (per_eval - chain_s) / chain_s}
 
 
 def _mark(value: float, target: float) -> str:
@@ -373,7 +416,10 @@ def table(rows: list[dict], over: dict | None) -> str:
                    f"one jd_accel alone {over['accel_us']:.3f} µs: the loop "
                    f"{over['accel_share_pct']:.0f} % of a right-hand side (target "
                    f"{TARGET_LOOP_SHARE:.0f} %: "
-                   f"{_mark(over['accel_share_pct'], TARGET_LOOP_SHARE)}); against M, k, q "
+                   f"{_mark(over['accel_share_pct'], TARGET_LOOP_SHARE)}); against one "
+                   f"jd_accel waiting on the last, as a stage does, {over['accel_chain_us']:.3f}"
+                   f" µs: {over['chain_share_pct']:.0f} % ("
+                   f"{_mark(over['chain_share_pct'], TARGET_LOOP_SHARE)}); against M, k, q "
                    f"per state {over['mkq_us']:.3f} µs: {over['loop_share_pct']:.0f} %")
     return "\n".join(out)
 

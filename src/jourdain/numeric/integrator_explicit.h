@@ -1,5 +1,28 @@
 /* jourdain's integrator library, part 4 of 4: the step loop of the explicit methods and its
  * entry points jd_integrate and jd_rhs. */
+/* DOP853's error norm of the trial step from x to x_new (Hairer, Norsett & Wanner I, II.10:
+   the 5th-order estimate scaled by the 3rd-order one); its rows S + 1 and S + 2 */
+static double error_norm8(long n, const jd_problem *P, const jd_row *rows, double h,
+                          const double *x, const double *x_new, const double *K, double *sc,
+                          double *e5v, double *e3v) {
+    double e5 = 0.0, e3 = 0.0;
+    error_scales(n, P->atol, P->rtol, x, x_new, sc);
+    stage_sum(n, rows, 1.0, NULL, K, e5v);
+    stage_sum(n, rows + 1, 1.0, NULL, K, e3v);
+    error_sums8(n, e5v, e3v, sc, &e5, &e3);
+    return (e5 == 0.0 && e3 == 0.0) ? 0.0 : h * e5 / sqrt((e5 + 0.01 * e3) * (double)n);
+}
+
+/* PI step-size control of an accepted step (Gustafsson; Hairer, Norsett & Wanner I, II.4 and
+   Hairer & Wanner II, IV.2): h_new = h * safety * en^-alpha * en_old^beta. Against the plain
+   en^(-1/k) it rejects a quarter as many steps on the benchmarks' pendulums and needs 10-17 %
+   fewer evaluations for the same error. */
+static double pi_factor(const jd_method *m, double en, double en_old) {
+    const double SAFETY = 0.9, MAX_FACTOR = 10.0;
+    return en == 0.0 ? MAX_FACTOR
+        : fmin(MAX_FACTOR, SAFETY * pow(en, -m->pi_alpha) * pow(en_old, m->pi_beta));
+}
+
 /*
  * Advance from st[0] = t towards t_end. st[1] holds the step size (0: choose one), st[2]
  * whether the last trial step was rejected and st[3] the last accepted step's error (0: none
@@ -40,7 +63,7 @@ int jd_integrate(const jd_problem *P, double t_end, double *st, double *x, doubl
     double t = st[0], h = st[1];
     int status = JD_CONTINUE, r = 0;
     long steps = 0;
-    const double SAFETY = 0.9, MIN_FACTOR = 0.2, MAX_FACTOR = 10.0;
+    const double SAFETY = 0.9, MIN_FACTOR = 0.2;
 
     if (!cnt[4]) {  /* the start of a run */
         r = rhs(&c, t, x, k0);
@@ -109,8 +132,21 @@ int jd_integrate(const jd_problem *P, double t_end, double *st, double *x, doubl
             int fin = stage_sum(n, rows + si, h, x, K, xs);
             r = rhs_at(&c, t + m->C[si] * h, xs, K + si * n, fin);
         }
+        /* DOP853: the error norm and the next step's factor (pure arithmetic on K_0 … K_11,
+           whose error rows have no term in the last stage) before the right-hand side at
+           x_new, not after it: in the order of the program they come before that call's
+           long chain of dependent operations, and the processor does them beside it, where
+           after it they waited for its end (they decide the next step's h, which its first
+           stage needs). Measured (cart(4), 10 s, one process alternating the libraries,
+           best of 100 runs, 4-10 rounds): 0.1132-0.1133 → 0.1119-0.1120 µs per right-hand
+           side. The same operations on the same values: the same numbers to the bit. */
+        double en = 0.0, factor = 0.0;
         if (!r) {
             int fin = stage_sum(n, rows + S, h, x, K, x_new);
+            if (P->method == 1 && fin) {
+                en = error_norm8(n, P, rows + S + 1, h, x, x_new, K, sc, err, xe);
+                if (en <= 1.0) factor = pi_factor(m, en, en_old);
+            }
             r = rhs_at(&c, t_new, x_new, K + S * n, fin);
         }
         cnt[1]++; steps++;
@@ -121,18 +157,13 @@ int jd_integrate(const jd_problem *P, double t_end, double *st, double *x, doubl
             if (h < h_min * 4.0) { fail[0] = c.fail_t; status = r; break; }
             continue;
         }
-        /* error estimate */
-        error_scales(n, P->atol, P->rtol, x, x_new, sc);
-        double en;
-        if (P->method == 1) {
-            double e5 = 0.0, e3 = 0.0, *a3v = xe;
-            stage_sum(n, rows + S + 1, 1.0, NULL, K, err);
-            stage_sum(n, rows + S + 2, 1.0, NULL, K, a3v);
-            error_sums8(n, err, a3v, sc, &e5, &e3);
-            en = (e5 == 0.0 && e3 == 0.0) ? 0.0 : h * e5 / sqrt((e5 + 0.01 * e3) * (double)n);
-        } else {
+        /* RK45's error estimate (with a term in the last stage: after it; DOP853 with x_new
+           not finite does not get here, rhs_at failed) */
+        if (P->method != 1) {
+            error_scales(n, P->atol, P->rtol, x, x_new, sc);
             error_rk5(n, S + 1, h, RK5_E, K, err);
             en = rms_scaled(n, err, sc);
+            if (en <= 1.0) factor = pi_factor(m, en, en_old);
         }
         if (!(en <= 1.0)) {
             if (!isfinite(en)) en = 1e10;
@@ -157,12 +188,7 @@ int jd_integrate(const jd_problem *P, double t_end, double *st, double *x, doubl
         memcpy(x, x_new, n * sizeof(double));
         memcpy(k0, K + S * n, n * sizeof(double));
         t = t_new;
-        /* PI step-size control (Gustafsson; Hairer, Norsett & Wanner I, II.4 and Hairer &
-           Wanner II, IV.2): h_new = h * safety * en^-alpha * en_old^beta. Against the plain
-           en^(-1/k) it rejects a quarter as many steps on the benchmarks' pendulums and needs
-           10-17 % fewer evaluations for the same error. */
-        double factor = en == 0.0 ? MAX_FACTOR
-            : fmin(MAX_FACTOR, SAFETY * pow(en, -m->pi_alpha) * pow(en_old, m->pi_beta));
+        /* PI step-size control (pi_factor) */
         en_old = fmax(en, 1e-4);
         if (rejected) factor = fmin(1.0, factor);
         rejected = 0;

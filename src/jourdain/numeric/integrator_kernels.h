@@ -23,7 +23,14 @@
  * to the compiler), and each stage's sum but its last term summed one stage ahead (while the
  * previous stage's right-hand side runs, the last term added once its K is known). What is
  * left is spread thin: jd_integrate 2 %, pow 1.8 %, memcpy 1.2 %, error_sums8 0.9 %, and
- * jd_accel itself about 6 % slower inside the loop than alone (perf's share). */
+ * jd_accel itself about 6 % slower inside the loop than alone (perf's share). A second pass
+ * (benchmarks/setup.py has its figures): jd_accel "alone" was timed on independent states,
+ * whose calls the processor overlaps (0.077 µs each); each waiting on the last, as a stage
+ * waits on the one before, it takes 0.100 µs, and the loop adds 0.01 µs to that (with a
+ * right-hand side of no cost the loop takes 0.029 µs per right-hand side, mostly hidden
+ * under jd_accel's latency). Tried and left out, slower: a stage sum's last term (the stage
+ * just computed) added in scalars (0.115 → 0.122 µs); no faster within the noise: K_0
+ * copied once per step instead of twice (x's and k0's copies are off the critical path). */
 #include <math.h>
 #include <string.h>
 #if defined(__GNUC__)
@@ -95,24 +102,35 @@ typedef double jd_v4 __attribute__((vector_size(32)));
 #define JD_LOAD4(v, p) memcpy(&(v), (p), sizeof(v))  /* unaligned */
 #define JD_INLINE static inline __attribute__((always_inline))
 
-/* the groups of four at o[0 … G) of one tile; returns Σ out·0 over them */
+/* the groups of four at o0, o1, o2 of one tile (the first G of them); returns Σ out·0 over
+   them. Its sums in three named vectors, not an array of three: with the array, GCC 12 kept
+   the loops over the groups of the start and the end as loops through the stack (and zeroed
+   it with rep stos where x is NULL), 253 instructions per call at n = 11 (callgrind), of
+   which 90 the sums themselves; named, the compiler holds them in registers throughout: 180
+   per call, the loop's instructions per right-hand side 490 → 405 (cart(4) with a
+   right-hand side of no cost, 10 s). Its time there 0.0287 → 0.0282 µs per right-hand side,
+   with the model's 0.1132 → 0.1125 µs (a C driver alternating the libraries in one
+   process, best of 100 runs, 4 rounds): the loop waits on latencies more than on its
+   instructions. The same operations in the same order: the same numbers to the bit. */
 JD_INLINE double tile(int G, const jd_row *r, double h, const double *K, long n,
-                      const double *x, const long *o, double *out) {
-    jd_v4 acc[3], kt;
-    for (int g = 0; g < G; ++g) {
-        if (x) JD_LOAD4(acc[g], x + o[g]);
-        else acc[g] = (jd_v4){0.0, 0.0, 0.0, 0.0};
+                      const double *x, long o0, long o1, long o2, double *out) {
+    jd_v4 a0 = {0.0, 0.0, 0.0, 0.0}, a1 = a0, a2 = a0, kt;
+    if (x) {
+        JD_LOAD4(a0, x + o0);
+        if (G > 1) JD_LOAD4(a1, x + o1);
+        if (G > 2) JD_LOAD4(a2, x + o2);
     }
     for (int t = 0; t < r->q; ++t) {
         const double *k = K + r->j[t] * n, w = h * r->a[t];
         jd_v4 wt = {w, w, w, w};
-        for (int g = 0; g < G; ++g) { JD_LOAD4(kt, k + o[g]); acc[g] += wt * kt; }
+        JD_LOAD4(kt, k + o0); a0 += wt * kt;
+        if (G > 1) { JD_LOAD4(kt, k + o1); a1 += wt * kt; }
+        if (G > 2) { JD_LOAD4(kt, k + o2); a2 += wt * kt; }
     }
-    jd_v4 z = acc[0] * 0.0;
-    for (int g = 0; g < G; ++g) {
-        memcpy(out + o[g], &acc[g], sizeof acc[g]);
-        if (g) z += acc[g] * 0.0;
-    }
+    jd_v4 z = a0 * 0.0;
+    memcpy(out + o0, &a0, sizeof a0);
+    if (G > 1) { memcpy(out + o1, &a1, sizeof a1); z += a1 * 0.0; }
+    if (G > 2) { memcpy(out + o2, &a2, sizeof a2); z += a2 * 0.0; }
     return (z[0] + z[1]) + (z[2] + z[3]);
 }
 
@@ -121,11 +139,11 @@ JD_INLINE int stage_body(long n, const jd_row *r, double h, const double *x, con
     double z = 0.0;  /* x·0 is 0 for finite x, NaN for inf or NaN */
     long groups = (n + 3) / 4;
     for (long g = 0; g < groups; g += 3) {
-        long o[3];
-        for (int k = 0; k < 3; ++k) o[k] = 4 * (g + k) < n - 4 ? 4 * (g + k) : n - 4;
-        long left = groups - g;
-        z += left >= 3 ? tile(3, r, h, K, n, x, o, out) : left == 2 ? tile(2, r, h, K, n, x, o, out)
-                                                                     : tile(1, r, h, K, n, x, o, out);
+        long o0 = 4 * g < n - 4 ? 4 * g : n - 4, o1 = 4 * g + 4 < n - 4 ? 4 * g + 4 : n - 4,
+             o2 = 4 * g + 8 < n - 4 ? 4 * g + 8 : n - 4, left = groups - g;
+        z += left >= 3 ? tile(3, r, h, K, n, x, o0, o1, o2, out)
+             : left == 2 ? tile(2, r, h, K, n, x, o0, o1, o2, out)
+                         : tile(1, r, h, K, n, x, o0, o1, o2, out);
     }
     return z == 0.0;
 }
