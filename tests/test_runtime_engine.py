@@ -22,13 +22,12 @@ from jourdain.numeric.runtime_engine import RuntimeFunction, runtime_function
 
 @pytest.fixture
 def fresh_cache(tmp_path, monkeypatch):
-    """An empty library cache (the integrator prebuilt, or built here first), nothing
-    memoized; the model's background build held back: ``jobs`` gets it, ``compiles`` the
+    """An empty library cache (the integrator's library at hand), nothing memoized; the model's background build held back: ``jobs`` gets it, ``compiles`` the
     compiler's runs from then on."""
     monkeypatch.setenv("JOURDAIN_CACHE", str(tmp_path))
     monkeypatch.setattr(toolchain, "_loaded", {})
     compiled.clear_cache()
-    integrator_library()  # as installed: prebuilt (or built by an earlier test), not spied on
+    integrator_library()  # at hand before the spy (prebuilt at install; in the tests built once)
     jobs: list = []
     compiles: list = []
     real = toolchain._compile

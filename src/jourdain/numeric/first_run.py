@@ -4,20 +4,19 @@ runs in the background).
 
 :func:`run_function` gives :func:`jourdain.numeric.compiled.mkq_function` where its library is
 loaded, cached or prebuilt. Where it is not, the first runs take a
-:class:`~jourdain.numeric.functions.ProvisionalFunction` while a thread builds the library,
-with nothing compiled before the first number:
+:class:`~jourdain.numeric.functions.ProvisionalFunction` while a thread builds the library:
 
 * on the symbolic path, the generated C read by the interpreter of the integrator's library
-  (:mod:`jourdain.numeric.interpreter`);
+  (:mod:`jourdain.numeric.interpreter`): nothing compiled before the first number;
 * on the recursions' paths (whose engines are C with the model's sizes as constants), the
-  engine of the integrator's library sized at run time, with the per-joint code on the
-  interpreter (:mod:`jourdain.numeric.runtime_engine`);
-* where the interpreter cannot read the per-joint code, the recursion's units compiled at -O0
-  under a key of their own: the compiler's front end alone (0.2 against 0.35-0.7 s for the
-  31-link cart and the spatial chains of 8 and 16 bodies), when no ``JOURDAIN_OPTIMIZE`` level
-  is set (that one is already a short compile).
+  same engines in the integrator's library sized at run time, their per-joint code on the
+  interpreter (:mod:`jourdain.numeric.runtime_engine`): nothing compiled either;
+* where the interpreter cannot read that per-joint code, the recursion's units compiled at
+  -O0 under a key of their own: the compiler's front end alone (0.2 against 0.35-0.7 s for
+  the 31-link cart and the spatial chains of 8 and 16 bodies), when no ``JOURDAIN_OPTIMIZE``
+  level is set (that one is already a short compile).
 
-Both give the library's numbers to the bit, so a motion never depends on whether the library
+All give the library's numbers to the bit, so a motion never depends on whether the library
 was built yet, and a run moves to the library between two calls of its C loop
 (``_Setup.take_compiled``). A forked child builds for itself; a failed build is reported once
 by a warning, and the runs stay on the provisional function.
