@@ -72,12 +72,14 @@ UNITS: tuple[tuple[str, tuple[str, ...], tuple[str, ...]], ...] = (
      "#define jd_solve_mkq jd_solve_loop\n",
      ("jd_inline.h", "sincos.h", "ldl_solve.h", "interpreter.h"), ()),
     # the recursions' engines sized at run time, planar and spatial (runtime_head.h: their
-    # jd_local on the interpreter above, numeric/runtime_engine.py), with the flags of a
-    # model's engine unit (compiled.ENGINE_FLAGS)
+    # jd_local on the interpreter above, numeric/runtime_engine.py); at -O1, which reorders no
+    # arithmetic either: where the library is not prebuilt, they add 0.25-0.35 s to its build
+    # (0.6 s at -O2; 0.65-0.9 s without them; 2-core AMD EPYC, 2026-11-27), and their first
+    # runs take 1.3-2 times the model library's time per state at either level
     ("#define JD_RT_PLANAR 1\n", ("runtime_head.h", "planar_engine.h", "runtime_engine.h"),
-     ("-fpeel-loops", "-funswitch-loops")),
+     ("-O1",)),
     ("#define JD_RT_PLANAR 0\n", ("runtime_head.h", "recursive_engine.h", "runtime_engine.h"),
-     ("-fpeel-loops", "-funswitch-loops")),
+     ("-O1",)),
 )
 
 _TABLE = re.compile(r"static const double (\w+)(?:\[\d+\])? = \{?([^};]*)\}?;")
