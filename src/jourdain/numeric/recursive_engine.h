@@ -31,10 +31,10 @@ static inline void jd_inertia_twist(const double *I, const double *V, double *F)
 
 /* everything but the projection: frames, twist columns V (6 per column), composite inertias
    Ic (13 per body), composite wrenches of q_c (Bc) and q_e (Wc), per body also the centre of
-   mass acceleration, Euler term and applied force rows for the full output */
-/* (its arrays by type, name and length, as an X-macro: JD_ARRAY makes each an array of its
-   length here, and a pointer into one allocation in the runtime-sized engine (runtime_head.h,
-   whose JD_RT_FIELD adds the sizes and tables it reads)) */
+   mass acceleration, Euler term and applied force rows for the full output. Its arrays by
+   type, name and length, as an X-macro: JD_ARRAY makes each an array of its length here, and
+   a pointer into one allocation in the runtime-sized engine (runtime_head.h, whose
+   JD_RT_FIELD adds the sizes and tables it reads) */
 #ifndef JD_ARRAY
 #define JD_ARRAY(type, name, n) type name[n];
 #define JD_RT_FIELD
