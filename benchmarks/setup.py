@@ -77,7 +77,12 @@ the recursions' first runs on their units compiled at -O0 while the -O2 library 
 (``numeric/first_run.py``; the old and the new tree in turn, ``--trials 3``, a loaded
 machine: import 0.23-0.26 s; motions the same to the bit): cold, build + first step after
 the import, cart(31) 0.311 → 0.224 s, chain(8) 0.625 → 0.241 s, chain(16) 0.709 → 0.238 s;
-import → first step 0.564 → 0.455, 0.936 → 0.472 and 0.952 → 0.509 s.
+import → first step 0.564 → 0.455, 0.936 → 0.472 and 0.952 → 0.509 s. Then without a
+compiler before the first number: the recursions' engines sized at run time in the prebuilt
+integrator library, their per-joint code interpreted (``numeric/runtime_engine.py``;
+2026-11-27, the old and the new tree in turn, 3 trials each, best; motions the same to the
+bit): cold, build + first step after the import, cart(31) 0.286 → 0.088 s, chain(8)
+0.324 → 0.077 s, chain(16) 0.245 → 0.054 s.
 
     .venv/bin/python benchmarks/setup.py                   # f = 2 … 32, 5 trials (minutes)
     .venv/bin/python benchmarks/setup.py --quick           # f = 2 and 5, 2 trials

@@ -41,10 +41,14 @@ def test_each_unit_is_compiled_with_its_own_flags(fresh_cache):
 
 def test_the_units_follow_their_table():
     """The kernels' unit defines JD_KERNELS (the definitions) and is the one at -O3; the step
-    loops' unit declares the kernels and holds the entry points."""
-    (main, main_flags), (kernels, kernel_flags), (interp, interp_flags) = integrator_c.units()
+    loops' unit declares the kernels and holds the entry points; the interpreter and the
+    recursions sized at run time (planar, spatial) follow."""
+    (main, main_flags), (kernels, kernel_flags), (interp, interp_flags), *engines = \
+        integrator_c.units()
     assert main_flags == () and kernel_flags == ("-O3",) and interp_flags == ()
     assert "int jd_interp_accel(" in interp and "int jd_interp_accel(" not in main
+    assert [text.split("\n", 1)[0] for text, _ in engines] == [
+        "#define JD_RT_PLANAR 1", "#define JD_RT_PLANAR 0"]
     assert kernels.startswith("#define JD_KERNELS 1") and "JD_KERNELS 1" not in main
     assert "int jd_integrate(" in main and "int jd_integrate(" not in kernels
     assert "int stage_sum(" in main and "int stage_sum(" in kernels  # declared; defined
@@ -67,9 +71,9 @@ def test_two_units_give_the_numbers_of_one_unit_bit_for_bit(fresh_cache, monkeyp
     called across units) must give the same trajectories and evaluation counts to the last
     bit for the explicit methods and Radau IIA: vectorizing reorders no sum."""
     two = _runs()
-    (main, _), _, interp = integrator_c.units()
+    (main, _), _, *rest = integrator_c.units()  # the interpreter and the engines as they are
     monkeypatch.setattr(integrator_c, "units",
-                        lambda: (("#define JD_KERNELS 1\n" + main, ()), interp))
+                        lambda: (("#define JD_KERNELS 1\n" + main, ()), *rest))
     problem.integrator_library.cache_clear()
     one = _runs()
     for (y2, yd2, n2), (y1, yd1, n1) in zip(two, one, strict=True):

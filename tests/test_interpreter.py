@@ -249,11 +249,13 @@ def test_a_cached_library_is_taken_at_once(fresh_cache):
 @pytest.mark.parametrize("model", [jd.models.planar_chain(40), spatial_chain(8)],
                          ids=["planar", "spatial"])
 def test_recursion_paths_run_first_on_their_build_at_O0(fresh_cache, monkeypatch, model):
-    """The interpreter reads the symbolic path's code; a model on a recursion runs first on its
-    units compiled at -O0 (where no JOURDAIN_OPTIMIZE level is set) while the optimized
-    library compiles: the same motion to the bit, then the library."""
+    """Where its engine sized at run time is not taken (tests/test_runtime_engine.py), a model
+    on a recursion runs first on its units compiled at -O0 (where no JOURDAIN_OPTIMIZE level is
+    set) while the optimized library compiles: the same motion to the bit, then the
+    library."""
     from jourdain.numeric.functions import ProvisionalFunction
 
+    monkeypatch.setattr(first_run, "FIRST_RUN_RUNTIME", False)
     monkeypatch.setenv("JOURDAIN_OPTIMIZE", "1")  # a short compile already: no first build
     assert not isinstance(first_run.run_function(model), ProvisionalFunction)
     compiled.clear_cache()

@@ -348,9 +348,20 @@ def planar_function(system: System, quick: bool = False) -> CompiledFunction:
     :func:`~jourdain.numeric.planar_recursion.is_planar`), memoized per system."""
     _refuse_closed(system)
     f = system.f
-    local, engine, _ = planar_units(system, accel_source(f))
-    return _load(system, ("M", "k", "q"), ((f, f), (f, 1), (f, 1)), (local, engine),
-                 unit_flags=((), ENGINE_FLAGS), quick=quick)
+    return _load(system, ("M", "k", "q"), ((f, f), (f, 1), (f, 1)),
+                 recursion_units(system, planar=True), unit_flags=((), ENGINE_FLAGS),
+                 quick=quick)
+
+
+def recursion_units(system: System, planar: bool) -> tuple[str, str]:
+    """The units of :func:`planar_function` (``planar``) or :func:`dynamics_function` (as
+    :func:`_recursive` forms them with ``accel``): the generated per-joint code and the engine
+    with the integrator's ``jd_accel``, which a first run on the engine sized at run time reads
+    (:mod:`jourdain.numeric.runtime_engine`)."""
+    if planar:
+        local, engine, _ = planar_units(system, accel_source(system.f))
+        return local, engine
+    return recursive_units(system, accel_template=accel_source(system.f))
 
 
 #: the memos of modules above this one that clear_cache empties too (they add themselves)

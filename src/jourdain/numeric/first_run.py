@@ -8,12 +8,15 @@ loaded, cached or prebuilt. Where it is not, the first runs take a
 
 * on the symbolic path, the generated C read by the interpreter of the integrator's library
   (:mod:`jourdain.numeric.interpreter`): nothing compiled before the first number;
-* on the recursions' paths (whose engines are C with the model's sizes as constants), the same
-  units compiled at -O0 under a key of their own: the compiler's front end alone
-  (0.2 against 0.35-0.7 s for the 31-link cart and the spatial chains of 8 and 16 bodies),
-  when no ``JOURDAIN_OPTIMIZE`` level is set (that one is already a short compile).
+* on the recursions' paths (whose engines are C with the model's sizes as constants), the
+  same engines in the integrator's library sized at run time, their per-joint code on the
+  interpreter (:mod:`jourdain.numeric.runtime_engine`): nothing compiled either;
+* where the interpreter cannot read that per-joint code, the recursion's units compiled at
+  -O0 under a key of their own: the compiler's front end alone (0.2 against 0.35-0.7 s for
+  the 31-link cart and the spatial chains of 8 and 16 bodies), when no ``JOURDAIN_OPTIMIZE``
+  level is set (that one is already a short compile).
 
-Both give the library's numbers to the bit, so a motion never depends on whether the library
+All give the library's numbers to the bit, so a motion never depends on whether the library
 was built yet, and a run moves to the library between two calls of its C loop
 (``_Setup.take_compiled``). A forked child builds for itself; a failed build is reported once
 by a warning, and the runs stay on the provisional function.
@@ -28,6 +31,7 @@ from typing import TYPE_CHECKING
 
 from .compiled import (
     ALSO_CLEARED,
+    ENGINE_FLAGS,
     _refuse_closed,
     _symbolic_parts,
     arguments,
@@ -36,12 +40,14 @@ from .compiled import (
     library_key,
     mkq_function,
     planar_function,
+    recursion_units,
 )
 from .cost import evaluation_path
 from .functions import CompiledFunction, ProvisionalFunction
 from .integrator_c import integrator_library
 from .integrator_ldl import ldl_source
 from .interpreter import FirstFunction, Interpreted, Unreadable, program
+from .runtime_engine import RuntimeFunction, runtime_function
 from .symbolic_accel import accel_source
 from .toolchain import CompilerError, build_soon, cached_library, compiler
 
@@ -50,7 +56,10 @@ if TYPE_CHECKING:
 
 #: the first runs of a symbolic-path model interpreted while its library compiles
 FIRST_RUN_INTERPRETED = True
-#: the first runs of a recursion-path model on its -O0 build while the -O2 one compiles
+#: the first runs of a recursion-path model on its engine sized at run time while its library
+#: compiles
+FIRST_RUN_RUNTIME = True
+#: else on its -O0 build while the -O2 one compiles
 FIRST_RUN_QUICK = True
 
 
@@ -66,8 +75,10 @@ def _run_function(system: System) -> CompiledFunction:
     if cached_mkq(system) is not None:  # a warm start: nothing derived
         return mkq_function(system)  # (the memoized one, which takes the same recipe)
     first: ProvisionalFunction | None = _interpreted(system) if FIRST_RUN_INTERPRETED else None
+    path = evaluation_path(system).path
+    if first is None and FIRST_RUN_RUNTIME and path in ("planar", "spatial"):
+        first = _runtime(system, path == "planar")
     if first is None and FIRST_RUN_QUICK and not os.environ.get("JOURDAIN_OPTIMIZE", "").strip():
-        path = evaluation_path(system).path
         if path in ("planar", "spatial"):
             fn = (planar_function if path == "planar" else dynamics_function)(system, quick=True)
             first = fn if isinstance(fn, ProvisionalFunction) else None
@@ -104,6 +115,20 @@ def _interpreted(system: System) -> FirstFunction | None:
         return None
     return FirstFunction(names, shapes, arguments(system), key, f, len(system.parameters),
                          len(system.inputs), lib, interp=Interpreted(prog, bool(ldl_source(f))))
+
+
+def _runtime(system: System, planar: bool) -> RuntimeFunction | None:
+    """The recursion's engine sized at run time, where the path is a recursion, its library
+    not at hand and its per-joint code readable; else None."""
+    units = recursion_units(system, planar)
+    key = library_key(units, ((), ENGINE_FLAGS))
+    if cached_library(key) is not None:
+        return None
+    try:
+        return runtime_function(system, planar, units, key, arguments(system),
+                                integrator_library())
+    except (Unreadable, CompilerError):
+        return None
 
 
 def run_function(system: System) -> CompiledFunction:

@@ -71,6 +71,15 @@ UNITS: tuple[tuple[str, tuple[str, ...], tuple[str, ...]], ...] = (
     ("#define JD_SOLVE_N_PARAM const long jd_n_,\n#define JD_F jd_n_\n"
      "#define jd_solve_mkq jd_solve_loop\n",
      ("jd_inline.h", "sincos.h", "ldl_solve.h", "interpreter.h"), ()),
+    # the recursions' engines sized at run time, planar and spatial (runtime_head.h: their
+    # jd_local on the interpreter above, numeric/runtime_engine.py); at -O1, which reorders no
+    # arithmetic either: where the library is not prebuilt, they add 0.25-0.35 s to its build
+    # (0.6 s at -O2; 0.65-0.9 s without them; 2-core AMD EPYC, 2026-11-27), and their first
+    # runs take 1.3-2 times the model library's time per state at either level
+    ("#define JD_RT_PLANAR 1\n", ("runtime_head.h", "planar_engine.h", "runtime_engine.h"),
+     ("-O1",)),
+    ("#define JD_RT_PLANAR 0\n", ("runtime_head.h", "recursive_engine.h", "runtime_engine.h"),
+     ("-O1",)),
 )
 
 _TABLE = re.compile(r"static const double (\w+)(?:\[\d+\])? = \{?([^};]*)\}?;")
@@ -151,7 +160,8 @@ def prebuild(dest: Path) -> Path:
 def integrator_library() -> ctypes.CDLL:
     """The compiled integrator (built once, cached on disk like the model code, or prebuilt):
     its translation units (:data:`UNITS`: the step loops at -O2, the kernels at -O3, the
-    interpreter of generated code), its entry points typed."""
+    interpreter of generated code, the recursions sized at run time), its entry points
+    typed."""
     key, texts, flags = library_source()
     lib = toolchain.build(key, texts, unit_flags=flags)
     vp, lg, db = ctypes.c_void_p, ctypes.c_long, ctypes.c_double
@@ -164,4 +174,9 @@ def integrator_library() -> ctypes.CDLL:
     lib.jd_interp_fn.argtypes = [vp, vp, vp, db, vp, vp, vp]
     lib.jd_interp_batch.restype = None
     lib.jd_interp_batch.argtypes = [vp, lg, lg, vp, vp, vp, vp, lg, vp, lg, vp]
+    for engine in ("plane", "spatial"):  # the recursions sized at run time (runtime_engine.h)
+        fn, batch = getattr(lib, f"jd_rt_{engine}_fn"), getattr(lib, f"jd_rt_{engine}_batch")
+        fn.restype, batch.restype = None, None
+        fn.argtypes = [vp, vp, vp, db, vp, vp, vp]
+        batch.argtypes = [vp, lg, lg, vp, vp, vp, vp, lg, vp, lg, vp]
     return lib

@@ -147,24 +147,41 @@ void jd_interp_batch(const jd_interp *P, long n, long f, const double *y, const 
                      out + i * P->n_out);
 }
 
+/* the program on one state into out, the mirrors copied (r: its n_reg registers): the
+   runtime-sized engines' jd_local (runtime_engine.h) */
+void jd_interp_eval(const void *ctx, double *r, const double *y, const double *yd, double t,
+                    const double *p, const double *u, double *out) {
+    const jd_interp *P = (const jd_interp *)ctx;
+    jd_interp_run(P, r, y, yd, t, p, u, out);
+    for (long i = 0; i < P->n_mirror; ++i) out[P->mirror[2 * i]] = out[P->mirror[2 * i + 1]];
+}
+
+/* the generated jd_accel's power ẏᵀq and solve ÿ = M⁻¹(q − k) from buf = [M (its upper
+   triangle and diagonal read), k, q], written out or the loop (work: 2f² + 3f): 0, 1 (M not
+   positive definite) or 2 (NaN or inf); also the runtime-sized engines' where the
+   articulated bodies do not apply */
+int jd_interp_solve(long f, long written_out, const double *buf, const double *yd,
+                    double *ydd, double *power, double *work) {
+    const double *M = buf, *k = buf + f * f, *q = k + f;
+    double w = 0.0;
+    for (long i = 0; i < f; ++i) w += yd[i] * q[i];
+    *power = w;
+    return written_out
+        ? jd_solve_written(f, M, k, q, ydd, work, work + f * f, work + 2 * f * f,
+                           work + 2 * f * f + f, work + 2 * f * f + 2 * f)
+        : jd_solve_loop(f, M, k, q, ydd, work);
+}
+
 /* the integrator's right-hand side (jd_problem.accel_ctx), as the library's jd_accel:
    0, 1 (M not positive definite) or 2 (NaN or inf) */
 int jd_interp_accel(const void *ctx, const double *y, const double *yd, double t,
                     const double *p, const double *u, double *ydd, double *power) {
     const jd_interp *P = (const jd_interp *)ctx;
-    const long f = P->f;
     double *r = jd_interp_work(P);
     if (!r) return 2;
     double *buf = r + P->n_reg, *work = buf + P->n_out;
     jd_interp_run(P, r, y, yd, t, p, u, buf);  /* M's upper triangle and diagonal, k, q */
-    const double *M = buf, *k = buf + f * f, *q = k + f;
-    double w = 0.0;
-    for (long i = 0; i < f; ++i) w += yd[i] * q[i];
-    *power = w;
-    int status = P->written_out
-        ? jd_solve_written(f, M, k, q, ydd, work, work + f * f, work + 2 * f * f,
-                           work + 2 * f * f + f, work + 2 * f * f + 2 * f)
-        : jd_solve_loop(f, M, k, q, ydd, work);
+    int status = jd_interp_solve(P->f, P->written_out, buf, yd, ydd, power, work);
     free(r);
     return status;
 }

@@ -24,8 +24,8 @@ build the run takes the library's right-hand side (``_Setup.take_compiled`` in
 :mod:`jourdain.simulation.problem`); later runs take the library from their start
 (:func:`jourdain.numeric.first_run.run_function`).
 
-Only the symbolic path is read: the recursions' engines are C compiled with the model's sizes
-as constants; their first runs take the same units compiled at -O0 (:mod:`.first_run`).
+The recursions' per-joint code (``jd_local``, split or not) is read the same way, for their
+engines sized at run time (:mod:`jourdain.numeric.runtime_engine`).
 """
 
 from __future__ import annotations
@@ -202,6 +202,8 @@ class _Reader:
             return self.out_reg[k]
         if name in self.blocks:
             return self.blocks[name] + k
+        if f"{name}[{k}]" in self.names:  # a split function's shared temporaries, x[k]
+            return self.names[f"{name}[{k}]"]
         raise Unreadable(f"unknown array {name!r}")
 
     def call(self, name: str) -> int:
@@ -238,10 +240,11 @@ class _Reader:
         if not s.endswith(";"):
             raise Unreadable(f"not a statement: {s[:80]!r}")
         s = s[:-1]
-        m = re.fullmatch(r"double jd_a\[(\d+)\], jd_s\[\1\], jd_c\[\1\]", s)
+        # a split function (ccode.function_source) declares jd_a alone: its pairs go to x
+        m = re.fullmatch(r"double jd_a\[(\d+)\](, jd_s\[\1\], jd_c\[\1\])?", s)
         if m:
             n = int(m.group(1))
-            for name in ("jd_a", "jd_s", "jd_c"):
+            for name in ("jd_a", "jd_s", "jd_c")[:3 if m.group(2) else 1]:
                 self.blocks[name] = self.n_var
                 self.n_var += n
             return
@@ -250,6 +253,18 @@ class _Reader:
             if self.blocks["jd_c"] != self.blocks["jd_s"] + int(m.group(1)):
                 raise Unreadable("sin/cos blocks")
             self.ops.extend((SINCOS, self.blocks["jd_s"], self.blocks["jd_a"], int(m.group(1))))
+            return
+        # (a split function's sin/cos pairs in x[0 … 2n), its temporaries in x[k] after them)
+        m = re.fullmatch(r"jd_sincos_n\(jd_a, (\d+), x, x \+ \1\)", s)
+        if m:
+            n, first = int(m.group(1)), self.n_var
+            self.n_var += 2 * n
+            self.names.update((f"x[{k}]", first + k) for k in range(2 * n))
+            self.ops.extend((SINCOS, first, self.blocks["jd_a"], n))
+            return
+        m = re.fullmatch(r"(x\[\d+\]) = (.*)", s)
+        if m:
+            self.names[m.group(1)] = self.parse(m.group(2))
             return
         m = re.fullmatch(r"const double (x\d+) = (.*)", s)
         if m:

@@ -13,12 +13,20 @@
    com (2), I_zz, f (2), l_z; per column: J_R,z, J_T (2) */
 #define JD_PB 17
 
-typedef struct {
-    double c[JD_P], s[JD_P], o[2 * JD_P], w[JD_P], v[2 * JD_P], al[JD_P], a[2 * JD_P];
-    double V[3 * JD_NC];
-    double I[4 * JD_P], B[3 * JD_P], Wr[3 * JD_P];     /* each body's own */
-    double Ic[4 * JD_P], Bc[3 * JD_P], Wc[3 * JD_P];   /* summed over its sub-tree */
-} jd_plane;
+/* The work's arrays, by type, name and length, as an X-macro: JD_ARRAY makes each an array
+   of its length here, and a pointer into one allocation in the runtime-sized engine
+   (runtime_head.h, whose JD_RT_FIELD adds the sizes and tables it reads) */
+#ifndef JD_ARRAY
+#define JD_ARRAY(type, name, n) type name[n];
+#define JD_RT_FIELD
+#endif
+#define JD_PLANE_ARRAYS(JD_X) \
+    JD_X(double, c, JD_P) JD_X(double, s, JD_P) JD_X(double, o, 2 * JD_P) JD_X(double, w, JD_P) \
+    JD_X(double, v, 2 * JD_P) JD_X(double, al, JD_P) JD_X(double, a, 2 * JD_P) \
+    JD_X(double, V, 3 * JD_NC) \
+    JD_X(double, I, 4 * JD_P) JD_X(double, B, 3 * JD_P) JD_X(double, Wr, 3 * JD_P) /* own */ \
+    JD_X(double, Ic, 4 * JD_P) JD_X(double, Bc, 3 * JD_P) JD_X(double, Wc, 3 * JD_P) /* sub-tree */
+typedef struct { JD_PLANE_ARRAYS(JD_ARRAY) JD_RT_FIELD } jd_plane;
 
 static inline double jd_dot3(const double *a, const double *b) {
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
@@ -128,6 +136,17 @@ static void jd_plane_project(const jd_plane *W, double *M, double *k, double *q)
         for (int s = 0; s < r; ++s) M[r * JD_F + s] = M[s * JD_F + r];
 }
 
+/* the power ẏᵀq of the applied forces (q_j: the columns of coordinate j on the wrenches
+   of q̄^e summed over their sub-trees) */
+static double jd_plane_power(const jd_plane *W, const double *yd) {
+    double w = 0.0;
+    for (int b = 0; b < JD_P; ++b)
+        for (int c = jd_col_start[b]; c < jd_col_start[b + 1]; ++c)
+            w += yd[jd_col_coord[c]] * jd_dot3(W->V + 3 * c, W->Wc + 3 * b);
+    return w;
+}
+
+#ifndef JD_RUNTIME  /* the entry points; the runtime-sized engine has its own (runtime_engine.h) */
 /* the work on the stack when small (JD_PLANE_STACK, as recursive_engine.h's JD_WORK_STACK:
    threads may have small stacks), else on the heap */
 void jd_fn(const double *y, const double *yd, double t, const double *p, const double *u,
@@ -146,6 +165,7 @@ void jd_fn(const double *y, const double *yd, double t, const double *p, const d
     free(W);
 #endif
 }
+#endif
 
 /* jd_fn_batch: ccode.batch_source, appended by planar_recursion.py */
 
@@ -188,9 +208,10 @@ static int jd_small_inverse(int n, const double *D, double *Dinv, double scale) 
     return 0;
 }
 
-typedef struct {
-    double IA[6 * JD_P], pA[3 * JD_P], U[3 * JD_NC], Dinv[9 * JD_P], uu[JD_NC], X[3 * JD_P];
-} jd_plane_aba_work;
+#define JD_PLANE_ABA_ARRAYS(JD_X) \
+    JD_X(double, IA, 6 * JD_P) JD_X(double, pA, 3 * JD_P) JD_X(double, U, 3 * JD_NC) \
+    JD_X(double, Dinv, 9 * JD_P) JD_X(double, uu, JD_NC) JD_X(double, X, 3 * JD_P)
+typedef struct { JD_PLANE_ABA_ARRAYS(JD_ARRAY) } jd_plane_aba_work;
 
 static int jd_plane_aba(const jd_plane *W, jd_plane_aba_work *K, double *ydd) {
     double *IA = K->IA, *pA = K->pA, *U = K->U, *Dinv = K->Dinv, *uu = K->uu, *X = K->X;
@@ -265,6 +286,7 @@ static int jd_plane_aba(const jd_plane *W, jd_plane_aba_work *K, double *ydd) {
     return 0;
 }
 
+#ifndef JD_RUNTIME
 /* the integrator's right-hand side: ÿ by the articulated bodies, O(f), and the power ẏᵀq of
    the applied forces */
 int jd_accel(const double *y, const double *yd, double t, const double *p, const double *u,
@@ -279,15 +301,12 @@ int jd_accel(const double *y, const double *yd, double t, const double *p, const
 #endif
     jd_local(y, yd, t, p, u, L);
     jd_plane_recursion(L, yd, &A->W, 1);
-    double w = 0.0;
-    for (int b = 0; b < JD_P; ++b)
-        for (int c = jd_col_start[b]; c < jd_col_start[b + 1]; ++c)
-            w += yd[jd_col_coord[c]] * jd_dot3(A->W.V + 3 * c, A->W.Wc + 3 * b);
-    *power = w;
+    *power = jd_plane_power(&A->W, yd);
     int status = jd_plane_aba(&A->W, &A->K, ydd);
 #if !JD_PLANE_STACK
     free(A);
 #endif
     return status;
 }
+#endif
 #endif

@@ -31,16 +31,24 @@ static inline void jd_inertia_twist(const double *I, const double *V, double *F)
 
 /* everything but the projection: frames, twist columns V (6 per column), composite inertias
    Ic (13 per body), composite wrenches of q_c (Bc) and q_e (Wc), per body also the centre of
-   mass acceleration, Euler term and applied force rows for the full output */
-typedef struct {
-    jd_frame fr[JD_P];
-    double V[6 * JD_NC];
-    double Ic[13 * JD_P], Bc[6 * JD_P], Wc[6 * JD_P];
-    double c[3 * JD_P], qc[6 * JD_P];
-#if JD_ABA
-    double Wb[6 * JD_P];  /* each body's own q_e wrench (own_only: Ic and Bc stay each body's own) */
+   mass acceleration, Euler term and applied force rows for the full output. Its arrays by
+   type, name and length, as an X-macro: JD_ARRAY makes each an array of its length here, and
+   a pointer into one allocation in the runtime-sized engine (runtime_head.h, whose
+   JD_RT_FIELD adds the sizes and tables it reads) */
+#ifndef JD_ARRAY
+#define JD_ARRAY(type, name, n) type name[n];
+#define JD_RT_FIELD
 #endif
-} jd_work;
+#if JD_ABA  /* each body's own q_e wrench (own_only: Ic and Bc stay each body's own) */
+#define JD_WORK_ABA(JD_X) JD_X(double, Wb, 6 * JD_P)
+#else
+#define JD_WORK_ABA(JD_X)
+#endif
+#define JD_WORK_ARRAYS(JD_X) \
+    JD_X(jd_frame, fr, JD_P) JD_X(double, V, 6 * JD_NC) \
+    JD_X(double, Ic, 13 * JD_P) JD_X(double, Bc, 6 * JD_P) JD_X(double, Wc, 6 * JD_P) \
+    JD_X(double, c, 3 * JD_P) JD_X(double, qc, 6 * JD_P) JD_WORK_ABA(JD_X)
+typedef struct { JD_WORK_ARRAYS(JD_ARRAY) JD_RT_FIELD } jd_work;
 
 /* own_only (the articulated bodies): Ic and Bc stay each body's own and only Wc is summed
    (for the power ẏᵀq), with the own Wc kept in Wb */
@@ -259,6 +267,17 @@ static void jd_distribution(const double *L, const jd_work *W, double *Q) {
 }
 #endif
 
+/* the power ẏᵀq of the applied forces (q_j = Σ over the columns of coordinate j of
+   V·(Σ q̄^e as a wrench)) */
+static double jd_power(const jd_work *W, const double *yd) {
+    double w = 0.0;
+    for (int b = 0; b < JD_P; ++b)
+        for (int c = jd_col_start[b]; c < jd_col_start[b + 1]; ++c)
+            w += yd[jd_col_coord[c]] * jd_dot6(W->V + 6 * c, W->Wc + 6 * b);
+    return w;
+}
+
+#ifndef JD_RUNTIME  /* the entry points; the runtime-sized engine has its own (runtime_engine.h) */
 void jd_fn(const double *y, const double *yd, double t, const double *p, const double *u,
            double *out) {
     double L[JD_NL > 0 ? JD_NL : 1];
@@ -284,6 +303,7 @@ void jd_fn(const double *y, const double *yd, double t, const double *p, const d
     free(W);
 #endif
 }
+#endif
 
 /* jd_fn_batch: ccode.batch_source, appended by recursive.py */
 
@@ -358,8 +378,10 @@ static int jd_spd_inverse(int n, const double *D, double *Dinv, double scale) {
    carry none (S_iᵀ·f_i = 0), which gives ÿ_i = −D_i⁻¹(U_iᵀ·X_λ + S_iᵀ·p^A_i), D = SᵀI^A S,
    U = I^A S, and the parent gains I^A − U D⁻¹ Uᵀ and p^A − U D⁻¹ Sᵀp^A. Body wrenches start
    from q̄^c − q̄^e at ÿ = 0 (B − W). O(f) per state; ÿ and every joint wrench. */
-typedef struct { double IA[36 * JD_P], pA[6 * JD_P], U[36 * JD_P], Dinv[36 * JD_P],
-                 u[6 * JD_P], X[6 * JD_P]; } jd_aba_work;
+#define JD_ABA_ARRAYS(JD_X) \
+    JD_X(double, IA, 36 * JD_P) JD_X(double, pA, 6 * JD_P) JD_X(double, U, 36 * JD_P) \
+    JD_X(double, Dinv, 36 * JD_P) JD_X(double, u, 6 * JD_P) JD_X(double, X, 6 * JD_P)
+typedef struct { JD_ABA_ARRAYS(JD_ARRAY) } jd_aba_work;
 
 static int jd_aba(const jd_work *W, jd_aba_work *A, double *ydd, double *wrench) {
     double scale = 0.0;
@@ -474,6 +496,7 @@ static int jd_aba(const jd_work *W, jd_aba_work *A, double *ydd, double *wrench)
 }
 #endif
 
+#ifndef JD_RUNTIME  /* the joint wrenches and the entry points (not in the runtime-sized engine) */
 /* a wrench about the inertial origin (moment, force) in body i's frame at its origin (F, T) */
 static void jd_to_joint_frames(const jd_work *W, double *wrench) {
     for (int i = 0; i < JD_P; ++i) {
@@ -540,13 +563,10 @@ int jd_accel(const double *y, const double *yd, double t, const double *p, const
              double *ydd, double *power) {
     jd_work *W = jd_at_state(y, yd, t, p, u, sizeof(jd_aba_work));
     if (!W) return 2;
-    double w = 0.0;
-    for (int b = 0; b < JD_P; ++b)
-        for (int c = jd_col_start[b]; c < jd_col_start[b + 1]; ++c)
-            w += yd[jd_col_coord[c]] * jd_dot6(W->V + 6 * c, W->Wc + 6 * b);
-    *power = w;
+    *power = jd_power(W, yd);
     int status = jd_aba(W, (jd_aba_work *)(W + 1), ydd, NULL);
     free(W);
     return status;
 }
+#endif
 #endif
