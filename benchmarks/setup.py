@@ -84,6 +84,28 @@ integrator library, their per-joint code interpreted (``numeric/runtime_engine.p
 bit): cold, build + first step after the import, cart(31) 0.286 → 0.088 s, chain(8)
 0.324 → 0.077 s, chain(16) 0.245 → 0.054 s.
 
+Warm starts without the derivation (``numeric/recipes.py``: the library named by a recipe kept
+under an exact fingerprint of the model; ``numeric/native.py``: the native target asked of the
+compiler once per processor, not in every process, 7-8 ms), 2026-11-27, ``--trials 3``, the
+tree before (9473c84) and after in turn, twice, a machine loaded by other work (import
+0.19-0.27 s): warm, build + first step after the import, in s (rounds 1 and 2):
+
+| model | before | after |
+| --- | ---: | ---: |
+| cart(1) | 0.010, 0.010 | 0.009, 0.008 |
+| cart(4) | 0.015, 0.022 | 0.011, 0.010 |
+| cart(8) | 0.040, 0.046 | 0.013, 0.009 |
+| cart(16) | 0.064, 0.103 | 0.017, 0.016 |
+| cart(31) | 0.065, 0.094 | 0.017, 0.015 |
+| chain(2) | 0.020, 0.021 | 0.019, 0.018 |
+| chain(4) | 0.071, 0.085 | 0.018, 0.015 |
+| chain(8) | 0.129, 0.082 | 0.016, 0.018 |
+| chain(16) | 0.043, 0.040 | 0.024, 0.033 |
+
+What is left of a warm start after the import is the model's own construction (its
+validation; ``spatial_chain``'s random inertias import ``numpy.random``), the fingerprint (1 µs
+per piece: 0.2-2 ms here, 15-25 ms for models of f = 127) and the run's setup.
+
     .venv/bin/python benchmarks/setup.py                   # f = 2 … 32, 5 trials (minutes)
     .venv/bin/python benchmarks/setup.py --quick           # f = 2 and 5, 2 trials
     .venv/bin/python benchmarks/setup.py --mujoco --json setup.json
