@@ -102,6 +102,26 @@ tree before (9473c84) and after in turn, twice, a machine loaded by other work (
 | chain(8) | 0.129, 0.082 | 0.016, 0.018 |
 | chain(16) | 0.043, 0.040 | 0.024, 0.033 |
 
+All of issue 35's setup work together (the interpreter, the engines sized at run time, the
+recipes), ``--trials 3 --mujoco``, the tree before (9473c84, which had the interpreter and the
+-O0 first builds) and after in turn, a quieter machine (import 0.14-0.19 s), in s:
+
+| model | cold before → after | cold after the import | warm before → after | warm after the import | MuJoCo |
+| --- | ---: | ---: | ---: | ---: | ---: |
+| cart(1) | 0.191 → 0.227 | 0.014 → 0.020 | 0.181 → 0.192 | 0.011 → 0.008 | 0.268 |
+| cart(4) | 0.165 → 0.239 | 0.021 → 0.030 | 0.176 → 0.170 | 0.018 → 0.010 | 0.277 |
+| cart(8) | 0.187 → 0.213 | 0.031 → 0.043 | 0.170 → 0.165 | 0.026 → 0.010 | 0.223 |
+| cart(16) | 0.284 → 0.255 | 0.096 → 0.116 | 0.222 → 0.209 | 0.062 → 0.014 | 0.198 |
+| cart(31) | 0.520 → 0.227 | 0.313 → 0.072 | 0.242 → 0.201 | 0.075 → 0.021 | 0.197 |
+| chain(2) | 0.215 → 0.179 | 0.036 → 0.028 | 0.217 → 0.194 | 0.026 → 0.016 | 0.138 |
+| chain(4) | 0.310 → 0.259 | 0.111 → 0.091 | 0.288 → 0.151 | 0.091 → 0.016 | 0.126 |
+| chain(8) | 0.562 → 0.253 | 0.367 → 0.086 | 0.304 → 0.163 | 0.115 → 0.017 | 0.183 |
+| chain(16) | 0.490 → 0.256 | 0.301 → 0.070 | 0.207 → 0.161 | 0.043 → 0.022 | 0.186 |
+
+(the symbolic path's cold columns did not change in code: their spread is the machine's; the
+step loop in the same run: 0.115 µs per right-hand side, jd_accel alone 0.097 µs (19 %),
+chained 0.104 µs (11 %); jd_accel alone varies between processes from 0.077 to 0.097 µs.)
+
 What is left of a warm start after the import is the model's own construction (its
 validation; ``spatial_chain``'s random inertias import ``numpy.random``), the fingerprint (1 µs
 per piece: 0.2-2 ms here, 15-25 ms for models of f = 127) and the run's setup.
