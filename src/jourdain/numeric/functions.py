@@ -195,6 +195,49 @@ class ProvisionalFunction(CompiledFunction):
 
 
 @dataclass(frozen=True, eq=False)
+class ContextFunction(ProvisionalFunction):
+    """A provisional function whose entry points in ``lib`` (the integrator's library) take a
+    context first, :attr:`ctx_address`: the interpreter's program
+    (:class:`jourdain.numeric.interpreter.FirstFunction`) or an engine sized at run time
+    (:class:`jourdain.numeric.runtime_engine.RuntimeFunction`). A subclass names them
+    (:meth:`entries`) and its context; the integrator's right-hand side is
+    ``jd_problem.accel_ctx`` with ``ctx``."""
+
+    def entries(self) -> tuple[Any, Any, Any]:
+        """``lib``'s M, k, q of one state, of a batch, and ÿ (each with the context first)."""
+        raise NotImplementedError
+
+    @property
+    def address(self) -> int:
+        return 0  # no function without its context: the problem takes accel_ctx
+
+    @property
+    def accel_address(self) -> int | None:
+        return None
+
+    @property
+    def accel_ctx_address(self) -> int | None:
+        return ctypes.cast(self.entries()[2], ctypes.c_void_p).value
+
+    def raw(self, y: np.ndarray, yd: np.ndarray, t: float, p: np.ndarray, u: np.ndarray,
+            out: np.ndarray | None = None) -> np.ndarray:
+        if out is None:
+            out = np.empty(self.size)
+        ctx = self.ctx_address
+        assert ctx is not None
+        self.entries()[0](ctx, y.ctypes.data, yd.ctypes.data, ctypes.c_double(t),
+                          p.ctypes.data, u.ctypes.data, out.ctypes.data)
+        return out
+
+    def _batch(self, n: int, Y: np.ndarray, YD: np.ndarray, T: np.ndarray, P: np.ndarray,
+               ps: int, U: np.ndarray, us: int, out: np.ndarray) -> None:
+        ctx = self.ctx_address
+        assert ctx is not None
+        self.entries()[1](ctx, n, self.f, Y.ctypes.data, YD.ctypes.data, T.ctypes.data,
+                          P.ctypes.data, ps, U.ctypes.data, us, out.ctypes.data)
+
+
+@dataclass(frozen=True, eq=False)
 class InterpretedFunction(CompiledFunction):
     """The same interface without a C compiler: SymEngine's ``Lambdify`` (its LLVM backend
     when available, else its interpreter). Slower; simulation needs the compiled form."""

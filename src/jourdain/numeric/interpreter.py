@@ -34,10 +34,11 @@ import ctypes
 import re
 import struct
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
-from .functions import ProvisionalFunction
+from .functions import ContextFunction
 
 #: operation codes (interpreter.h's JI_* in order)
 (ADD, SUB, MUL, DIV, NEG, SQ, CUBE, POWI, SQRT, FN1, ATAN2, POW, FMAX, FMIN, SINCOS, STORE,
@@ -356,42 +357,16 @@ class Interpreted:
 
 
 @dataclass(frozen=True, eq=False)
-class FirstFunction(ProvisionalFunction):
+class FirstFunction(ContextFunction):
     """The interface of :class:`CompiledFunction` on the interpreter: ``lib`` is the
-    integrator's library, ``interp`` the program; :attr:`accel_ctx_address` and
-    :attr:`ctx_address` are the integrator's right-hand side (``jd_problem.accel_ctx``, ``ctx``).
+    integrator's library, ``interp`` the program (the context of ``jd_interp_*``).
     ``compiled`` holds the compiled function once the thread that builds it is done."""
 
     interp: Interpreted | None = field(default=None, repr=False)
 
-    @property
-    def address(self) -> int:
-        return 0  # no function without its context: the problem takes accel_ctx
-
-    @property
-    def accel_address(self) -> int | None:
-        return None
-
-    @property
-    def accel_ctx_address(self) -> int | None:
-        return ctypes.cast(self.lib.jd_interp_accel, ctypes.c_void_p).value
+    def entries(self) -> tuple[Any, Any, Any]:
+        return self.lib.jd_interp_fn, self.lib.jd_interp_batch, self.lib.jd_interp_accel
 
     @property
     def ctx_address(self) -> int | None:
         return None if self.interp is None else self.interp.address
-
-    def raw(self, y: np.ndarray, yd: np.ndarray, t: float, p: np.ndarray, u: np.ndarray,
-            out: np.ndarray | None = None) -> np.ndarray:
-        if out is None:
-            out = np.empty(self.size)
-        assert self.interp is not None
-        self.lib.jd_interp_fn(self.interp.address, y.ctypes.data, yd.ctypes.data,
-                              ctypes.c_double(t), p.ctypes.data, u.ctypes.data, out.ctypes.data)
-        return out
-
-    def _batch(self, n: int, Y: np.ndarray, YD: np.ndarray, T: np.ndarray, P: np.ndarray,
-               ps: int, U: np.ndarray, us: int, out: np.ndarray) -> None:
-        assert self.interp is not None
-        self.lib.jd_interp_batch(self.interp.address, n, self.f, Y.ctypes.data, YD.ctypes.data,
-                                 T.ctypes.data, P.ctypes.data, ps, U.ctypes.data, us,
-                                 out.ctypes.data)

@@ -28,11 +28,11 @@ from __future__ import annotations
 import ctypes
 import re
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .functions import ProvisionalFunction
+from .functions import ContextFunction
 from .integrator_ldl import ldl_source
 from .interpreter import Interpreted, Program, Unreadable, _body, _Reader
 from .recursive import BODY_BLOCK
@@ -105,7 +105,7 @@ class RuntimeContext:
 
 
 @dataclass(frozen=True, eq=False)
-class RuntimeFunction(ProvisionalFunction):
+class RuntimeFunction(ContextFunction):
     """The interface of :class:`CompiledFunction` on an engine sized at run time: ``lib`` is the
     integrator's library, ``engine`` ``"plane"`` or ``"spatial"`` (its entry points
     ``jd_rt_<engine>_…``), ``aba`` whether ÿ is the articulated bodies' (else M, k, q and the
@@ -116,39 +116,14 @@ class RuntimeFunction(ProvisionalFunction):
     engine: str = "spatial"
     aba: bool = False
 
-    @property
-    def address(self) -> int:
-        return 0  # no function without its context: the problem takes accel_ctx
-
-    @property
-    def accel_address(self) -> int | None:
-        return None
-
-    @property
-    def accel_ctx_address(self) -> int | None:
-        entry = getattr(self.lib, f"jd_rt_{self.engine}_{'accel' if self.aba else 'ldl'}")
-        return ctypes.cast(entry, ctypes.c_void_p).value
+    def entries(self) -> tuple[Any, Any, Any]:
+        e = self.engine
+        return (getattr(self.lib, f"jd_rt_{e}_fn"), getattr(self.lib, f"jd_rt_{e}_batch"),
+                getattr(self.lib, f"jd_rt_{e}_{'accel' if self.aba else 'ldl'}"))
 
     @property
     def ctx_address(self) -> int | None:
         return None if self.context is None else self.context.address
-
-    def raw(self, y: np.ndarray, yd: np.ndarray, t: float, p: np.ndarray, u: np.ndarray,
-            out: np.ndarray | None = None) -> np.ndarray:
-        if out is None:
-            out = np.empty(self.size)
-        assert self.context is not None
-        getattr(self.lib, f"jd_rt_{self.engine}_fn")(
-            self.context.address, y.ctypes.data, yd.ctypes.data, ctypes.c_double(t),
-            p.ctypes.data, u.ctypes.data, out.ctypes.data)
-        return out
-
-    def _batch(self, n: int, Y: np.ndarray, YD: np.ndarray, T: np.ndarray, P: np.ndarray,
-               ps: int, U: np.ndarray, us: int, out: np.ndarray) -> None:
-        assert self.context is not None
-        getattr(self.lib, f"jd_rt_{self.engine}_batch")(
-            self.context.address, n, self.f, Y.ctypes.data, YD.ctypes.data, T.ctypes.data,
-            P.ctypes.data, ps, U.ctypes.data, us, out.ctypes.data)
 
 
 def runtime_function(system: System, planar: bool, units: tuple[str, str], key: str,
