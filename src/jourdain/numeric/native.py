@@ -31,16 +31,19 @@ CPU_FIELDS = ("vendor_id", "cpu family", "model", "model name", "stepping", "mic
 def cpu_identity(path: str = "/proc/cpuinfo") -> str | None:
     """The identifying lines of the first processor in ``path`` (:data:`CPU_FIELDS`), or None
     where it cannot be read or names none of them."""
+    keep = []
     try:
         with open(path, encoding="utf-8", errors="replace") as fh:
-            text = fh.read()
+            # up to the first blank line only: the kernel writes the file as it is read, one
+            # block per processor (hundreds on a large server)
+            for line in fh:
+                if not line.strip():
+                    break
+                name, _, value = line.partition(":")
+                if name.strip() in CPU_FIELDS:
+                    keep.append(f"{name.strip()}={value.strip()}")
     except OSError:
         return None
-    keep = []
-    for line in text.split("\n\n", 1)[0].splitlines():
-        name, _, value = line.partition(":")
-        if name.strip() in CPU_FIELDS:
-            keep.append(f"{name.strip()}={value.strip()}")
     return "\n".join(keep) or None
 
 
