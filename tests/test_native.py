@@ -148,3 +148,37 @@ def test_a_source_that_does_not_compile_leaves_native_code_on(monkeypatch, tmp_p
         toolchain.build(toolchain.content_key("broken source", src), src)
     assert toolchain._native_failed == set()
     assert toolchain.host_flags() == ("-O2",)
+
+
+#: lanes that add and subtract what the source writes as a product and a sum: GCC 12.2 -O2
+#: with -march=native on an AVX-512 machine (and -march=skylake-avx512) vectorized x[20] and
+#: x[21] into one vfmaddsub despite -ffp-contract=off (reduced from random_tree(70, seed=3)'s
+#: per-joint code, whose ÿ then differed from the -O0 build's at 15 of 200 states)
+FUSABLE = """
+void jd_probe(double *x) {
+    x[10] = (-0.4721937725576087*x[0]);
+    x[11] = ((0.16217774529983747*x[1]) + x[10]);
+    x[20] = ((-0.16217774529983747*x[1]) + x[10]);
+    x[21] = ((0.36829466850378856*x[0]) + x[2]);
+}
+"""
+
+
+def test_no_fused_multiply_add_where_the_vectorizer_pairs_lanes(cache):
+    """Every product and sum rounded apart, as the source writes them (numeric/toolchain.py's
+    NO_FUSED), against Python's own float arithmetic, which never fuses: a fused lane differs
+    in the last bit at about a third of the random inputs."""
+    lib = toolchain.build(toolchain.content_key("fused lanes", FUSABLE), FUSABLE)
+    probe = lib.jd_probe
+    probe.argtypes, probe.restype = [ctypes.c_void_p], None
+    x = np.zeros(32)
+    wrong = []
+    for a, b, c in np.random.default_rng(1).uniform(-10.0, 10.0, (500, 3)).tolist():
+        x[:3] = a, b, c
+        probe(x.ctypes.data)
+        x10 = -0.4721937725576087 * a
+        want = [x10, 0.16217774529983747 * b + x10, -0.16217774529983747 * b + x10,
+                0.36829466850378856 * a + c]
+        if [x[10], x[11], x[20], x[21]] != want:
+            wrong.append((a, b, c))
+    assert not wrong, f"{len(wrong)} of 500 inputs fused, e.g. {wrong[0]} ({toolchain.host_flags()})"

@@ -5,8 +5,8 @@ Every cache key holds the native target (:func:`jourdain.numeric.toolchain.conte
 asking the compiler's driver for it (:func:`ask_target`) starts a process: 7-8 ms of every
 warm start on the 2-core test machine, a third of what was left of it after the imports. The
 answer depends on the compiler and on the processor only, so it is kept in the cache under a
-key of both (:func:`machine_key`): the compiler's resolved path, size and time of change, and
-the processor's identity as the kernel reports it (vendor, family, model, stepping, microcode,
+key of both (:func:`machine_key`): the compiler's resolved path, size and time of change, the
+flags asked about, and the processor's identity as the kernel reports it (vendor, family, model, stepping, microcode,
 cache size and instruction-set flags from ``/proc/cpuinfo``). A cache shared by machines of
 different processors (a home folder on a cluster) therefore keeps one answer per processor,
 and a changed compiler is asked again. Where ``/proc/cpuinfo`` cannot be read, nothing is
@@ -47,9 +47,9 @@ def cpu_identity(path: str = "/proc/cpuinfo") -> str | None:
     return "\n".join(keep) or None
 
 
-def machine_key(cc: str) -> str | None:
-    """The key of the native target of compiler ``cc`` on this processor, or None where either
-    cannot be identified."""
+def machine_key(cc: str, flags: tuple[str, ...] = ()) -> str | None:
+    """The key of the native target of compiler ``cc`` with ``flags`` on this processor, or None
+    where either cannot be identified."""
     cpu = cpu_identity()
     try:
         real = os.path.realpath(cc)
@@ -58,7 +58,7 @@ def machine_key(cc: str) -> str | None:
         return None
     if cpu is None:
         return None
-    text = f"{real}\0{st.st_size}\0{st.st_mtime_ns}\0{cpu}"
+    text = f"{real}\0{st.st_size}\0{st.st_mtime_ns}\0{' '.join(flags)}\0{cpu}"
     return hashlib.sha256(text.encode()).hexdigest()[:32]
 
 
@@ -86,7 +86,7 @@ def native_target_of(cc: str, flags: tuple[str, ...], folder: Path | None) -> st
     """:func:`ask_target`, kept in ``folder`` (the cache; None: nowhere) under
     :func:`machine_key` as a sealed file, and read from there when kept (an answer of None is
     not kept)."""
-    key = machine_key(cc) if folder is not None else None
+    key = machine_key(cc, flags) if folder is not None else None
     path = folder / f"native-{key}.target" if folder is not None and key is not None else None
     if path is not None:
         data = read_sealed(path)
