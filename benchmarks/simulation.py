@@ -49,7 +49,8 @@ loop also compiled for AVX2 (−20 ns in M, k, q but not in jd_accel). 10× PyDy
 about 400 ns per right-hand side. Fewer right-hand sides with Verner's "most efficient" 7(6)
 pair (10 per step)? No: driven by SciPy's RungeKutta against its DOP853 on the same function, it
 needed as many for the same final error (4 812 evaluations for 7.5e-7 against 4 742 for 6.5e-7).
-Compiled for the machine (-march=native, AVX-512, -ffp-contract=off: bit-identical numbers) and
+Compiled for the machine (-march=native, AVX-512, -ffp-contract=off: bit-identical numbers; since
+2026-11-27 without FMA and AVX-512, numeric/toolchain.py NO_FUSED, at the same speed) and
 with the stage sums in registers: 8.4-8.7× → 9.2-9.4× PyDy at n = 12, 440-470 ns per
 right-hand side (two alternated rounds on a loaded machine). Tried then and not kept: the LDLᵀ
 written out at f = 13 under AVX-512 (32 registers): 343 → 277 ns in the C microbenchmark, but

@@ -78,13 +78,15 @@ CFLAGS = ("-O2", "-fPIC", "-shared", "-fno-math-errno", "-std=c99", "-ffp-contra
 #: them at every vector length). ``-ffp-contract=off`` keeps the compiler from fusing a product
 #: and a sum that the source writes apart, but GCC 12's vectorizer does not ask it there: its
 #: SLP pattern for lanes that add and subtract the same operands takes a product in as
-#: ``vfmaddsub``/``vfmsubadd`` (GCC 12.2 -O2 with -march=native on AVX-512 or skylake-avx512;
-#: later GCC checks the flag). One rounding fewer: ``random_tree(70, seed=3)``'s ÿ differed
-#: from the -O0 and -O1 builds' (and the first runs') by up to 6e-13 at 15 of 200 states,
-#: and 6 of the libraries in this machine's caches held such instructions. Without these sets
-#: no vectorizer can form one; batches of M, k, q went 0.83-1.09× the time of the build with
-#: AVX-512 (five models, the two alternated in one process; benchmarks/simulation.py
-#: cross-checks the end-to-end figure).
+#: ``vfmaddsub``/``vfmsubadd`` (GCC 12.2 -O2, -march=native on an AVX-512 machine and
+#: -march=skylake-avx512; later GCC checks the flag). One rounding fewer: ``random_tree(70,
+#: seed=3)``'s ÿ differed from the -O0 and -O1 builds' (and the first runs') by up to 6e-13 at
+#: 15 of 200 states, and a dozen libraries in this machine's caches held such instructions
+#: (bundled and tutorial models among them; tests/test_native.py). Without these sets
+#: no vectorizer can form one. Against the build with them (2-core AMD EPYC, GCC 12.2, the two
+#: alternated): batches of M, k, q 0.83-1.09× the time (five models, one process); the 12-link
+#: cart end to end (``benchmarks/simulation.py --n 12``, two rounds) 2.056-2.059 → 2.073-2.075
+#: ms at rtol 5e-8, 10.8-11.0× → 10.9-11.5× PyDy.
 NO_FUSED = (("-mno-fma", "-mno-fma4", "-mno-avx512f")
             if getattr(os, "uname", None) and os.uname().machine.lower() in
             ("x86_64", "amd64", "i386", "i686") else ())
