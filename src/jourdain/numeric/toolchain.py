@@ -82,7 +82,7 @@ CFLAGS = ("-O2", "-fPIC", "-shared", "-fno-math-errno", "-std=c99", "-ffp-contra
 #: -march=skylake-avx512; later GCC checks the flag). One rounding fewer: ``random_tree(70,
 #: seed=3)``'s ÿ differed from the -O0 and -O1 builds' (and the first runs') by up to 6e-13 at
 #: 15 of 200 states, and a dozen libraries in this machine's caches held such instructions
-#: (bundled and tutorial models among them; tests/test_native.py). Without these sets
+#: (a tutorial's model among them; tests/test_native.py). Without these sets
 #: no vectorizer can form one. Against the build with them (2-core AMD EPYC, GCC 12.2, the two
 #: alternated): batches of M, k, q 0.83-1.09× the time (five models, one process); the 12-link
 #: cart end to end (``benchmarks/simulation.py --n 12``, two rounds) 2.056-2.059 → 2.073-2.075
