@@ -22,6 +22,25 @@ from pathlib import Path
 
 from .cachefile import keep_sealed, read_sealed
 
+#: x86: no instruction set that holds a fused multiply-add (FMA3, FMA4, and AVX-512, which has
+#: them at every vector length). ``-ffp-contract=off`` keeps the compiler from fusing a product
+#: and a sum that the source writes apart, but GCC 12's vectorizer does not ask it there: its
+#: SLP pattern for lanes that add and subtract the same operands takes a product in as
+#: ``vfmaddsub``/``vfmsubadd`` (GCC 12.2 -O2, -march=native on an AVX-512 machine and
+#: -march=skylake-avx512; later GCC checks the flag). One rounding fewer: ``random_tree(70,
+#: seed=3)``'s ÿ differed from the -O0 and -O1 builds' (and the first runs') by up to 6e-13 at
+#: 15 of 200 states, and a dozen libraries in this machine's caches held such instructions
+#: (a tutorial's model among them; tests/test_native.py). Without these sets
+#: no vectorizer can form one. Against the build with them (2-core AMD EPYC, GCC 12.2, the two
+#: alternated): batches of M, k, q 0.83-1.09× the time (five models, one process); the 12-link
+#: cart end to end (``benchmarks/simulation.py --n 12``, two rounds) 2.056-2.059 → 2.073-2.075
+#: ms at rtol 5e-8, 10.8-11.0× → 10.9-11.5× PyDy.
+NO_FUSED = (("-mno-fma", "-mno-fma4", "-mno-avx512f")
+            if getattr(os, "uname", None) and os.uname().machine.lower() in
+            ("x86_64", "amd64", "i386", "i686") else ())
+#: the flags for this machine's instruction set (numeric/toolchain.py's module docstring)
+NATIVE_FLAGS = ("-march=native", *NO_FUSED)
+
 #: the lines of /proc/cpuinfo that identify a processor (not its clock, nor the core's number)
 CPU_FIELDS = ("vendor_id", "cpu family", "model", "model name", "stepping", "microcode",
               "cache size", "flags", "address sizes", "CPU implementer", "CPU architecture",

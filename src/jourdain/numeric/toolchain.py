@@ -14,12 +14,13 @@ changed library is deleted and rebuilt, never handed to the dynamic loader) and 
 key (each library exports its key, read back after loading; each pickle holds its key).
 
 Code for this machine: the libraries are compiled with ``-march=native`` (every instruction set
-extension of the processor but those with fused multiply-adds, :data:`NO_FUSED`) where the
-compiler accepts it, and the key holds the processor's features as the compiler reports them,
-so that a cache shared by different machines never hands one a library built for another.
-``-ffp-contract=off`` keeps every operation of the source a separately rounded one, and
-:data:`NO_FUSED` the vectorizer from fusing any, so the numbers are bit-for-bit those of the
-portable build (tests/test_native.py); only the speed differs. Measured with ``benchmarks/simulation.py`` (12-link pendulum on a cart, AMD EPYC with
+extension of the processor but those with fused multiply-adds,
+:data:`jourdain.numeric.native.NO_FUSED`) where the compiler accepts it, and the key holds the
+processor's features as the compiler reports them, so that a cache shared by different machines
+never hands one a library built for another. ``-ffp-contract=off`` keeps every operation of the
+source a separately rounded one, and ``NO_FUSED`` the vectorizer from fusing any, so the numbers
+are bit-for-bit those of the portable build (tests/test_native.py); only the speed
+differs. Measured with ``benchmarks/simulation.py`` (12-link pendulum on a cart, AMD EPYC with
 AVX-512, alternated with the portable build): M, k, q 222-227 → 179-188 ns, a right-hand side
 480-503 → 440-470 ns, 8.4-8.7× → 9.2-9.4× PyDy. Everything native or nothing: the
 integrator library alone compiled native made the runs slower, not faster (2.30 against 2.10
@@ -69,29 +70,12 @@ from .buildlock import build_soon as build_soon
 from .cachefile import FORMAT, discard, read_sealed, seal, stamp, stamp_of, stamp_source
 from .cachefile import keep_file as keep_file  # the cache's writer, for the other layers
 from .cachefile import not_private as not_private
+from .native import NATIVE_FLAGS as NATIVE_FLAGS  # -march=native, no fused multiply-adds
 from .native import native_target_of
 
 #: Compiler flags; part of every cache key. No -ffast-math: NaN checks must keep working. No
 #: contraction to fused multiply-adds: the same results with and without FMA hardware.
 CFLAGS = ("-O2", "-fPIC", "-shared", "-fno-math-errno", "-std=c99", "-ffp-contract=off")
-#: x86: no instruction set that holds a fused multiply-add (FMA3, FMA4, and AVX-512, which has
-#: them at every vector length). ``-ffp-contract=off`` keeps the compiler from fusing a product
-#: and a sum that the source writes apart, but GCC 12's vectorizer does not ask it there: its
-#: SLP pattern for lanes that add and subtract the same operands takes a product in as
-#: ``vfmaddsub``/``vfmsubadd`` (GCC 12.2 -O2, -march=native on an AVX-512 machine and
-#: -march=skylake-avx512; later GCC checks the flag). One rounding fewer: ``random_tree(70,
-#: seed=3)``'s ÿ differed from the -O0 and -O1 builds' (and the first runs') by up to 6e-13 at
-#: 15 of 200 states, and a dozen libraries in this machine's caches held such instructions
-#: (a tutorial's model among them; tests/test_native.py). Without these sets
-#: no vectorizer can form one. Against the build with them (2-core AMD EPYC, GCC 12.2, the two
-#: alternated): batches of M, k, q 0.83-1.09× the time (five models, one process); the 12-link
-#: cart end to end (``benchmarks/simulation.py --n 12``, two rounds) 2.056-2.059 → 2.073-2.075
-#: ms at rtol 5e-8, 10.8-11.0× → 10.9-11.5× PyDy.
-NO_FUSED = (("-mno-fma", "-mno-fma4", "-mno-avx512f")
-            if getattr(os, "uname", None) and os.uname().machine.lower() in
-            ("x86_64", "amd64", "i386", "i686") else ())
-#: the flags for this machine's instruction set (see the module docstring)
-NATIVE_FLAGS = ("-march=native", *NO_FUSED)
 
 _loaded: dict[str, ctypes.CDLL] = {}
 #: the private directory used instead of a cache directory that is not safe (one per process)
