@@ -20,6 +20,12 @@ and compiles the equations of motion and the reactions, and compares at one stat
   to the largest of ``|f|``, ``|q̄^e|`` and ``|q̄^c|`` (a free-floating tree at rest falls as one
   and its joint wrenches vanish);
 * ``τ``: ``max|rnea(y, ẏ, ÿ)| / max|nle|`` (zero up to rounding: no actuators);
+* ``first``: the model's first run against its compiled library, bit for bit (:func:`first_run`:
+  a motion of 0.3 s, and M, k, q at the states): ``same``, else ``DIFFERS`` (and the exit
+  status is 1). The fresh cache holds nothing, so the first run is what a user's first run is:
+  the recursions' engines sized at run time, the interpreter, or an -O0 build. (It found GCC
+  12's vectorizer fusing multiply-adds in ``random_tree(70, 3)``'s -O2 library:
+  numeric/native.py, ``NO_FUSED``.)
 * ``time``: the child's wall time (imports, derivation, code generation, C compilation, all
   states), and ``source``: the start of the SHA-256 of the generated C sources.
 
@@ -164,12 +170,43 @@ def source_digest(system: Any) -> str:
     return h.hexdigest()
 
 
+def first_run(system: Any, at: list[tuple[np.ndarray, np.ndarray]]) -> dict:
+    """The first run of ``system`` (:func:`jourdain.numeric.first_run.run_function`, its
+    library's build held back) and then its compiled library: whether a motion of 0.3 s from
+    the second state of ``at`` and M, k, q at all of them are the same to the bit, and the
+    kinds of the two functions."""
+    from jourdain.numeric import first_run as runs
+
+    jobs: list = []
+    soon = runs.build_soon
+    runs.build_soon = lambda fn, *args, **kw: jobs.append((fn, args))  # built below instead
+    try:
+        first = runs.run_function(system)
+        motions = [system.simulate((0.0, 0.3), *at[min(1, len(at) - 1)])]
+    finally:
+        runs.build_soon = soon
+    for fn, args in jobs:
+        fn(*args)
+    final = runs.run_function(system)
+    motions.append(system.simulate((0.0, 0.3), *at[min(1, len(at) - 1)]))
+    Y, YD = np.array([y for y, _ in at]), np.array([yd for _, yd in at])
+    one, other = first.batch(Y, YD), final.batch(Y, YD)
+    same = (all(one[k].tobytes() == other[k].tobytes() for k in ("M", "k", "q"))
+            and all(getattr(motions[0], k).tobytes() == getattr(motions[1], k).tobytes()
+                    for k in ("t", "y", "ydd")))
+    return {"first_same": same, "first_kind": type(first).__name__,
+            "final_kind": type(final).__name__}
+
+
 def case(kind: str, n: int, seed: int = 0, n_states: int = 5, state_seed: int = 1) -> dict:
     """One model in this process: f, the largest relative errors over the states of
     :func:`states`, the smallest eigenvalue of M, the source digest, SHA-256 of M and g at all
     states (for bit-for-bit comparison between processes) and timings."""
     t0 = time.perf_counter()
     system, model, index = build(kind, n, seed)
+    t_check = time.perf_counter()
+    first = first_run(system, states(system.f, n_states, state_seed))
+    t0 += time.perf_counter() - t_check  # the timings below as without this check
     worst: dict[str, float] = {}
     hm, hg = hashlib.sha256(), hashlib.sha256()
     t_first = None
@@ -186,7 +223,7 @@ def case(kind: str, n: int, seed: int = 0, n_states: int = 5, state_seed: int = 
             better = min if key == "eig_min" else max
             worst[key] = better(worst.get(key, e), e)
     return {"kind": kind, "n": n, "seed": seed, "f": system.f, "states": n_states + 1,
-            **worst, "source_sha256": source_digest(system), "M_sha256": hm.hexdigest(),
+            **worst, **first, "source_sha256": source_digest(system), "M_sha256": hm.hexdigest(),
             "g_sha256": hg.hexdigest(), "t_first_s": t_first,
             "t_total_s": time.perf_counter() - t0,
             "hashseed": os.environ.get("PYTHONHASHSEED")}
@@ -226,7 +263,7 @@ def spawn(spec: dict, hashseed: int | str, cache: str | os.PathLike | None = Non
 
 
 HEADER = (f"{'model':<22}{'f':>4}{'M(0.1)':>9}{'λ_min(0.1)':>11}{'M':>9}{'λ_min':>10}"
-          f"{'cond':>9}{'nle':>9}{'aba':>9}{'rnea':>9}{'τ':>9}{'time/s':>8}  source")
+          f"{'cond':>9}{'nle':>9}{'aba':>9}{'rnea':>9}{'τ':>9}{'first':>8}{'time/s':>8}  source")
 
 
 def row(r: dict) -> str:
@@ -235,7 +272,8 @@ def row(r: dict) -> str:
             else f"random_tree({r['n']}, {r['seed']})")
     return (f"{name:<22}{r['f']:>4}{r['M_0']:>9.1e}{r['eig_min_0']:>11.2e}{r['M']:>9.1e}"
             f"{r['eig_min']:>10.2e}{r['cond']:>9.1e}{r['nle']:>9.1e}{r['aba']:>9.1e}"
-            f"{r['rnea']:>9.1e}{r['tau']:>9.1e}{r['wall_s']:>8.1f}  {r['source_sha256'][:12]}")
+            f"{r['rnea']:>9.1e}{r['tau']:>9.1e}{'same' if r['first_same'] else 'DIFFERS':>8}"
+            f"{r['wall_s']:>8.1f}  {r['source_sha256'][:12]}")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -265,10 +303,12 @@ def main(argv: list[str] | None = None) -> int:
         print(f"PYTHONHASHSEED={a.hashseed}; errors relative to the largest entry, the largest "
               f"over y = 0.1·1, ẏ = 0 and {a.states} random states")
         print(HEADER)
+    differ = 0
     for spec in specs:
         r = spawn(spec, a.hashseed, a.cache, a.timeout)
         print(json.dumps(r) if a.json else row(r), flush=True)
-    return 0
+        differ += not r["first_same"]
+    return 1 if differ else 0
 
 
 if __name__ == "__main__":

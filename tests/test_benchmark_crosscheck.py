@@ -18,6 +18,8 @@ def test_crosscheck_benchmark_quick_case(capsys):
     (r,) = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
     assert r["hashseed"] == "8" and r["f"] == 8 and r["states"] == 2
     assert r["eig_min"] > 0 and r["eig_min_0"] > 0 and len(r["source_sha256"]) == 64
+    # its first run on the provisional form (nothing compiled yet), then the library: the same
+    assert r["first_kind"] != r["final_kind"] == "CompiledFunction" and r["first_same"]
     # errors relative to the largest entry, far below any modelling error
     assert max(r[k] for k in ("M", "M_0", "nle", "rnea", "tau")) < 1e3 * 2.2e-16 * r["f"]
     assert r["aba"] < 1e3 * 2.2e-16 * r["f"] * r["cond"]
