@@ -6,11 +6,11 @@ asking the compiler's driver for it (:func:`ask_target`) starts a process: 7-8 m
 warm start on the 2-core test machine, a third of what was left of it after the imports. The
 answer depends on the compiler and on the processor only, so it is kept in the cache under a
 key of both (:func:`machine_key`): the compiler's resolved path, size and time of change, the
-flags asked about, and the processor's identity as the kernel reports it (vendor, family, model, stepping, microcode,
-cache size and instruction-set flags from ``/proc/cpuinfo``). A cache shared by machines of
-different processors (a home folder on a cluster) therefore keeps one answer per processor,
-and a changed compiler is asked again. Where ``/proc/cpuinfo`` cannot be read, nothing is
-kept and the compiler is asked in every process, as before.
+flags asked about, and the processor's identity as the kernel reports it (vendor, family,
+model, stepping, microcode, cache size and instruction-set flags from ``/proc/cpuinfo``). A
+cache shared by machines of different processors (a home folder on a cluster) therefore keeps
+one answer per processor, and a changed compiler is asked again. Where ``/proc/cpuinfo``
+cannot be read, nothing is kept and the compiler is asked in every process, as before.
 """
 
 from __future__ import annotations
@@ -30,11 +30,11 @@ from .cachefile import keep_sealed, read_sealed
 #: -march=skylake-avx512; later GCC checks the flag). One rounding fewer: ``random_tree(70,
 #: seed=3)``'s ÿ differed from the -O0 and -O1 builds' (and the first runs') by up to 6e-13 at
 #: 15 of 200 states, and a dozen libraries in this machine's caches held such instructions
-#: (a tutorial's model among them; tests/test_native.py). Without these sets
-#: no vectorizer can form one. Against the build with them (2-core AMD EPYC, GCC 12.2, the two
-#: alternated): batches of M, k, q 0.83-1.09× the time (five models, one process); the 12-link
-#: cart end to end (``benchmarks/simulation.py --n 12``, two rounds) 2.056-2.059 → 2.073-2.075
-#: ms at rtol 5e-8, 10.8-11.0× → 10.9-11.5× PyDy.
+#: (a tutorial's model among them; tests/test_native.py). Without these sets no vectorizer
+#: can form one. Against the build with them (2-core AMD EPYC, GCC 12.2, the two alternated):
+#: batches of M, k, q 0.83-1.09× the time (five models, one process); the 12-link cart end to
+#: end (``benchmarks/simulation.py --n 12``, two rounds) 2.056-2.059 → 2.073-2.075 ms at rtol
+#: 5e-8, 10.8-11.0× → 10.9-11.5× PyDy.
 NO_FUSED = (("-mno-fma", "-mno-fma4", "-mno-avx512f")
             if getattr(os, "uname", None) and os.uname().machine.lower() in
             ("x86_64", "amd64", "i386", "i686") else ())
